@@ -1,0 +1,23 @@
+#!/bin/sh
+# Check that Debian's packages this project needs are installed; install the missing
+# ones with apt-get when running as root, otherwise print the exact command and fail.
+set -eu
+PACKAGES="g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev nlohmann-json3-dev \
+gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
+python3-pytest python3-vtk9 xvfb"
+missing=""
+for p in $PACKAGES; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -z "$missing" ]; then
+    exit 0
+fi
+echo "missing Debian packages:$missing" >&2
+if [ "$(id -u)" = 0 ]; then
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -o DPkg::Lock::Timeout=600
+    apt-get install -y --no-install-recommends -o DPkg::Lock::Timeout=600 $missing
+else
+    echo "run as root:  apt-get update && apt-get install -y$missing" >&2
+    exit 1
+fi

@@ -1,0 +1,124 @@
+"""The driver that the Makefile calls for each Python-side stage of a case.
+
+    /usr/bin/python3 -m pipeline.run check CASE.yaml
+    /usr/bin/python3 -m pipeline.run mesh-parameters CASE.yaml OUT.json   # rewritten only on change
+    /usr/bin/python3 -m pipeline.run mesh CASE.yaml GEO OUT.msh
+    /usr/bin/python3 -m pipeline.run preprocess CASE.yaml MESH OUT_DIR    # nodes.vtu + case.json
+
+Every check runs before any file is written; files are written under a temporary
+name and renamed, so an interrupted stage leaves nothing half-written.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+
+from .case import CaseError, load_case
+from .resolve import resolve
+
+
+def write_atomically(path: str, text: str):
+    directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".tmp-", suffix=os.path.basename(path))
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def cmd_check(args):
+    case = load_case(args.case)
+    print(f"{args.case}: ok ({case['dimension']}D {case['analysis']}, "
+          f"{len(case['materials'])} block(s), end time {case['time']['end']:g} s)")
+
+
+def cmd_mesh_parameters(args):
+    """Keep the gmsh parameters in their own file so that Make re-meshes only when they change."""
+    case = load_case(args.case)
+    text = json.dumps(case["geometry"]["parameters"], sort_keys=True, indent=1) + "\n"
+    try:
+        with open(args.out, encoding="utf-8") as stream:
+            if stream.read() == text:
+                return
+    except OSError:
+        pass
+    write_atomically(args.out, text)
+
+
+def cmd_mesh(args):
+    from preprocess.gmsh_mesh import mesh_geo
+
+    case = load_case(args.case)
+    mesh_geo(args.geo, args.out, case["dimension"], case["geometry"]["parameters"])
+
+
+def cmd_preprocess(args):
+    from preprocess import build_node_cloud
+    from preprocess.node_file import write_node_file
+
+    case = load_case(args.case)
+    disc = case["discretization"]
+    cloud = build_node_cloud(
+        args.mesh,
+        dimension=case["dimension"],
+        thickness=case["thickness"],
+        method=disc["method"],
+        dx=disc["dx"],
+        block_names=list(case["materials"]),
+        set_layers={name: opts["layer"] for name, opts in case["node_sets"].items()
+                    if opts["layer"] is not None},
+    )
+    resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
+                       nodes_file="nodes.vtu")
+    os.makedirs(args.out_dir, exist_ok=True)
+    write_node_file(os.path.join(args.out_dir, "nodes.vtu"), cloud)
+    write_atomically(os.path.join(args.out_dir, "case.json"), json.dumps(resolved, indent=1) + "\n")
+    print(f"{args.case}: {len(cloud.volume)} nodes, dx = {cloud.grid_spacing:.6g} m, "
+          f"horizon = {resolved['horizon']:.6g} m, node sets: {', '.join(resolved['node_sets'])}")
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="pipeline.run", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("check", help="validate a case file")
+    p.add_argument("case")
+    p.set_defaults(func=cmd_check)
+    p = sub.add_parser("mesh-parameters", help="write the gmsh parameters of a case if they changed")
+    p.add_argument("case")
+    p.add_argument("out")
+    p.set_defaults(func=cmd_mesh_parameters)
+    p = sub.add_parser("mesh", help="mesh the case's .geo with gmsh")
+    p.add_argument("case")
+    p.add_argument("geo")
+    p.add_argument("out")
+    p.set_defaults(func=cmd_mesh)
+    p = sub.add_parser("preprocess", help="mesh → node cloud (nodes.vtu) and resolved case.json")
+    p.add_argument("case")
+    p.add_argument("mesh")
+    p.add_argument("out_dir")
+    p.set_defaults(func=cmd_preprocess)
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except CaseError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except Exception as err:  # preprocess errors carry the file name in their message
+        if type(err).__name__ == "PreprocessError":
+            print(f"error: {err}", file=sys.stderr)
+            return 2
+        raise
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

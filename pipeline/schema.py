@@ -1,0 +1,172 @@
+"""The case-file schema, declared once: every key with its type, default, SI unit and one-line doc.
+
+Each stage reads the part it needs from the validated case; docs/case-file.md is
+generated from this table (`/usr/bin/python3 -m pipeline.schema`), so the
+documentation cannot drift from what the code accepts.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+REQUIRED = object()  # marks a key without a default
+
+
+@dataclass
+class Key:
+    """One key of the case file.
+
+    kind: number | integer | string | choice | section | named (user-named
+    sub-sections, e.g. materials) | list (of sections) | names (list of strings)
+    | components (x/y/z → number or [[t, v], ...] table) | numbers (list of
+    numbers) | parameters (name → number) | number_or_choice.
+    """
+    kind: str
+    doc: str
+    default: Any = None
+    unit: str = ""
+    choices: tuple = ()
+    minimum: float | None = None          # inclusive
+    above: float | None = None            # exclusive lower bound
+    fields: dict[str, "Key"] = field(default_factory=dict)
+    table: bool = True                    # components: allow a time table
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED
+
+
+def section(doc: str, **fields: Key) -> Key:
+    return Key("section", doc, default={}, fields=fields)
+
+
+COMPONENT_DOC = ("per component x, y, z: a number, or a table [[t0, v0], [t1, v1], ...] "
+                 "interpolated linearly in time and held constant outside it")
+
+MATERIAL = {
+    "model": Key("choice", "constitutive model (bond-based prototype microelastic brittle)",
+                 default="pmb", choices=("pmb",)),
+    "density": Key("number", "mass density ρ", default=REQUIRED, unit="kg/m³", above=0.0),
+    "youngs_modulus": Key("number", "Young's modulus E (bond-based PMB fixes ν: 1/4 in 3D and "
+                          "plane strain, 1/3 in plane stress)", default=REQUIRED, unit="Pa", above=0.0),
+    "fracture_energy": Key("number", "critical energy release rate G0; omit for an unbreakable "
+                           "material", default=None, unit="J/m²", above=0.0),
+}
+
+BOUNDARY_CONDITION = {
+    "set": Key("string", "node set (a gmsh physical group name)", default=REQUIRED),
+    "displacement": Key("components", "prescribed displacement; " + COMPONENT_DOC, unit="m"),
+    "velocity": Key("components", "prescribed velocity; " + COMPONENT_DOC, unit="m/s"),
+    "body_force": Key("components", "body force density b added to every node of the set "
+                      "(thesis §2.1: loads act in a layer); " + COMPONENT_DOC, unit="N/m³"),
+}
+
+INITIAL_CONDITION = {
+    "set": Key("string", "node set (a gmsh physical group name)", default=REQUIRED),
+    "velocity": Key("components", "initial velocity per component x, y, z", unit="m/s", table=False),
+    "displacement": Key("components", "initial displacement per component x, y, z", unit="m",
+                        table=False),
+}
+
+CASE = {
+    "title": Key("string", "a one-line description, shown in figures", default=""),
+    "dimension": Key("choice", "spatial dimension of the geometry", default=REQUIRED, choices=(2, 3)),
+    "analysis": Key("choice", "3d, or the 2D model; default 3d in 3D and plane_stress in 2D",
+                    default=None, choices=("3d", "plane_stress", "plane_strain")),
+    "thickness": Key("number", "plate thickness h of a 2D case (node volume = area × h)",
+                     default=None, unit="m", above=0.0),
+    "geometry": section(
+        "how gmsh meshes cases/<case>/<case>.geo",
+        parameters=Key("parameters", "values passed to gmsh as -setnumber NAME VALUE, overriding "
+                       "the .geo's DefineConstant[] entries", default={}),
+    ),
+    "discretization": section(
+        "how the mesh becomes a node cloud",
+        method=Key("choice", "lattice: a regular grid of spacing dx clipped to the mesh (most stable); "
+                   "mesh-nodes: the mesh's own nodes", default="lattice",
+                   choices=("lattice", "mesh-nodes")),
+        dx=Key("number", "lattice spacing; required for lattice", default=None, unit="m", above=0.0),
+        horizon_factor=Key("number", "horizon δ = horizon_factor × dx (thesis §2.1: δ = 3dx works well; "
+                           "the extra 0.015 keeps lattice bonds at exactly 3dx)", default=3.015, above=0.0),
+        horizon=Key("number", "horizon δ; overrides horizon_factor", default=None, unit="m", above=0.0),
+    ),
+    "materials": Key("named", "one entry per block, named after a gmsh physical group of the "
+                     "top dimension (surface in 2D, volume in 3D)", default=REQUIRED, fields=MATERIAL),
+    "node_sets": Key("named", "options of node sets (every gmsh physical group is a node set)",
+                     default={}, fields={
+                         "layer": Key("number", "nodes within this distance of a curve/surface group "
+                                      "belong to it (thesis §2.1: conditions act in a layer); default: "
+                                      "the first row of nodes", default=None, unit="m", minimum=0.0),
+                     }),
+    "no_fail": Key("names", "node sets whose bonds never break (e.g. where loads are applied)",
+                   default=[]),
+    "boundary_conditions": Key("list", "conditions applied during the run", default=[],
+                               fields=BOUNDARY_CONDITION),
+    "initial_conditions": Key("list", "state at t = 0 (the rest of the body starts at rest)",
+                              default=[], fields=INITIAL_CONDITION),
+    "damping": Key("number", "velocity damping α: force density −ρ·α·v (the thesis's damping "
+                   "correction); 0 for none", default=0.0, unit="1/s", minimum=0.0),
+    "time": section(
+        "time integration",
+        end=Key("number", "simulated end time", default=REQUIRED, unit="s", above=0.0),
+        integrator=Key("choice", "time integrator", default="verlet", choices=("verlet",)),
+        dt=Key("number_or_choice", "time step: 'stable' (thesis eq. 2.5, minimised over nodes, times "
+               "safety_factor) or a number", default="stable", unit="s", choices=("stable",), above=0.0),
+        safety_factor=Key("number", "fraction of the stable time step used", default=0.8, above=0.0),
+        max_steps=Key("integer", "stop after this many steps", default=100_000_000, minimum=1),
+    ),
+    "output": section(
+        "what the solver writes and how often",
+        every_time=Key("number", "a frame every this much simulated time (default: end/50)",
+                       default=None, unit="s", above=0.0),
+        every_steps=Key("integer", "a frame every this many steps (instead of every_time)",
+                        default=None, minimum=1),
+        history_every=Key("integer", "a history.csv row every this many steps", default=1, minimum=1),
+    ),
+    "figures": section(
+        "what postprocess draws",
+        times=Key("numbers", "simulated times of the damage and displacement maps (default: four "
+                  "frames spread over the run)", default=None, unit="s"),
+        displacement_component=Key("choice", "displacement component coloured in the maps",
+                                   default="x", choices=("x", "y", "z")),
+    ),
+}
+
+
+def markdown() -> str:
+    """The case-file reference, generated from CASE."""
+    rows = ["# Case file reference", "",
+            "Generated from pipeline/schema.py by `/usr/bin/python3 -m pipeline.schema`; "
+            "do not edit by hand. SI units throughout.", "",
+            "| key | type | default | unit | meaning |", "|---|---|---|---|---|"]
+
+    def fmt_default(key: Key) -> str:
+        if key.required:
+            return "**required**"
+        if key.default is None or key.default == {} or key.default == []:
+            return "–"
+        return f"`{key.default}`"
+
+    def kind_text(key: Key) -> str:
+        if key.kind in ("choice", "number_or_choice"):
+            extra = " or number" if key.kind == "number_or_choice" else ""
+            return " \\| ".join(str(c) for c in key.choices) + extra
+        return key.kind
+
+    def emit(keys: dict, prefix: str):
+        for name, key in keys.items():
+            path = f"{prefix}{name}"
+            rows.append(f"| `{path}` | {kind_text(key)} | {fmt_default(key)} | {key.unit} | {key.doc} |")
+            if key.kind == "section":
+                emit(key.fields, path + ".")
+            elif key.kind == "named":
+                emit(key.fields, path + ".<name>.")
+            elif key.kind == "list":
+                emit(key.fields, path + "[].")
+
+    emit(CASE, "")
+    return "\n".join(rows) + "\n"
+
+
+if __name__ == "__main__":
+    print(markdown(), end="")

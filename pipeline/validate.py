@@ -1,0 +1,258 @@
+"""Check a loaded case file against pipeline/schema.py and fill in the defaults.
+
+Every error names the file, the line and the key, and says what to do:
+    plate.yaml:14: time.safety_factr: unknown key (did you mean 'safety_factor'?)
+All errors of a file are collected and reported together, before any work is done.
+"""
+from __future__ import annotations
+
+import copy
+import difflib
+import math
+import re
+
+from .schema import CASE, REQUIRED, Key
+from .yaml_lines import CaseError
+
+NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+COMPONENTS = ("x", "y", "z")
+
+
+class _Checker:
+    def __init__(self, path: str, lines: dict):
+        self.path = path
+        self.lines = lines
+        self.errors: list[str] = []
+
+    def line_of(self, keypath: tuple) -> int:
+        # The nearest enclosing key that has a line: a missing key reports its parent's line.
+        while keypath and keypath not in self.lines:
+            keypath = keypath[:-1]
+        return self.lines.get(keypath, 1)
+
+    def error(self, keypath: tuple, message: str):
+        dotted = ".".join(f"[{p}]" if isinstance(p, int) else str(p) for p in keypath).replace(".[", "[")
+        self.errors.append(f"{self.path}:{self.line_of(keypath)}: {dotted or '<top>'}: {message}")
+
+    # -- scalar kinds -------------------------------------------------------
+    def number(self, value, keypath: tuple, key: Key):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}")
+            return None
+        value = float(value)
+        if not math.isfinite(value):
+            self.error(keypath, f"expected a finite number, got {value!r}")
+            return None
+        return self.bounds(value, keypath, key)
+
+    def integer(self, value, keypath: tuple, key: Key):
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.error(keypath, f"expected a whole number, got {value!r}")
+            return None
+        return self.bounds(value, keypath, key)
+
+    def bounds(self, value, keypath, key: Key):
+        if key.above is not None and not value > key.above:
+            self.error(keypath, f"must be greater than {key.above:g}{self.unit(key)}, got {value:g}")
+            return None
+        if key.minimum is not None and value < key.minimum:
+            self.error(keypath, f"must be at least {key.minimum:g}{self.unit(key)}, got {value:g}")
+            return None
+        return value
+
+    @staticmethod
+    def unit(key: Key) -> str:
+        return f" [{key.unit}]" if key.unit else ""
+
+    def choice(self, value, keypath: tuple, key: Key):
+        if value in key.choices and not isinstance(value, bool):
+            return value
+        options = ", ".join(repr(c) for c in key.choices)
+        hint = self.closest(str(value), [str(c) for c in key.choices])
+        self.error(keypath, f"{value!r} is not one of {options}{hint}")
+        return None
+
+    @staticmethod
+    def closest(word: str, candidates) -> str:
+        match = difflib.get_close_matches(word, list(candidates), n=1, cutoff=0.5)
+        return f" (did you mean '{match[0]}'?)" if match else ""
+
+    # -- composite kinds ----------------------------------------------------
+    def check(self, value, keypath: tuple, key: Key):
+        kind = key.kind
+        if kind == "number":
+            return self.number(value, keypath, key)
+        if kind == "integer":
+            return self.integer(value, keypath, key)
+        if kind == "string":
+            if not isinstance(value, str) or not value:
+                self.error(keypath, f"expected a non-empty text, got {value!r}")
+                return None
+            return value
+        if kind == "choice":
+            return self.choice(value, keypath, key)
+        if kind == "number_or_choice":
+            if isinstance(value, str):
+                return self.choice(value, keypath, key)
+            return self.number(value, keypath, key)
+        if kind == "section":
+            return self.mapping(value, keypath, key.fields)
+        if kind == "named":
+            return self.named(value, keypath, key)
+        if kind == "list":
+            if not isinstance(value, list):
+                self.error(keypath, "expected a list of entries ('- set: ...')")
+                return []
+            return [self.mapping(item, keypath + (i,), key.fields) for i, item in enumerate(value)]
+        if kind == "names":
+            if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+                self.error(keypath, f"expected a list of node-set names, got {value!r}")
+                return []
+            return list(value)
+        if kind == "numbers":
+            if not isinstance(value, list):
+                self.error(keypath, f"expected a list of numbers{self.unit(key)}, got {value!r}")
+                return None
+            out = [self.number(v, keypath + (i,), Key("number", "", unit=key.unit))
+                   for i, v in enumerate(value)]
+            return None if None in out else out
+        if kind == "parameters":
+            if not isinstance(value, dict):
+                self.error(keypath, "expected NAME: number entries")
+                return {}
+            out = {}
+            for name, v in value.items():
+                if not NAME_PATTERN.match(name):
+                    self.error(keypath + (name,), "a gmsh parameter name is letters, digits and '_'")
+                out[name] = self.number(v, keypath + (name,), Key("number", ""))
+            return out
+        if kind == "components":
+            return self.components(value, keypath, key)
+        raise AssertionError(f"schema kind {kind!r} has no checker")
+
+    def mapping(self, value, keypath: tuple, fields: dict):
+        if value is None:
+            value = {}
+        if not isinstance(value, dict):
+            self.error(keypath, f"expected a section of keys ({', '.join(fields)}), got {value!r}")
+            return {}
+        out = {}
+        for name, item in value.items():
+            if name not in fields:
+                self.error(keypath + (name,), f"unknown key{self.closest(name, fields)}; "
+                           f"known keys here: {', '.join(fields)}")
+        for name, key in fields.items():
+            if name in value and value[name] is not None:
+                out[name] = self.check(value[name], keypath + (name,), key)
+            elif key.required:
+                self.error(keypath + (name,), f"missing required key: {key.doc}")
+                out[name] = None
+            elif key.kind == "section":
+                out[name] = self.mapping({}, keypath + (name,), key.fields)
+            else:
+                out[name] = copy.deepcopy(key.default)
+        return out
+
+    def named(self, value, keypath: tuple, key: Key):
+        if not isinstance(value, dict) or (key.required and not value):
+            self.error(keypath, "expected one or more NAME: entries, NAME a gmsh physical group")
+            return {}
+        out = {}
+        for name, entry in value.items():
+            if not NAME_PATTERN.match(name):
+                self.error(keypath + (name,), "a name is letters, digits and '_', not starting with a digit")
+            out[name] = self.mapping(entry, keypath + (name,), key.fields)
+        return out
+
+    def components(self, value, keypath: tuple, key: Key):
+        if not isinstance(value, dict) or not value:
+            self.error(keypath, "expected components, e.g. {x: 0.0, z: 1.5}")
+            return {}
+        out = {}
+        for comp, v in value.items():
+            if comp not in COMPONENTS:
+                self.error(keypath + (comp,), f"unknown component{self.closest(str(comp), COMPONENTS)}; "
+                           "use x, y or z")
+                continue
+            out[comp] = self.table(v, keypath + (comp,), key)
+        return out
+
+    def table(self, value, keypath: tuple, key: Key):
+        """A number, or [[t, v], ...] with t strictly increasing: returned as (times, values)."""
+        if isinstance(value, list) and key.table:
+            times, values = [], []
+            for i, row in enumerate(value):
+                if (not isinstance(row, list) or len(row) != 2 or
+                        any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in row)):
+                    self.error(keypath + (i,), f"a table row is [time, value], got {row!r}")
+                    return None
+                times.append(float(row[0]))
+                values.append(float(row[1]))
+            if not times:
+                self.error(keypath, "the table is empty; give a number or [[t0, v0], ...]")
+                return None
+            if any(b <= a for a, b in zip(times, times[1:])):
+                self.error(keypath, f"table times must increase strictly, got {times}")
+                return None
+            return (times, values)
+        number = self.number(value, keypath, Key("number", "", unit=key.unit))
+        return None if number is None else ([0.0], [number])
+
+
+def validate(data, path: str, lines: dict) -> dict:
+    """Return the case with defaults filled in, or raise CaseError listing every problem."""
+    checker = _Checker(path, lines)
+    if not isinstance(data, dict):
+        raise CaseError(f"{path}:1: the case file must be a mapping of keys (dimension:, materials:, ...)")
+    case = checker.mapping(data, (), CASE)
+    if checker.errors:
+        raise CaseError("\n".join(checker.errors))
+    _check_context(case, checker)
+    if checker.errors:
+        raise CaseError("\n".join(checker.errors))
+    return case
+
+
+def _check_context(case: dict, checker: _Checker):
+    """Rules that tie one key to another."""
+    dim = case["dimension"]
+    if case["analysis"] is None:
+        case["analysis"] = "3d" if dim == 3 else "plane_stress"
+    if dim == 3 and case["analysis"] != "3d":
+        checker.error(("analysis",), f"'{case['analysis']}' is a 2D model but dimension is 3; use 3d")
+    if dim == 2 and case["analysis"] == "3d":
+        checker.error(("analysis",), "dimension is 2: use plane_stress or plane_strain")
+    if dim == 2 and case["thickness"] is None:
+        checker.error(("thickness",), "a 2D case needs thickness [m] (node volume = area × thickness)")
+    if dim == 3 and case["thickness"] is not None:
+        checker.error(("thickness",), "thickness is for 2D cases only; remove it")
+    disc = case["discretization"]
+    if disc["method"] == "lattice" and disc["dx"] is None:
+        checker.error(("discretization", "dx"), "the lattice method needs dx [m], the node spacing")
+    if disc["horizon"] is not None and disc["dx"] is not None and disc["horizon"] < disc["dx"]:
+        checker.error(("discretization", "horizon"),
+                      f"horizon {disc['horizon']:g} m is smaller than dx {disc['dx']:g} m: nodes would "
+                      "have no bonds; use about 3·dx")
+    if disc["horizon"] is None and disc["horizon_factor"] < 1.0:
+        checker.error(("discretization", "horizon_factor"),
+                      "must be at least 1 (the horizon must reach the nearest neighbour); use about 3")
+    for i, bc in enumerate(case["boundary_conditions"]):
+        kinds = [k for k in ("displacement", "velocity", "body_force") if bc[k]]
+        if not kinds:
+            checker.error(("boundary_conditions", i), "give displacement, velocity or body_force")
+        prescribed = set(bc["displacement"] or {}) & set(bc["velocity"] or {})
+        for comp in sorted(prescribed):
+            checker.error(("boundary_conditions", i, "velocity", comp),
+                          f"component {comp} is given both a displacement and a velocity; keep one")
+        if dim == 2:
+            pass  # z is allowed in 2D: a membrane moves out of its plane
+    for i, ic in enumerate(case["initial_conditions"]):
+        if not ic["velocity"] and not ic["displacement"]:
+            checker.error(("initial_conditions", i), "give velocity or displacement")
+    out = case["output"]
+    if out["every_time"] is not None and out["every_steps"] is not None:
+        checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
+    if out["every_time"] is None and out["every_steps"] is None:
+        out["every_time"] = case["time"]["end"] / 50.0

@@ -1,0 +1,161 @@
+"""The case-file loader: defaults, and errors that name the file, the line and the key."""
+import os
+import textwrap
+
+import pytest
+
+from pipeline import schema
+from pipeline.case import CaseError, load_case
+from pipeline.resolve import check_set_names, resolve
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+MINIMAL = """\
+dimension: 2
+thickness: 0.001
+discretization:
+  dx: 0.001
+materials:
+  plate:
+    density: 2000
+    youngs_modulus: 1.0e9
+time:
+  end: 1.0e-3
+"""
+
+
+def write(tmp_path, text, name="plate.yaml"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return str(path)
+
+
+def error_of(tmp_path, text):
+    with pytest.raises(CaseError) as info:
+        load_case(write(tmp_path, text))
+    return str(info.value)
+
+
+def test_defaults_are_filled_in(tmp_path):
+    case = load_case(write(tmp_path, MINIMAL))
+    assert case["analysis"] == "plane_stress"
+    assert case["discretization"]["method"] == "lattice"
+    assert case["discretization"]["horizon_factor"] == 3.015
+    assert case["time"]["dt"] == "stable"
+    assert case["time"]["safety_factor"] == 0.8
+    assert case["output"]["every_time"] == pytest.approx(1.0e-3 / 50)
+    assert case["materials"]["plate"]["fracture_energy"] is None
+    assert case["_name"] == "plate"
+
+
+def test_unknown_key_names_line_and_closest_key(tmp_path):
+    text = MINIMAL.replace("  end: 1.0e-3", "  end: 1.0e-3\n  safety_factr: 0.5")
+    message = error_of(tmp_path, text)
+    assert "plate.yaml:11: time.safety_factr: unknown key (did you mean 'safety_factor'?)" in message
+
+
+def test_missing_required_key(tmp_path):
+    message = error_of(tmp_path, MINIMAL.replace("    density: 2000\n", ""))
+    assert "plate.yaml:6: materials.plate.density: missing required key" in message
+
+
+def test_wrong_type_and_out_of_range_are_all_reported(tmp_path):
+    text = (MINIMAL.replace("youngs_modulus: 1.0e9", "youngs_modulus: -5")
+            .replace("dx: 0.001", "dx: fine"))
+    message = error_of(tmp_path, text)
+    assert "plate.yaml:4: discretization.dx: expected a number [m], got 'fine'" in message
+    assert "plate.yaml:8: materials.plate.youngs_modulus: must be greater than 0 [Pa], got -5" in message
+
+
+def test_unknown_choice_suggests(tmp_path):
+    message = error_of(tmp_path, MINIMAL + "analysis: plane_stres\n")
+    assert "plate.yaml:11: analysis: 'plane_stres' is not one of" in message
+    assert "did you mean 'plane_stress'?" in message
+
+
+def test_2d_needs_thickness(tmp_path):
+    message = error_of(tmp_path, MINIMAL.replace("thickness: 0.001\n", ""))
+    assert "thickness: a 2D case needs thickness" in message
+
+
+def test_horizon_smaller_than_dx(tmp_path):
+    message = error_of(tmp_path, MINIMAL.replace("dx: 0.001", "dx: 0.001\n  horizon: 0.0005"))
+    assert "discretization.horizon: horizon 0.0005 m is smaller than dx 0.001 m" in message
+
+
+def test_time_table_must_increase(tmp_path):
+    text = MINIMAL + textwrap.dedent("""\
+        boundary_conditions:
+          - set: left
+            velocity: {x: [[0.0, 0.0], [0.0, 1.0]]}
+        """)
+    message = error_of(tmp_path, text)
+    assert "boundary_conditions[0].velocity.x: table times must increase strictly" in message
+
+
+def test_displacement_and_velocity_on_same_component(tmp_path):
+    text = MINIMAL + textwrap.dedent("""\
+        boundary_conditions:
+          - set: left
+            displacement: {x: 0.0}
+            velocity: {x: 1.0}
+        """)
+    message = error_of(tmp_path, text)
+    assert "component x is given both a displacement and a velocity" in message
+
+
+def test_invalid_yaml_names_line(tmp_path):
+    message = error_of(tmp_path, MINIMAL + "time: [unclosed\n")
+    assert message.startswith(str(tmp_path / "plate.yaml") + ":")
+    assert "not valid YAML" in message
+
+
+def test_duplicate_key(tmp_path):
+    message = error_of(tmp_path, MINIMAL + "damping: 1.0\ndamping: 2.0\n")
+    assert "plate.yaml:12: key 'damping' appears twice" in message
+
+
+def test_missing_node_set_lists_existing(tmp_path):
+    text = MINIMAL + textwrap.dedent("""\
+        boundary_conditions:
+          - set: lefft
+            displacement: {x: 0.0}
+        """)
+    case = load_case(write(tmp_path, text))
+    with pytest.raises(CaseError) as info:
+        check_set_names(case, ["left", "right", "plate"])
+    message = str(info.value)
+    assert "plate.yaml:12: node set 'lefft' is not a physical group of the mesh (did you mean 'left'?)" in message
+    assert "the mesh has: left, plate, right" in message
+
+
+def test_resolve_expands_components_and_tables(tmp_path):
+    text = MINIMAL + textwrap.dedent("""\
+        boundary_conditions:
+          - set: left
+            displacement: {x: 0.0, z: [[0.0, 0.0], [1.0e-3, 2.0e-5]]}
+        initial_conditions:
+          - set: plate
+            velocity: {y: 3.5}
+        """)
+    case = load_case(write(tmp_path, text))
+    resolved = resolve(case, node_sets=["left", "plate"], grid_spacing=0.001, nodes_file="nodes.vtu")
+    assert resolved["horizon"] == pytest.approx(3.015e-3)
+    assert resolved["boundary_conditions"] == [
+        {"set": "left", "kind": "displacement", "component": 0, "times": [0.0], "values": [0.0]},
+        {"set": "left", "kind": "displacement", "component": 2, "times": [0.0, 1.0e-3],
+         "values": [0.0, 2.0e-5]},
+    ]
+    assert resolved["initial_conditions"] == [
+        {"set": "plate", "kind": "velocity", "component": 1, "value": 3.5}]
+    assert resolved["blocks"][0]["id"] == 1 and resolved["blocks"][0]["name"] == "plate"
+
+
+def test_membrane_case_is_valid():
+    case = load_case(os.path.join(ROOT, "cases", "membrane", "membrane.yaml"))
+    assert case["dimension"] == 2 and "membrane" in case["materials"]
+
+
+def test_case_file_reference_is_generated_from_schema():
+    with open(os.path.join(ROOT, "docs", "case-file.md"), encoding="utf-8") as stream:
+        assert stream.read() == schema.markdown(), "regenerate: /usr/bin/python3 -m pipeline.schema > docs/case-file.md"
