@@ -1,0 +1,80 @@
+"""The part of the resolved case.json (pipeline/formats.md §3) that the postprocessor uses."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import numbers
+
+from .errors import PostprocessError
+
+AXES = "xyz"
+
+
+@dataclasses.dataclass
+class CaseSettings:
+    name: str                       # `case`: shown in every title
+    dimension: int                  # 2 or 3
+    title: str = ""                 # one-line description, if the case has one
+    grid_spacing: float | None = None   # dx [m]: sizes the markers of the maps
+    times: list | None = None       # `figures.times` [s], or None for four frames spread over the run
+    component: int = 0              # `figures.displacement_component`: 0, 1, 2 for x, y, z
+    block_names: dict = dataclasses.field(default_factory=dict)  # block id -> name, for Gmsh
+
+    @property
+    def heading(self) -> str:
+        """The case's name, with its title when it has one."""
+        return f"{self.name} ({self.title})" if self.title else self.name
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def load_case_settings(path: str) -> CaseSettings:
+    """Read and check the keys postprocess needs; an error names the file and the key."""
+    try:
+        with open(path, encoding="utf-8") as stream:
+            case = json.load(stream)
+    except FileNotFoundError:
+        raise PostprocessError(f"{path}: no such file; preprocess the case first (make case=<case>), "
+                               f"or point to it with --case-json PATH") from None
+    except json.JSONDecodeError as error:
+        raise PostprocessError(f"{path}:{error.lineno}:{error.colno}: not valid JSON ({error.msg})") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise PostprocessError(f"{path}: cannot read: {error}") from None
+    if not isinstance(case, dict):
+        raise PostprocessError(f"{path}: expected a JSON object (pipeline/formats.md §3)")
+
+    def fail(key, what):
+        raise PostprocessError(f"{path}: {key}: {what} (pipeline/formats.md §3)")
+
+    name = case.get("case")
+    if not isinstance(name, str) or not name:
+        fail("case", f"expected the case name, got {name!r}")
+    dimension = case.get("dimension")
+    if dimension not in (2, 3) or isinstance(dimension, bool):
+        fail("dimension", f"expected 2 or 3, got {dimension!r}")
+    title = case.get("title") or ""
+    if not isinstance(title, str):
+        fail("title", f"expected a string, got {title!r}")
+    spacing = case.get("grid_spacing")
+    if spacing is not None and not (_is_number(spacing) and spacing > 0):
+        fail("grid_spacing", f"expected a length > 0 [m], got {spacing!r}")
+
+    figures = case.get("figures") or {}
+    if not isinstance(figures, dict):
+        fail("figures", f"expected an object, got {figures!r}")
+    times = figures.get("times")
+    if times is not None:
+        if not isinstance(times, list) or not times or not all(_is_number(t) for t in times):
+            fail("figures.times", f"expected a non-empty list of times [s] or null, got {times!r}")
+        times = [float(t) for t in times]
+    component = figures.get("displacement_component", 0)
+    if component not in (0, 1, 2) or isinstance(component, bool):
+        fail("figures.displacement_component", f"expected 0, 1 or 2 (x, y, z), got {component!r}")
+    blocks = case.get("blocks") or []
+    block_names = {b["id"]: b["name"] for b in blocks if isinstance(b, dict)
+                   and isinstance(b.get("id"), int) and isinstance(b.get("name"), str)}
+    return CaseSettings(name=name, dimension=dimension, title=title,
+                        grid_spacing=None if spacing is None else float(spacing),
+                        times=times, component=int(component), block_names=block_names)

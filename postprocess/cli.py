@@ -1,0 +1,159 @@
+"""The command line: read a case's solver output and write its figures and Gmsh views.
+
+    /usr/bin/python3 -m postprocess OUT_DIR [--case-json PATH] [--only figures|gmsh]
+
+Reads OUT_DIR/case.json (or PATH), OUT_DIR/history.csv and OUT_DIR/frames.pvd with its frames;
+writes OUT_DIR/figures/{energy,timestep,probe,damage_<i>,displacement_<i>}.png and
+OUT_DIR/gmsh/{results.msh,damage_final.pos}. Every frame is read once, in order.
+Exit status 0 on success, 1 with a message naming the file on an error, 2 on a usage error.
+"""
+from __future__ import annotations
+
+import argparse
+import glob
+import os
+import re
+import sys
+
+from .casefile import load_case_settings
+from .errors import PostprocessError
+from .history import read_history
+from .series import read_frame, read_series
+from .selection import centre_node, default_times, select_frames
+
+MAP_NAME = re.compile(r"(damage|displacement)_(\d+)\.png$")
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python3 -m postprocess",
+        description="Figures (PNG) and Gmsh views of a solver run (pipeline/formats.md §4).")
+    parser.add_argument("out_dir", metavar="OUT_DIR", help="the case's output directory, e.g. out/membrane")
+    parser.add_argument("--case-json", metavar="PATH",
+                        help="the resolved case (default: OUT_DIR/case.json)")
+    parser.add_argument("--only", choices=("figures", "gmsh"), help="write only the figures or only the Gmsh files")
+    return parser
+
+
+def _check_inputs(out_dir: str, case_json: str, need_history: bool):
+    """Every input present, or one error listing what is missing and how to make it."""
+    if not os.path.isdir(out_dir):
+        raise PostprocessError(f"{out_dir}: no such directory; run the case first: "
+                               f"make case={os.path.basename(os.path.normpath(out_dir))}")
+    needed = [case_json, os.path.join(out_dir, "frames.pvd")]
+    if need_history:
+        needed.append(os.path.join(out_dir, "history.csv"))
+    missing = [path for path in needed if not os.path.isfile(path)]
+    if missing:
+        name = os.path.basename(os.path.normpath(out_dir))
+        if os.path.isfile(case_json):
+            try:
+                name = load_case_settings(case_json).name
+            except PostprocessError:
+                pass
+        stage = "preprocess and solve" if case_json in missing else "run the solver"
+        raise PostprocessError("missing input: " + ", ".join(missing) +
+                               f"; {stage} first: make case={name}")
+
+
+def _remove_stale_maps(directory: str, count: int):
+    """Maps numbered ≥ count are left from an earlier run with more `figures.times`: remove them."""
+    for path in glob.glob(os.path.join(directory, "*.png")):
+        match = MAP_NAME.search(os.path.basename(path))
+        if match and int(match.group(2)) >= count:
+            os.unlink(path)
+
+
+def run(out_dir: str, case_json: str | None = None, only: str | None = None, log=print) -> list[str]:
+    """Write the outputs of one case; returns the paths written."""
+    case_json = case_json or os.path.join(out_dir, "case.json")
+    do_figures, do_gmsh = only in (None, "figures"), only in (None, "gmsh")
+    _check_inputs(out_dir, case_json, need_history=do_figures)
+    case = load_case_settings(case_json)
+    series = read_series(os.path.join(out_dir, "frames.pvd"))
+    times = [t for t, _ in series]
+    history = read_history(os.path.join(out_dir, "history.csv")) if do_figures else None
+
+    requested, selected = [], []
+    if do_figures:
+        requested = case.times if case.times is not None else default_times(times)
+        selected = select_frames(times, requested)
+        for t in requested:
+            if t < times[0] or t > times[-1]:
+                print(f"postprocess: note: figures.times {t:g} s is outside the run "
+                      f"[{times[0]:g}, {times[-1]:g}] s; drawing the nearest frame", file=sys.stderr)
+
+    kept: dict = {}
+    probe: dict = {"values": [], "node": None, "position": None}
+    state: dict = {"last": None, "count": None}
+
+    def frames():
+        """Each frame once: feeds the probe, keeps the frames the maps need, and yields for Gmsh."""
+        for index, (t, path) in enumerate(series):
+            frame = read_frame(path)
+            if state["count"] is None:
+                state["count"] = len(frame.points)
+                probe["node"] = centre_node(frame.points)
+                probe["position"] = frame.points[probe["node"]]
+            elif len(frame.points) != state["count"]:
+                raise PostprocessError(f"{path}: {len(frame.points)} points, the first frame "
+                                       f"{series[0][1]} has {state['count']}")
+            probe["values"].append(float(frame.displacement[probe["node"], case.component]))
+            if index in selected:
+                kept[index] = frame
+            state["last"] = (index, t, frame)
+            yield index, t, frame
+
+    written = []
+    if do_gmsh:
+        from .gmsh_export import write_damage_pos, write_results_msh
+
+        gmsh_dir = os.path.join(out_dir, "gmsh")
+        path = os.path.join(gmsh_dir, "results.msh")
+        write_results_msh(path, frames(), block_names=case.block_names or None)
+        written.append(path)
+        index, t, frame = state["last"]
+        path = os.path.join(gmsh_dir, "damage_final.pos")
+        write_damage_pos(path, frame, time=t, title=f"{case.heading}, frame {index}")
+        written.append(path)
+    else:
+        for _ in frames():
+            pass
+
+    if do_figures:
+        from .energy_plot import plot_energy
+        from .maps import displacement_range, plot_map
+        from .probe import plot_probe
+        from .timestep_plot import plot_timestep
+
+        fig_dir = os.path.join(out_dir, "figures")
+        path = os.path.join(fig_dir, "energy.png")
+        plot_energy(history, case, path)
+        written.append(path)
+        path = os.path.join(fig_dir, "timestep.png")
+        plot_timestep(history, case, path)
+        written.append(path)
+        shared = displacement_range([kept[i] for i in selected], case.component)
+        for number, (t_requested, index) in enumerate(zip(requested, selected)):
+            for quantity in ("damage", "displacement"):
+                path = os.path.join(fig_dir, f"{quantity}_{number}.png")
+                plot_map(kept[index], case, path, quantity=quantity, time=times[index], index=index,
+                         requested=t_requested, vrange=shared if quantity == "displacement" else None)
+                written.append(path)
+        _remove_stale_maps(fig_dir, len(selected))
+        path = os.path.join(fig_dir, "probe.png")
+        plot_probe(times, probe["values"], case, path, node=probe["node"], position=probe["position"])
+        written.append(path)
+    log(f"postprocess: {case.name}: {len(series)} frames → " +
+        ", ".join(os.path.relpath(p, out_dir) for p in written) + f" in {out_dir}")
+    return written
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        run(args.out_dir, args.case_json, args.only)
+    except PostprocessError as error:
+        print(f"postprocess: error: {error}", file=sys.stderr)
+        return 1
+    return 0
