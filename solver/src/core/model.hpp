@@ -1,0 +1,33 @@
+// Everything the time loop needs that does not change with time: nodes, bonds, material, conditions.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/bonds.hpp"
+#include "core/case.hpp"
+#include "core/conditions.hpp"
+#include "core/material.hpp"
+#include "core/nodes.hpp"
+
+namespace pd {
+
+struct Model {
+  Nodes nodes;
+  BondList bonds;  // the only part that changes: bonds break
+  MaterialTable material;
+  double horizon = 0.0;  // δ [m]
+  double damping = 0.0;  // α [1/s]
+  std::vector<double> density;             // ρ per node [kg/m³]
+  std::vector<std::int32_t> block_index;   // block id − 1 per node (row of the pair tables)
+  std::vector<std::uint8_t> no_fail;       // 1: bonds with this end never break
+  Conditions conditions;
+};
+
+// Checks the node file against the case (blocks in range, sets present) and builds the bonds.
+Model build_model(const Case& c, Nodes nodes);
+
+// Stable step of the explicit scheme, thesis eq. 2.5 (validation.md F2):
+// Δt = min_i √(2ρ_i / Σ_p V_p c_ip/|ξ_p|), without safety factor; +inf if no node has a bond.
+double stable_time_step(const Model& model);
+
+}  // namespace pd

@@ -1,0 +1,23 @@
+// The time-dependent state: displacement u, velocity v, force density f, and the energy ledger.
+#pragma once
+#include "core/nodes.hpp"
+
+namespace pd {
+
+struct State {
+  Vec3Array u;  // displacement [m]
+  Vec3Array v;  // velocity [m/s]
+  Vec3Array f;  // force density of the conservative terms (bonds + body force) at u [N/m³]
+  std::vector<double> w;  // strain-energy density W_i at u, from the last force evaluation [J/m³]
+
+  // Work ledger, integrated with the trapezoidal rule over each step.
+  double external_power = 0.0;  // body-force + reaction power at the current state [W]
+  double damping_power = 0.0;   // Σ ρ α V |v|² over free components [W]
+  double external_work = 0.0;   // [J]
+  double damping_work = 0.0;    // [J]
+
+  explicit State(std::size_t n = 0) : u(make_vec3(n)), v(make_vec3(n)), f(make_vec3(n)), w(n, 0.0) {}
+  std::size_t size() const { return u[0].size(); }
+};
+
+}  // namespace pd

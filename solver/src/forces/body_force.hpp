@@ -1,0 +1,20 @@
+// The body-force term: a prescribed force density b(t) on the nodes of a set (thesis eq. 2.1, b_i^n).
+#pragma once
+#include "core/model.hpp"
+#include "core/state.hpp"
+
+namespace pd {
+
+class BodyForceTerm {
+ public:
+  explicit BodyForceTerm(const Model& model) : model_(model) {}
+  // f += b(t) on every node of every body-force condition. Accumulates; never clears f.
+  void AddMult(double t, Vec3Array& f) const;
+  // Σ_i V_i b_i(t)·v_i [W]
+  double power(double t, const Vec3Array& v) const;
+
+ private:
+  const Model& model_;
+};
+
+}  // namespace pd

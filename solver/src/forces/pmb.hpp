@@ -1,0 +1,72 @@
+// The PMB bond force (thesis eqs. 1.9–1.11, 2.1): the kernel every integrator calls, bond breaking,
+// strain energy and damage.
+#pragma once
+#include <cfloat>
+#include <cstdint>
+#include <vector>
+
+#include "core/model.hpp"
+#include "core/state.hpp"
+
+namespace pd {
+
+// A stretch with |s| ≤ kStretchZero is set to zero: round-off in y_j − y_i would otherwise create
+// "numerical, not physical forces" (thesis §2.2, machine-precision remark; LAMMPS peri/pmb zeroes
+// |dr| < 2.22e−16 for the same reason).
+constexpr double kStretchZero = 4.0 * DBL_EPSILON;
+
+// Plain pointers into the model and state, so the kernel is one free function over arrays.
+struct PmbArrays {
+  const std::int64_t* offsets;
+  const std::int32_t* neighbour;
+  const double* length;        // |ξ|
+  const std::uint8_t* broken;
+  const double* x[3];          // reference positions
+  const double* u[3];          // displacements
+  const double* volume;
+  const std::int32_t* block;   // block index (0-based) per node
+  const double* c_pair;        // micromodulus per block pair
+  std::int64_t blocks;
+  std::int64_t nodes;
+};
+
+PmbArrays pmb_arrays(const Model& model, const Vec3Array& u);
+
+// f_i += Σ_j c·s·(y_j − y_i)/|y_j − y_i|·V_j over intact bonds, s = (|ξ+η| − |ξ|)/|ξ|
+// (thesis eqs. 1.9, 1.10, 2.1). Each node writes only its own f_i: parallel over nodes,
+// schedule static, bitwise the same for any thread count. Accumulates; never clears f.
+// If w is not null, also stores the strain-energy density W_i = Σ_j ¼ c s² |ξ| V_j of every node
+// (validation.md C4; overwritten, not accumulated): a few flops per bond, so the energy needs no
+// second pass over the bonds.
+void add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w = nullptr);
+
+// The force term as a small class with one verb (MFEM's AddMult).
+class PmbBondForce {
+ public:
+  explicit PmbBondForce(const Model& model) : model_(model) {}
+  void AddMult(const Vec3Array& u, Vec3Array& f, double* energy_density = nullptr) const;
+
+ private:
+  const Model& model_;
+};
+
+// After the state update: every intact bond whose stretch exceeds s0 of its block pair breaks for
+// good, unless an end is in a no-fail set. The stretch is computed from y_j − y_i, which is the
+// exact negative of y_i − y_j in IEEE arithmetic, so both stored copies of a bond see bitwise the
+// same stretch and break in the same call: symmetric and deterministic without a reverse index.
+// Returns the number of bonds broken now, each counted once.
+std::int64_t update_broken_bonds(Model& model, const Vec3Array& u);
+
+// U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
+// summed serially in node order, so the value does not depend on the thread count.
+double strain_energy(const Model& model, const Vec3Array& u);
+// The same per node, divided by V_i: the strain-energy density W_i [J/m³].
+std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u);
+
+// Damage per node: 1 − Σ_intact V_j / Σ_all V_j (0 for a node without bonds).
+std::vector<double> damage(const Model& model);
+
+// Broken bonds, each counted once.
+std::int64_t broken_bond_count(const Model& model);
+
+}  // namespace pd

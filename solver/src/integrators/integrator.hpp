@@ -1,0 +1,52 @@
+// The integrator contract (MFEM's ODESolver::Step): step(state, t, dt) advances the state from t;
+// on return t is the new time and dt the step actually taken, which a step-size controller
+// (the adaptive Zohdi scheme, a later issue) may have changed. Plus the force evaluation and
+// energy bookkeeping every integrator shares.
+#pragma once
+#include <memory>
+#include <string>
+
+#include "core/model.hpp"
+#include "core/registry.hpp"
+#include "core/state.hpp"
+
+namespace pd {
+
+struct StepReport {
+  int iterations = 1;         // fixed-point iterations K of the accepted step (1 for Verlet)
+  int rejected = 0;           // rejected attempts before acceptance (0 for Verlet)
+  std::int64_t broken_now = 0;  // bonds broken during the step, each counted once
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual std::string name() const = 0;
+  // Imposes the prescribed motion at t and evaluates f and the powers there; call once first.
+  virtual void initialize(State& state, double t) = 0;
+  virtual void step(State& state, double& t, double& dt) = 0;
+  const StepReport& last_step() const { return report_; }
+
+ protected:
+  StepReport report_;
+};
+
+using IntegratorFactory = std::unique_ptr<Integrator> (*)(Model&);
+const Registry<IntegratorFactory>& integrator_registry();
+
+// f = bond forces + body forces at (u, t): clears f, then every force term adds into it.
+void evaluate_forces(const Model& model, State& state, double t);
+
+// Imposes the prescribed displacement / velocity at t (used at the start of a run).
+void impose_prescribed_motion(const Model& model, State& state, double t);
+
+// Body-force power plus the power of the reactions at prescribed components, Σ V (ρa − f)·v
+// where a is the prescribed acceleration (the slope of a velocity table; 0 for a piecewise-linear
+// displacement — the impulses at its kinks are not counted) [W].
+double external_power(const Model& model, const State& state, double t);
+
+// Recomputes state.external_power and state.damping_power at t and adds the trapezoidal work
+// increments dt/2·(P_old + P_new) to the ledger; pass dt = 0 to only initialise the powers.
+void update_work(const Model& model, State& state, double t, double dt);
+
+}  // namespace pd

@@ -1,0 +1,19 @@
+// Velocity Verlet (central difference, thesis eq. 2.4) with trapezoidal velocity damping.
+#pragma once
+#include "integrators/integrator.hpp"
+
+namespace pd {
+
+class VelocityVerlet : public Integrator {
+ public:
+  explicit VelocityVerlet(Model& model) : model_(model) {}
+  std::string name() const override { return "verlet"; }
+  void initialize(State& state, double t) override;
+  // Takes exactly the dt it is given.
+  void step(State& state, double& t, double& dt) override;
+
+ private:
+  Model& model_;
+};
+
+}  // namespace pd

@@ -1,0 +1,292 @@
+// case.json → pd::Case, with every key and value checked against pipeline/formats.md §3.
+#include "io/case_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "integrators/integrator.hpp"
+
+namespace pd {
+
+namespace {
+
+using json = nlohmann::json;
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1u : 0u)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string show(const json& j) {
+  std::string s = j.dump();
+  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+class Checker {
+ public:
+  explicit Checker(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw Error(file_ + ": " + key + ": " + what);
+  }
+
+  // Unknown keys are errors that name the closest known key.
+  void known_keys(const json& obj, const std::string& where, const std::vector<std::string>& allowed) const {
+    for (const auto& item : obj.items()) {
+      if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
+      std::string best;
+      std::size_t best_distance = 1000;
+      for (const auto& a : allowed) {
+        const std::size_t d = edit_distance(item.key(), a);
+        if (d < best_distance) best_distance = d, best = a;
+      }
+      const std::string key = where.empty() ? item.key() : where + "." + item.key();
+      fail(key, "unknown key" + (best_distance <= 3 ? " (did you mean '" + best + "'?)" : std::string()));
+    }
+  }
+
+  const json* optional(const json& obj, const std::string& name) const {
+    auto it = obj.find(name);
+    return it == obj.end() ? nullptr : &*it;
+  }
+  const json& required(const json& obj, const std::string& name, const std::string& key) const {
+    const json* j = optional(obj, name);
+    if (!j) fail(key, "required key is missing");
+    return *j;
+  }
+
+  const json& object(const json& j, const std::string& key) const {
+    if (!j.is_object()) fail(key, "must be an object, got " + show(j));
+    return j;
+  }
+  const json& array(const json& j, const std::string& key) const {
+    if (!j.is_array()) fail(key, "must be a list, got " + show(j));
+    return j;
+  }
+  std::string string(const json& j, const std::string& key) const {
+    if (!j.is_string()) fail(key, "must be a string, got " + show(j));
+    return j.get<std::string>();
+  }
+  double number(const json& j, const std::string& key) const {
+    if (!j.is_number()) fail(key, "must be a number, got " + show(j));
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail(key, "must be finite, got " + show(j));
+    return v;
+  }
+  double positive(const json& j, const std::string& key) const {
+    const double v = number(j, key);
+    if (!(v > 0.0)) fail(key, "must be > 0, got " + show(j));
+    return v;
+  }
+  double non_negative(const json& j, const std::string& key) const {
+    const double v = number(j, key);
+    if (v < 0.0) fail(key, "must be ≥ 0, got " + show(j));
+    return v;
+  }
+  std::int64_t integer(const json& j, const std::string& key, std::int64_t minimum, std::int64_t maximum) const {
+    if (!j.is_number_integer()) fail(key, "must be an integer, got " + show(j));
+    const auto v = j.get<std::int64_t>();
+    if (v < minimum || v > maximum)
+      fail(key, "must be between " + std::to_string(minimum) + " and " + std::to_string(maximum) + ", got " + show(j));
+    return v;
+  }
+  std::vector<std::string> strings(const json& j, const std::string& key) const {
+    std::vector<std::string> out;
+    for (std::size_t k = 0; k < array(j, key).size(); ++k)
+      out.push_back(string(j[k], key + "[" + std::to_string(k) + "]"));
+    return out;
+  }
+  std::vector<double> numbers(const json& j, const std::string& key) const {
+    std::vector<double> out;
+    for (std::size_t k = 0; k < array(j, key).size(); ++k)
+      out.push_back(number(j[k], key + "[" + std::to_string(k) + "]"));
+    return out;
+  }
+
+ private:
+  std::string file_;
+};
+
+BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
+  const std::string where = "blocks[" + std::to_string(k) + "]";
+  ck.object(j, where);
+  ck.known_keys(j, where, {"id", "name", "model", "density", "youngs_modulus", "fracture_energy"});
+  const std::int64_t id = ck.integer(ck.required(j, "id", where + ".id"), where + ".id", 1, 1 << 30);
+  if (id != static_cast<std::int64_t>(k) + 1)
+    ck.fail(where + ".id", "must be " + std::to_string(k + 1) + " (blocks are numbered 1, 2, … in order), got " +
+                               std::to_string(id));
+  BlockMaterial b;
+  b.name = ck.string(ck.required(j, "name", where + ".name"), where + ".name");
+  if (const json* m = ck.optional(j, "model")) {
+    b.model = ck.string(*m, where + ".model");
+    if (b.model != "pmb") ck.fail(where + ".model", "unknown model '" + b.model + "'; known: pmb");
+  }
+  b.density = ck.positive(ck.required(j, "density", where + ".density"), where + ".density");
+  b.youngs_modulus = ck.positive(ck.required(j, "youngs_modulus", where + ".youngs_modulus"), where + ".youngs_modulus");
+  if (const json* g = ck.optional(j, "fracture_energy"); g && !g->is_null())
+    b.fracture_energy = ck.positive(*g, where + ".fracture_energy");
+  return b;
+}
+
+BoundaryCondition read_boundary(const Checker& ck, const json& j, std::size_t k) {
+  const std::string where = "boundary_conditions[" + std::to_string(k) + "]";
+  ck.object(j, where);
+  ck.known_keys(j, where, {"set", "kind", "component", "times", "values"});
+  BoundaryCondition bc;
+  bc.set = ck.string(ck.required(j, "set", where + ".set"), where + ".set");
+  bc.kind = ck.string(ck.required(j, "kind", where + ".kind"), where + ".kind");
+  if (bc.kind != "displacement" && bc.kind != "velocity" && bc.kind != "body_force")
+    ck.fail(where + ".kind", "unknown kind '" + bc.kind + "'; known: displacement, velocity, body_force");
+  bc.component = static_cast<int>(ck.integer(ck.required(j, "component", where + ".component"), where + ".component", 0, 2));
+  bc.times = ck.numbers(ck.required(j, "times", where + ".times"), where + ".times");
+  bc.values = ck.numbers(ck.required(j, "values", where + ".values"), where + ".values");
+  if (bc.times.empty()) ck.fail(where + ".times", "needs at least one time");
+  if (bc.values.size() != bc.times.size())
+    ck.fail(where + ".values", "has " + std::to_string(bc.values.size()) + " entries but times has " +
+                                   std::to_string(bc.times.size()));
+  for (std::size_t i = 1; i < bc.times.size(); ++i)
+    if (!(bc.times[i] > bc.times[i - 1]))
+      ck.fail(where + ".times", "must be strictly increasing (entry " + std::to_string(i) + ")");
+  return bc;
+}
+
+InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
+  const std::string where = "initial_conditions[" + std::to_string(k) + "]";
+  ck.object(j, where);
+  ck.known_keys(j, where, {"set", "kind", "component", "value"});
+  InitialCondition ic;
+  ic.set = ck.string(ck.required(j, "set", where + ".set"), where + ".set");
+  ic.kind = ck.string(ck.required(j, "kind", where + ".kind"), where + ".kind");
+  if (ic.kind != "displacement" && ic.kind != "velocity")
+    ck.fail(where + ".kind", "unknown kind '" + ic.kind + "'; known: velocity, displacement");
+  ic.component = static_cast<int>(ck.integer(ck.required(j, "component", where + ".component"), where + ".component", 0, 2));
+  ic.value = ck.number(ck.required(j, "value", where + ".value"), where + ".value");
+  return ic;
+}
+
+}  // namespace
+
+Case parse_case(const std::string& text, const std::filesystem::path& path) {
+  const std::string file = path.string();
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw Error(file + ": not valid JSON: " + e.what());
+  }
+  const Checker ck(file);
+  if (!root.is_object()) throw Error(file + ": the top level must be a JSON object");
+  ck.known_keys(root, "", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension",
+                           "analysis", "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets",
+                           "node_sets", "boundary_conditions", "initial_conditions", "damping", "time",
+                           "adaptive", "output", "figures"});
+  Case c;
+  c.file = path;
+  const std::int64_t version = ck.integer(ck.required(root, "format_version", "format_version"), "format_version", 0, 1 << 30);
+  if (version != kCaseFormatVersion)
+    ck.fail("format_version", "is " + std::to_string(version) + "; this solver reads version " +
+                                  std::to_string(kCaseFormatVersion));
+  if (const json* j = ck.optional(root, "case")) c.name = ck.string(*j, "case");
+  if (const json* j = ck.optional(root, "title")) c.title = ck.string(*j, "title");
+  if (const json* j = ck.optional(root, "source")) c.source = ck.string(*j, "source");
+  const std::filesystem::path dir = path.parent_path();
+  const std::string nodes_file = ck.string(ck.required(root, "nodes_file", "nodes_file"), "nodes_file");
+  if (nodes_file.empty()) ck.fail("nodes_file", "must not be empty");
+  c.nodes_file = dir / nodes_file;
+  std::string output_dir = ".";
+  if (const json* j = ck.optional(root, "output_dir")) output_dir = ck.string(*j, "output_dir");
+  c.output_dir = dir / output_dir;
+
+  c.dimension = static_cast<int>(ck.integer(ck.required(root, "dimension", "dimension"), "dimension", 2, 3));
+  c.analysis = ck.string(ck.required(root, "analysis", "analysis"), "analysis");
+  if (!analysis_registry().contains(c.analysis)) ck.fail("analysis", analysis_registry().unknown_message(c.analysis));
+  if (analysis_dimension(c.analysis) != c.dimension)
+    ck.fail("analysis", "'" + c.analysis + "' does not fit dimension " + std::to_string(c.dimension));
+  if (c.dimension == 2) {
+    c.thickness = ck.positive(ck.required(root, "thickness", "thickness"), "thickness");
+  } else if (const json* j = ck.optional(root, "thickness"); j && !j->is_null()) {
+    c.thickness = ck.positive(*j, "thickness");  // allowed but unused in 3D
+  }
+  c.grid_spacing = ck.positive(ck.required(root, "grid_spacing", "grid_spacing"), "grid_spacing");
+  c.horizon = ck.positive(ck.required(root, "horizon", "horizon"), "horizon");
+
+  const json& blocks = ck.array(ck.required(root, "blocks", "blocks"), "blocks");
+  if (blocks.empty()) ck.fail("blocks", "needs at least one block");
+  for (std::size_t k = 0; k < blocks.size(); ++k) c.blocks.push_back(read_block(ck, blocks[k], k));
+
+  if (const json* j = ck.optional(root, "no_fail_sets")) c.no_fail_sets = ck.strings(*j, "no_fail_sets");
+  if (const json* j = ck.optional(root, "node_sets")) c.node_sets = ck.strings(*j, "node_sets");
+  if (const json* j = ck.optional(root, "boundary_conditions"))
+    for (std::size_t k = 0; k < ck.array(*j, "boundary_conditions").size(); ++k)
+      c.boundary_conditions.push_back(read_boundary(ck, (*j)[k], k));
+  if (const json* j = ck.optional(root, "initial_conditions"))
+    for (std::size_t k = 0; k < ck.array(*j, "initial_conditions").size(); ++k)
+      c.initial_conditions.push_back(read_initial(ck, (*j)[k], k));
+  if (const json* j = ck.optional(root, "damping")) c.damping = ck.non_negative(*j, "damping");
+
+  const json& time = ck.object(ck.required(root, "time", "time"), "time");
+  ck.known_keys(time, "time", {"end", "integrator", "dt", "safety_factor", "max_steps"});
+  c.time.end = ck.positive(ck.required(time, "end", "time.end"), "time.end");
+  if (const json* j = ck.optional(time, "integrator")) {
+    c.time.integrator = ck.string(*j, "time.integrator");
+    if (!integrator_registry().contains(c.time.integrator))
+      ck.fail("time.integrator", integrator_registry().unknown_message(c.time.integrator));
+  }
+  if (const json* j = ck.optional(time, "dt")) {
+    if (j->is_string()) {
+      const std::string rule = j->get<std::string>();
+      if (rule == "exact")
+        ck.fail("time.dt", "\"exact\" (largest eigenvalue of the linearised operator) is not implemented yet; "
+                           "use \"stable\" or a number of seconds");
+      if (rule != "stable") ck.fail("time.dt", "unknown rule '" + rule + "'; known: stable, exact, or a number [s]");
+      c.time.dt_rule = "stable";
+    } else {
+      c.time.dt_rule = "fixed";
+      c.time.dt_value = ck.positive(*j, "time.dt");
+    }
+  }
+  if (const json* j = ck.optional(time, "safety_factor")) c.time.safety_factor = ck.positive(*j, "time.safety_factor");
+  if (const json* j = ck.optional(time, "max_steps"))
+    c.time.max_steps = ck.integer(*j, "time.max_steps", 1, std::numeric_limits<std::int64_t>::max());
+
+  if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) ck.object(*j, "adaptive");  // a later issue
+  if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
+
+  const json& output = ck.object(ck.required(root, "output", "output"), "output");
+  ck.known_keys(output, "output", {"every_time", "every_steps", "history_every"});
+  if (const json* j = ck.optional(output, "every_time"); j && !j->is_null())
+    c.output.every_time = ck.positive(*j, "output.every_time");
+  if (const json* j = ck.optional(output, "every_steps"); j && !j->is_null())
+    c.output.every_steps = ck.integer(*j, "output.every_steps", 1, std::numeric_limits<std::int64_t>::max());
+  if (c.output.every_time.has_value() == c.output.every_steps.has_value())
+    ck.fail("output", "exactly one of every_time and every_steps must be set (not null)");
+  if (const json* j = ck.optional(output, "history_every"))
+    c.output.history_every = ck.integer(*j, "output.history_every", 1, std::numeric_limits<std::int64_t>::max());
+  return c;
+}
+
+Case read_case(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open for reading");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_case(text.str(), path);
+}
+
+}  // namespace pd

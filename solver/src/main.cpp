@@ -1,0 +1,96 @@
+// pdsolve: the command-line front end of the solver library (see run.hpp for the work itself).
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+#include "core/error.hpp"
+#include "run.hpp"
+
+namespace {
+
+const char* const kUsage =
+    "usage: pdsolve CASE.json [--threads N] [--end-time T] [--max-steps N] [--quiet] [--help] [--version]\n"
+    "\n"
+    "Bond-based PMB peridynamics solver. Reads the resolved case CASE.json and its node file\n"
+    "(pipeline/formats.md), writes frames/*.vtu, frames.pvd, history.csv and run.log to the\n"
+    "case's output_dir.\n"
+    "\n"
+    "  --threads N     OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
+    "  --end-time T    simulated end time [s], overrides time.end\n"
+    "  --max-steps N   stop after N steps at most\n"
+    "  --quiet         print nothing on stdout and no progress line (run.log is still written)\n"
+    "  --help          this text\n"
+    "  --version       the solver version\n";
+
+[[noreturn]] void usage_error(const std::string& what) {
+  std::cerr << "pdsolve: " << what << "\n" << kUsage;
+  std::exit(pd::kUsageError);
+}
+
+double parse_number(const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used != text.size() || !(value > 0.0)) usage_error(option + " needs a number > 0, got '" + text + "'");
+  return value;
+}
+
+long long parse_integer(const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  long long value = 0;
+  try {
+    value = std::stoll(text, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used != text.size() || value < 1) usage_error(option + " needs an integer ≥ 1, got '" + text + "'");
+  return value;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  pd::RunOptions options;
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    auto value = [&]() -> std::string {
+      if (k + 1 >= argc) usage_error(arg + " needs a value");
+      return argv[++k];
+    };
+    if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage;
+      return pd::kOk;
+    } else if (arg == "--version") {
+      std::cout << "pdsolve " PD_VERSION "\n";
+      return pd::kOk;
+    } else if (arg == "--threads") {
+      options.threads = static_cast<int>(parse_integer(arg, value()));
+    } else if (arg == "--end-time") {
+      options.end_time = parse_number(arg, value());
+    } else if (arg == "--max-steps") {
+      options.max_steps = parse_integer(arg, value());
+    } else if (arg == "--quiet") {
+      options.quiet = true;
+    } else if (!arg.empty() && arg[0] == '-') {
+      usage_error("unknown option '" + arg + "'");
+    } else if (options.case_file.empty()) {
+      options.case_file = arg;
+    } else {
+      usage_error("more than one case file ('" + options.case_file.string() + "', '" + arg + "')");
+    }
+  }
+  if (options.case_file.empty()) usage_error("no case file given");
+  try {
+    return pd::run(options);
+  } catch (const pd::Error& e) {
+    std::cerr << "pdsolve: error: " << e.what() << "\n";
+    return pd::kInputError;
+  } catch (const std::exception& e) {
+    std::cerr << "pdsolve: internal error: " << e.what() << "\n";
+    return pd::kRunFailed;
+  }
+}

@@ -1,0 +1,214 @@
+// The time loop of pdsolve: read → build → loop → write (pipeline/formats.md §3–4).
+#include "run.hpp"
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "forces/pmb.hpp"
+#include "integrators/integrator.hpp"
+#include "io/case_reader.hpp"
+#include "io/node_file.hpp"
+#include "io/output.hpp"
+
+namespace pd {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string format(const char* fmt, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, value);
+  return buffer;
+}
+
+double kinetic_energy(const Model& m, const State& s) {
+  double sum = 0.0;  // serial, node order: the same for any thread count
+  for (std::size_t i = 0; i < s.size(); ++i)
+    sum += 0.5 * m.density[i] * m.nodes.volume[i] *
+           (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
+  return sum;
+}
+
+double stored_strain_energy(const Model& m, const State& s) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) sum += s.w[i] * m.nodes.volume[i];
+  return sum;
+}
+
+// The first node (lowest index) with a non-finite displacement or velocity, or −1.
+std::int64_t first_non_finite(const State& s) {
+  const auto n = static_cast<std::int64_t>(s.size());
+  std::int64_t first = n;
+#pragma omp parallel for schedule(static) reduction(min : first)
+  for (std::int64_t i = 0; i < n; ++i) {
+    bool ok = true;
+    for (std::size_t d = 0; d < 3; ++d)
+      ok = ok && std::isfinite(s.u[d][static_cast<std::size_t>(i)]) && std::isfinite(s.v[d][static_cast<std::size_t>(i)]);
+    if (!ok) first = std::min(first, i);
+  }
+  return first == n ? -1 : first;
+}
+
+std::string duration_text(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  char buffer[32];
+  const auto s = static_cast<long long>(seconds + 0.5);
+  if (s >= 3600) std::snprintf(buffer, sizeof buffer, "%lldh%02lldm", s / 3600, (s / 60) % 60);
+  else if (s >= 60) std::snprintf(buffer, sizeof buffer, "%lldm%02llds", s / 60, s % 60);
+  else std::snprintf(buffer, sizeof buffer, "%llds", s);
+  return buffer;
+}
+
+}  // namespace
+
+int run(const RunOptions& opt) {
+  // ---- read and build: every input error is thrown here, before any output exists
+  Case c = read_case(opt.case_file);
+  if (opt.end_time) c.time.end = *opt.end_time;
+  if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  const int threads = omp_get_max_threads();
+  Nodes nodes = read_node_file(c.nodes_file);
+  for (const auto& name : c.node_sets)
+    if (!nodes.find_set(name))
+      throw Error(c.file.string() + ": node_sets: '" + name + "' has no array 'set_" + name + "' in " +
+                  c.nodes_file.string());
+  const auto build_start = Clock::now();
+  Model model = build_model(c, std::move(nodes));
+  const double build_seconds = seconds_since(build_start);
+  const std::size_t n = model.nodes.size();
+
+  const double dt_stable = stable_time_step(model);
+  double dt = 0.0;
+  if (c.time.dt_rule == "stable") {
+    if (!std::isfinite(dt_stable))
+      throw Error(c.file.string() + ": time.dt: \"stable\" needs bonds, but no node has a partner within the horizon " +
+                  format("%.6g", c.horizon) + " m");
+    dt = dt_stable * c.time.safety_factor;
+  } else {
+    dt = c.time.dt_value;
+  }
+  std::int64_t max_steps = c.time.max_steps;
+  if (opt.max_steps) max_steps = std::min(max_steps, *opt.max_steps);
+  const double end = c.time.end;
+  // A remainder below this fraction of dt is absorbed into the last step rather than taken alone.
+  constexpr double kLastStepSlack = 1e-6;
+  const auto steps_for_end = static_cast<std::int64_t>(std::ceil(end / dt * (1.0 - kLastStepSlack)));
+  const std::int64_t steps_expected = std::min(steps_for_end, max_steps);
+  std::unique_ptr<Integrator> integrator = integrator_registry().get(c.time.integrator)(model);
+
+  State state(n);
+  apply_initial_conditions(c, model.nodes, state.u, state.v);
+  double t = 0.0;
+  integrator->initialize(state, t);
+  if (first_non_finite(state) >= 0) throw Error(c.file.string() + ": the initial state is not finite");
+
+  // ---- output starts here
+  OutputWriter out(c.output_dir);
+  RunLog log(c.output_dir / "run.log", opt.quiet);
+  log.line("pdsolve " PD_VERSION ": case " + (c.name.empty() ? opt.case_file.string() : c.name) + " (" +
+           opt.case_file.string() + ")");
+  log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(model.bonds.directed() / 2) + " (" +
+           format("%.1f", static_cast<double>(model.bonds.directed()) / static_cast<double>(n)) +
+           " per node), built in " + format("%.3f", build_seconds) + " s");
+  log.line("analysis " + c.analysis + ", horizon " + format("%.6g", c.horizon) + " m = " +
+           format("%.4g", c.horizon / c.grid_spacing) + " dx");
+  for (std::size_t b = 0; b < model.material.block.size(); ++b)
+    log.line("block " + std::to_string(b + 1) + " '" + c.blocks[b].name + "': c " +
+             format("%.6g", model.material.block[b].micromodulus) + ", s0 " +
+             (std::isinf(model.material.block[b].critical_stretch) ? std::string("none (unbreakable)")
+                                                                   : format("%.6g", model.material.block[b].critical_stretch)));
+  log.line("dt " + format("%.6g", dt) + " s (" +
+           (c.time.dt_rule == "stable" ? "stable " + format("%.6g", dt_stable) + " s × safety factor " + format("%g", c.time.safety_factor)
+                                       : "fixed; stable " + format("%.6g", dt_stable) + " s") +
+           "), integrator " + integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
+  if (c.time.dt_rule == "fixed" && dt > dt_stable)
+    log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
+  log.line("end time " + format("%.6g", end) + " s, steps expected " + std::to_string(steps_expected) +
+           (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
+
+  const auto loop_start = Clock::now();
+  std::int64_t step = 0, broken = broken_bond_count(model), last_frame_step = -1;
+  auto history_row = [&](double dt_taken) {
+    HistoryRow r;
+    r.step = step;
+    r.time = t;
+    r.dt = dt_taken;
+    r.iterations = step == 0 ? 0 : integrator->last_step().iterations;
+    r.rejected = step == 0 ? 0 : integrator->last_step().rejected;
+    r.kinetic_energy = kinetic_energy(model, state);
+    r.strain_energy = stored_strain_energy(model, state);
+    r.external_work = state.external_work;
+    r.damping_work = state.damping_work;
+    r.broken_bonds = broken;
+    r.wall_time = seconds_since(loop_start);
+    out.history(r);
+  };
+  std::int64_t next_frame_index = 1;  // every_time: frame k at t ≥ k·every_time
+  auto frame = [&](double dt_taken) {
+    out.frame(model, state, t, step);
+    history_row(dt_taken);
+    last_frame_step = step;
+    if (c.output.every_time) next_frame_index = static_cast<std::int64_t>(std::floor(t / *c.output.every_time * (1.0 + 1e-12))) + 1;
+  };
+  frame(0.0);
+
+  const bool progress = !opt.quiet && isatty(fileno(stderr));
+  auto last_progress = Clock::now();
+  int status = kOk;
+  double dt_taken = 0.0;
+  while (step < max_steps && t < end * (1.0 - 1e-12)) {
+    double h = dt;
+    if (end - t <= dt * (1.0 + kLastStepSlack)) h = end - t;  // land exactly on the end time
+    integrator->step(state, t, h);
+    dt_taken = h;
+    ++step;
+    broken += integrator->last_step().broken_now;
+    if (const std::int64_t bad = first_non_finite(state); bad >= 0) {
+      log.error("pdsolve: error: non-finite displacement or velocity at node " + std::to_string(bad) + " after step " +
+                std::to_string(step) + " (t = " + format("%.6g", t) + " s, dt = " + format("%.6g", h) +
+                " s, stable dt " + format("%.6g", dt_stable) + " s); stopped without writing this state");
+      status = kRunFailed;
+      break;
+    }
+    const bool frame_due = c.output.every_steps ? step % *c.output.every_steps == 0
+                                                : t >= static_cast<double>(next_frame_index) * *c.output.every_time - 1e-9 * h;
+    if (frame_due) frame(h);
+    else if (step % c.output.history_every == 0) history_row(h);
+    if (progress && seconds_since(last_progress) > 0.5) {
+      last_progress = Clock::now();
+      const double elapsed = seconds_since(loop_start);
+      const double fraction = std::max(t / end, static_cast<double>(step) / static_cast<double>(max_steps));
+      std::fprintf(stderr, "\rstep %lld/%lld  t = %.4g s  %5.1f%%  ETA %s   ", static_cast<long long>(step),
+                   static_cast<long long>(steps_expected), t, 100.0 * fraction,
+                   duration_text(elapsed * (1.0 - fraction) / std::max(fraction, 1e-12)).c_str());
+      std::fflush(stderr);
+    }
+  }
+  if (progress) std::fprintf(stderr, "\r%70s\r", "");
+  if (status == kOk && last_frame_step != step) frame(dt_taken);
+  out.finish();
+
+  const double wall = seconds_since(loop_start);
+  const double updates = static_cast<double>(model.bonds.directed()) * static_cast<double>(step);
+  log.line(std::string(status == kOk ? "done" : "stopped") + ": " + std::to_string(step) + " steps to t = " +
+           format("%.6g", t) + " s in " + format("%.3f", wall) + " s wall (" +
+           format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
+           std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds");
+  if (status == kOk && step >= max_steps && t < end * (1.0 - 1e-12))
+    log.line("note: stopped at max_steps " + std::to_string(max_steps) + " before the end time");
+  return status;
+}
+
+}  // namespace pd

@@ -1,0 +1,47 @@
+// Regular lattices and in-memory cases for the tests and benchmarks.
+#include "lattice.hpp"
+
+namespace pdtest {
+
+pd::Nodes cubic_lattice(int nx, int ny, int nz, double dx, int dimension, double thickness) {
+  pd::Nodes nodes;
+  nodes.dimension = dimension;
+  nodes.grid_spacing = dx;
+  const auto n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * static_cast<std::size_t>(nz);
+  nodes.x = pd::make_vec3(n);
+  const double volume = dimension == 3 ? dx * dx * dx : dx * dx * thickness;
+  nodes.volume.assign(n, volume);
+  nodes.block.assign(n, 1);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t p = node_index(i, j, k, nx, ny);
+        nodes.x[0][p] = i * dx;
+        nodes.x[1][p] = j * dx;
+        nodes.x[2][p] = k * dx;
+      }
+  return nodes;
+}
+
+pd::Case lattice_case(int dimension, const std::string& analysis, double dx, double horizon, double youngs_modulus,
+                      double density, double fracture_energy, double thickness) {
+  pd::Case c;
+  c.file = "memory-case.json";
+  c.nodes_file = "memory-nodes.vtu";
+  c.dimension = dimension;
+  c.analysis = analysis;
+  c.thickness = thickness;
+  c.grid_spacing = dx;
+  c.horizon = horizon;
+  pd::BlockMaterial b;
+  b.name = "body";
+  b.density = density;
+  b.youngs_modulus = youngs_modulus;
+  if (fracture_energy >= 0.0) b.fracture_energy = fracture_energy;
+  c.blocks.push_back(b);
+  c.time.end = 1.0;
+  c.output.every_steps = 1;
+  return c;
+}
+
+}  // namespace pdtest

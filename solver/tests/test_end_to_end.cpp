@@ -1,0 +1,198 @@
+// End to end: pdsolve runs on a node file and case.json written here, and its frames, frames.pvd
+// and history.csv read back; bad input fails with a message and writes nothing.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "io/node_file.hpp"
+#include "io/output.hpp"
+#include "io/vtu.hpp"
+#include "lattice.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("pd_test_e2e_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+int run_solver(const std::string& args, const fs::path& log) {
+  const std::string command = std::string(PDSOLVE_PATH) + " " + args + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A 2D plate, 16 × 8 nodes, left edge clamped, the right edge pulled fast enough to break bonds.
+void write_plate_case(const fs::path& dir, const std::string& extra_time = "") {
+  const double dx = 1e-3;
+  pd::Nodes nodes = pdtest::cubic_lattice(16, 8, 1, dx, 2, 1e-3);
+  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)};
+  pd::NodeSet right{"right", std::vector<std::uint8_t>(nodes.size(), 0)};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    left.member[i] = nodes.x[0][i] < 2.5 * dx;
+    right.member[i] = nodes.x[0][i] > 12.5 * dx;
+  }
+  nodes.sets = {left, right};
+  pd::write_node_file(dir / "nodes.vtu", nodes);
+  std::ofstream(dir / "case.json") << R"({
+    "format_version": 1, "case": "plate", "title": "test plate", "source": "plate.yaml",
+    "nodes_file": "nodes.vtu", "output_dir": "out", "dimension": 2, "analysis": "plane_stress",
+    "thickness": 0.001, "grid_spacing": 0.001, "horizon": 0.003015,
+    "blocks": [{"id": 1, "name": "plate", "model": "pmb", "density": 2440.0, "youngs_modulus": 7.2e10,
+                "fracture_energy": 3.8}],
+    "no_fail_sets": ["left"], "node_sets": ["left", "right"],
+    "boundary_conditions": [
+      {"set": "left", "kind": "displacement", "component": 0, "times": [0.0], "values": [0.0]},
+      {"set": "right", "kind": "velocity", "component": 0, "times": [0.0, 1e-6], "values": [0.0, 20.0]}],
+    "initial_conditions": [{"set": "right", "kind": "velocity", "component": 1, "value": 0.0}],
+    "damping": 0.0,
+    "time": {"end": 4e-6, "integrator": "verlet", "dt": "stable", "safety_factor": 0.8, "max_steps": 100000)" +
+                                       extra_time + R"(},
+    "output": {"every_time": 1e-6, "every_steps": null, "history_every": 5},
+    "figures": {"times": null, "displacement_component": 0}
+  })";
+}
+
+}  // namespace
+
+TEST(EndToEnd, RunWritesFramesPvdAndHistoryThatReadBack) {
+  const fs::path dir = temp_dir("plate");
+  write_plate_case(dir);
+  ASSERT_EQ(run_solver((dir / "case.json").string() + " --threads 2", dir / "log.txt"), 0) << slurp(dir / "log.txt");
+  const fs::path out = dir / "out";
+
+  // run.log has the start summary; stdout had it too.
+  const std::string log = slurp(out / "run.log");
+  for (const char* word : {"nodes 128", "bonds", "horizon", "c ", "s0 ", "dt ", "steps expected", "threads 2", "done"})
+    EXPECT_NE(log.find(word), std::string::npos) << word << " not in run.log:\n" << log;
+  EXPECT_NE(slurp(dir / "log.txt").find("steps expected"), std::string::npos);
+
+  // frames.pvd lists every frame, first at t = 0, last at the end time.
+  const std::string pvd = slurp(out / "frames.pvd");
+  const std::regex dataset("<DataSet timestep=\"([^\"]+)\" group=\"\" part=\"0\" file=\"(frames/frame_[0-9]{6}\\.vtu)\"/>");
+  std::vector<std::pair<double, std::string>> frames;
+  for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), dataset); it != std::sregex_iterator(); ++it)
+    frames.emplace_back(std::stod((*it)[1]), (*it)[2]);
+  ASSERT_EQ(frames.size(), 5u) << pvd;  // t = 0, 1, 2, 3, 4 µs
+  EXPECT_EQ(frames.front().first, 0.0);
+  EXPECT_NEAR(frames.back().first, 4e-6, 1e-18);
+
+  std::int64_t previous_step = -1;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const pd::VtuGrid g = pd::read_vtu(out / frames[k].second);
+    ASSERT_EQ(g.points_count(), 128u);
+    const auto time = pd::values_of<double>(*g.find(g.field_data, "TIME"));
+    const auto step = pd::values_of<std::int64_t>(*g.find(g.field_data, "step"));
+    EXPECT_EQ(time[0], frames[k].first);
+    EXPECT_GT(step[0], previous_step);
+    previous_step = step[0];
+    for (const char* name : {"displacement", "velocity"}) {
+      const pd::VtuArray* a = g.find(g.point_data, name);
+      ASSERT_TRUE(a) << name;
+      EXPECT_EQ(a->type, "Float64");
+      EXPECT_EQ(a->components, 3);
+    }
+    const auto damage = pd::values_of<double>(*g.find(g.point_data, "damage"));
+    const auto block = pd::values_of<std::int32_t>(*g.find(g.point_data, "block"));
+    EXPECT_EQ(block, std::vector<std::int32_t>(128, 1));
+    const auto types = pd::values_of<std::uint8_t>(g.types);
+    const auto flag = pd::values_of<std::uint8_t>(*g.find(g.cell_data, "broken_bond"));
+    ASSERT_GE(types.size(), 128u);
+    for (std::size_t c = 0; c < types.size(); ++c) {
+      EXPECT_EQ(types[c], c < 128 ? 1 : 3);
+      EXPECT_EQ(flag[c], c < 128 ? 0 : 1);
+    }
+    if (k == frames.size() - 1) {
+      const auto u = pd::values_of<double>(*g.find(g.point_data, "displacement"));
+      EXPECT_GT(types.size(), 128u);  // bonds broke: line cells present
+      EXPECT_GT(*std::max_element(damage.begin(), damage.end()), 0.0);
+      // The right edge moved by ∫v dt = 20·(0.5 + 3) µs = 70 µm.
+      EXPECT_NEAR(u[3 * 15], 7e-5, 1e-12);
+      EXPECT_EQ(u[0], 0.0);  // the left edge is clamped in x
+    }
+  }
+
+  // history.csv: exactly the formats.md header, rows at step 0, every 5 steps and at frames.
+  std::ifstream history(out / "history.csv");
+  std::string line;
+  std::getline(history, line);
+  EXPECT_EQ(line, pd::kHistoryHeader);
+  EXPECT_EQ(line, "step,time,dt,iterations,rejected,kinetic_energy,strain_energy,external_work,damping_work,broken_bonds,wall_time");
+  int rows = 0;
+  double last_time = -1, last_work = 0, last_energy = 0;
+  long long last_broken = 0;
+  while (std::getline(history, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 11u) << line;
+    const double t = std::stod(cells[1]);
+    EXPECT_GT(t, last_time);
+    last_time = t;
+    last_energy = std::stod(cells[5]) + std::stod(cells[6]);
+    last_work = std::stod(cells[7]);
+    last_broken = std::stoll(cells[9]);
+    ++rows;
+  }
+  EXPECT_GT(rows, 5);
+  EXPECT_NEAR(last_time, 4e-6, 1e-18);
+  EXPECT_GT(last_broken, 0);
+  EXPECT_GT(last_work, 0.0);  // the pull did work…
+  EXPECT_LT(last_energy, 1.5 * last_work);  // …and the body holds no more than it received (plus slack)
+  EXPECT_FALSE(fs::exists(out / "history.csv.part"));
+  fs::remove_all(dir);
+}
+
+TEST(EndToEnd, SameFramesWithOneAndTwoThreads) {
+  const fs::path dir = temp_dir("threads");
+  write_plate_case(dir);
+  ASSERT_EQ(run_solver((dir / "case.json").string() + " --threads 1 --quiet", dir / "log1.txt"), 0);
+  const std::string one = slurp(dir / "out" / "frames" / "frame_000004.vtu");
+  ASSERT_EQ(run_solver((dir / "case.json").string() + " --threads 2 --quiet", dir / "log2.txt"), 0);
+  const std::string two = slurp(dir / "out" / "frames" / "frame_000004.vtu");
+  EXPECT_FALSE(one.empty());
+  EXPECT_TRUE(one == two) << "frames differ between 1 and 2 threads";
+  EXPECT_TRUE(slurp(dir / "log1.txt").empty());  // --quiet
+  fs::remove_all(dir);
+}
+
+TEST(EndToEnd, BadInputFailsBeforeAnyOutput) {
+  const fs::path dir = temp_dir("bad");
+  write_plate_case(dir, R"(, "extra": 1)");
+  EXPECT_EQ(run_solver((dir / "case.json").string(), dir / "log.txt"), 1);
+  EXPECT_NE(slurp(dir / "log.txt").find("case.json: time.extra: unknown key"), std::string::npos) << slurp(dir / "log.txt");
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  EXPECT_EQ(run_solver("", dir / "log.txt"), 2);  // usage
+  EXPECT_EQ(run_solver((dir / "case.json").string() + " --threads zero", dir / "log.txt"), 2);
+  EXPECT_EQ(run_solver("--version", dir / "log.txt"), 0);
+  fs::remove_all(dir);
+}
+
+TEST(EndToEnd, NonFiniteStateStopsTheRunNamingTheStep) {
+  const fs::path dir = temp_dir("blowup");
+  write_plate_case(dir);
+  std::string text = slurp(dir / "case.json");
+  auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+  replace("\"dt\": \"stable\"", "\"dt\": 1e-5");                          // far above the stable step
+  replace("\"fracture_energy\": 3.8", "\"fracture_energy\": null");  // nothing breaks to save it
+  std::ofstream(dir / "case.json") << text;
+  EXPECT_EQ(run_solver((dir / "case.json").string() + " --end-time 1e-2", dir / "log.txt"), 3);
+  const std::string log = slurp(dir / "log.txt");
+  EXPECT_NE(log.find("non-finite"), std::string::npos) << log;
+  EXPECT_NE(log.find("after step"), std::string::npos) << log;
+  fs::remove_all(dir);
+}
