@@ -1,16 +1,19 @@
 # Orchestration only: each stage is a program, files are the interface (pipeline/formats.md).
 #   make case=membrane        mesh → node cloud → solve → figures and Gmsh views, in out/membrane/
 #   make figures case=X       redraw figures and Gmsh views from existing results
+#   make case=X config=Y      run cases/X/Y.yaml (a variant of case X) into out/X-Y/
 #   make test                 build everything and run every test
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
 case    ?= membrane
+config  ?= $(case)
 PY      := /usr/bin/python3
 PYTEST  := /usr/bin/python3 -m pytest
 JOBS    ?= 2
 CASEDIR := cases/$(case)
-OUT     := out/$(case)
+YAML    := $(CASEDIR)/$(config).yaml
+OUT     := out/$(case)$(if $(filter-out $(case),$(config)),-$(config))
 SOLVER  := build/solver/pdsolve
 DEPS    := build/.deps-ok
 
@@ -41,16 +44,16 @@ $(SOLVER): $(SOLVER_SOURCES) | $(DEPS)
 	@touch $@
 
 check: | $(DEPS)
-	$(PY) -m pipeline.run check $(CASEDIR)/$(case).yaml
+	$(PY) -m pipeline.run check $(YAML)
 
 # gmsh parameters live in the .yaml; this file changes only when they do.
-$(OUT)/mesh-parameters.json: $(CASEDIR)/$(case).yaml $(PRE_SOURCES) | $(DEPS)
+$(OUT)/mesh-parameters.json: $(YAML) $(PRE_SOURCES) | $(DEPS)
 	$(PY) -m pipeline.run mesh-parameters $< $@
 
 $(OUT)/mesh.msh: $(CASEDIR)/$(case).geo $(OUT)/mesh-parameters.json | $(DEPS)
-	$(PY) -m pipeline.run mesh $(CASEDIR)/$(case).yaml $< $@
+	$(PY) -m pipeline.run mesh $(YAML) $< $@
 
-$(OUT)/nodes.vtu $(OUT)/case.json &: $(CASEDIR)/$(case).yaml $(MESH) $(PRE_SOURCES) | $(DEPS)
+$(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
 	$(PY) -m pipeline.run preprocess $< $(MESH) $(OUT)
 
 $(OUT)/history.csv $(OUT)/frames.pvd &: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)

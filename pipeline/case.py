@@ -10,10 +10,16 @@ __all__ = ["CaseError", "load_case"]
 
 
 def load_case(path: str) -> dict:
-    """Return the validated case; the case name is the file's stem (cases/<case>/<case>.yaml)."""
+    """Return the validated case.
+
+    Its name is the folder's for cases/<case>/<case>.yaml, and "<case>-<config>" for a
+    variant cases/<case>/<config>.yaml: the name of its folder under out/ (see Makefile).
+    """
     data, lines = load_with_lines(path)
     case = validate(data, path, lines)
     case["_path"] = path
     case["_lines"] = lines
-    case["_name"] = os.path.splitext(os.path.basename(path))[0]
+    stem = os.path.splitext(os.path.basename(path))[0]
+    folder = os.path.basename(os.path.dirname(os.path.abspath(path)))
+    case["_name"] = stem if stem == folder else f"{folder}-{stem}"
     return case

@@ -45,7 +45,13 @@ def test_defaults_are_filled_in(tmp_path):
     assert case["time"]["safety_factor"] == 0.8
     assert case["output"]["every_time"] == pytest.approx(1.0e-3 / 50)
     assert case["materials"]["plate"]["fracture_energy"] is None
-    assert case["_name"] == "plate"
+
+
+def test_case_name_is_folder_and_variant(tmp_path):
+    folder = tmp_path / "plate"
+    folder.mkdir()
+    assert load_case(write(folder, MINIMAL, "plate.yaml"))["_name"] == "plate"
+    assert load_case(write(folder, MINIMAL, "fine.yaml"))["_name"] == "plate-fine"
 
 
 def test_unknown_key_names_line_and_closest_key(tmp_path):
