@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import difflib
+import math
 
 from .yaml_lines import CaseError
 
@@ -64,6 +65,10 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
             for comp, (_times, values) in (ic[kind] or {}).items():
                 initial.append({"set": ic["set"], "kind": kind, "component": AXIS[comp],
                                 "value": values[0]})
+    contact = dict(case["contact"])
+    if contact["skin"] is None:
+        contact["skin"] = 0.5 * grid_spacing  # half the node spacing: few rebuilds, few extra pairs
+    indenters = [_resolve_indenter(ind) for ind in case["indenters"]]
     time = dict(case["time"])
     figures = dict(case["figures"])
     figures["displacement_component"] = AXIS[figures["displacement_component"]]
@@ -85,7 +90,28 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "boundary_conditions": boundary,
         "initial_conditions": initial,
         "damping": case["damping"],
+        "partial_volume": case["discretization"]["partial_volume"],
+        "contact": contact,
+        "indenters": indenters,
         "time": time,
         "output": dict(case["output"]),
         "figures": figures,
     }
+
+
+def _unit(vector: list[float]) -> list[float]:
+    norm = math.sqrt(sum(c * c for c in vector))
+    return [c / norm for c in vector]
+
+
+def _resolve_indenter(ind: dict) -> dict:
+    """Every key explicit; directions as unit vectors (the solver checks them again)."""
+    out = {"name": ind["name"], "shape": ind["shape"], "centre": ind["centre"],
+           "velocity": ind["velocity"] or [0.0, 0.0, 0.0], "stiffness": ind["stiffness"]}
+    if ind["shape"] == "plane":
+        out["normal"] = _unit(ind["normal"])
+    else:
+        out["radius"] = ind["radius"]
+    if ind["shape"] == "cylinder":
+        out["axis"] = _unit(ind["axis"] or [0.0, 0.0, 1.0])
+    return out

@@ -15,9 +15,11 @@ import json
 import os
 import sys
 import tempfile
+import warnings
 
 from .case import CaseError, load_case
 from .resolve import resolve
+from .stability import check_discretized_case
 
 
 def write_atomically(path: str, text: str):
@@ -78,6 +80,9 @@ def cmd_preprocess(args):
     )
     resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
                        nodes_file="nodes.vtu")
+    # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.
+    for warning in check_discretized_case(case, resolved, cloud):
+        print(f"warning: {warning}", file=sys.stderr)
     os.makedirs(args.out_dir, exist_ok=True)
     write_node_file(os.path.join(args.out_dir, "nodes.vtu"), cloud)
     write_atomically(os.path.join(args.out_dir, "case.json"), json.dumps(resolved, indent=1) + "\n")
@@ -107,6 +112,8 @@ def main(argv=None) -> int:
     p.add_argument("out_dir")
     p.set_defaults(func=cmd_preprocess)
     args = parser.parse_args(argv)
+    # Preprocess warnings name their file already; print them as such, not as Python source lines.
+    warnings.showwarning = lambda message, *rest, **kw: print(f"warning: {message}", file=sys.stderr)
     try:
         args.func(args)
     except CaseError as err:

@@ -17,7 +17,7 @@ class Key:
     """One key of the case file.
 
     kind: number | integer | string | choice | section | named (user-named
-    sub-sections, e.g. materials) | list (of sections) | names (list of strings)
+    sub-sections, e.g. materials) | list (of sections) | names (list of strings) | boolean
     | components (x/y/z → number or [[t, v], ...] table) | numbers (list of
     numbers) | parameters (name → number) | number_or_choice.
     """
@@ -68,6 +68,22 @@ INITIAL_CONDITION = {
                         table=False),
 }
 
+INDENTER = {
+    "name": Key("string", "name of the indenter (history.csv columns indenter_<name>_fx, _fy, _fz)",
+                default=REQUIRED),
+    "shape": Key("choice", "sphere, cylinder (a disk in 2D) or plane", default=REQUIRED,
+                 choices=("sphere", "cylinder", "plane")),
+    "radius": Key("number", "radius R (sphere, cylinder)", default=None, unit="m", above=0.0),
+    "centre": Key("numbers", "centre (sphere, cylinder) or a point of the plane at t = 0, [x, y(, z)]",
+                  default=REQUIRED, unit="m"),
+    "velocity": Key("numbers", "constant velocity of the indenter, [vx, vy(, vz)]", default=None, unit="m/s"),
+    "normal": Key("numbers", "plane: normal pointing out of the indenter, towards the body it pushes",
+                  default=None),
+    "axis": Key("numbers", "cylinder: axis direction (default z: a disk in a 2D case)", default=None),
+    "stiffness": Key("number", "K of the force density K·h² (LAMMPS fix indent; a force density "
+                     "as in LAMMPS PERI)", default=REQUIRED, unit="N/m⁵", above=0.0),
+}
+
 CASE = {
     "title": Key("string", "a one-line description, shown in figures", default=""),
     "dimension": Key("choice", "spatial dimension of the geometry", default=REQUIRED, choices=(2, 3)),
@@ -89,6 +105,10 @@ CASE = {
         horizon_factor=Key("number", "horizon δ = horizon_factor × dx (thesis §2.1: δ = 3dx works well; "
                            "the extra 0.015 keeps lattice bonds at exactly 3dx)", default=3.015, above=0.0),
         horizon=Key("number", "horizon δ; overrides horizon_factor", default=None, unit="m", above=0.0),
+        partial_volume=Key("choice", "share ν of a neighbour's volume inside the horizon (validation.md F3): "
+                           "none (full volumes), lammps (ν = (δ − |ξ|)/dx + ½ for δ − dx/2 ≤ |ξ| ≤ δ), "
+                           "hhb (family |ξ| − dx/2 ≤ δ, ν = (δ − |ξ| + dx/2)/dx on the outer shell)",
+                           default="none", choices=("none", "lammps", "hhb")),
     ),
     "materials": Key("named", "one entry per block, named after a gmsh physical group of the "
                      "top dimension (surface in 2D, volume in 3D)", default=REQUIRED, fields=MATERIAL),
@@ -106,6 +126,21 @@ CASE = {
                               default=[], fields=INITIAL_CONDITION),
     "damping": Key("number", "velocity damping α: force density −ρ·α·v (the thesis's damping "
                    "correction); 0 for none", default=0.0, unit="1/s", minimum=0.0),
+    "contact": section(
+        "short-range repulsion between nodes closer than d = min(0.9|ξ|, 1.35dx) (bonded pairs) or "
+        "1.35dx (others), force (c_s/δ)(d − r)V_j (thesis §1.1.3; validation.md F4)",
+        enabled=Key("choice", "auto: on when the case has more than one block (or self_contact); on; off",
+                    default="auto", choices=("auto", "on", "off")),
+        self_contact=Key("boolean", "also between nodes of the same block (fragments hitting each other)",
+                         default=False),
+        skin=Key("number", "Verlet-list skin: the list is rebuilt when a node has moved more than skin/2 "
+                 "(default: dx/2)", default=None, unit="m", above=0.0),
+        stiffness_factor=Key("number", "contact stiffness c_s = stiffness_factor × c (Silling: 15)",
+                             default=15.0, above=0.0),
+    ),
+    "indenters": Key("list", "rigid indenters moving at a constant velocity, pushing nodes inside them "
+                     "with force density K·h², h the depth below the surface (LAMMPS fix indent)",
+                     default=[], fields=INDENTER),
     "time": section(
         "time integration",
         end=Key("number", "simulated end time", default=REQUIRED, unit="s", above=0.0),

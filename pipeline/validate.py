@@ -93,6 +93,11 @@ class _Checker:
             return value
         if kind == "choice":
             return self.choice(value, keypath, key)
+        if kind == "boolean":
+            if not isinstance(value, bool):
+                self.error(keypath, f"expected true or false, got {value!r}")
+                return None
+            return value
         if kind == "number_or_choice":
             if isinstance(value, str):
                 return self.choice(value, keypath, key)
@@ -251,8 +256,39 @@ def _check_context(case: dict, checker: _Checker):
     for i, ic in enumerate(case["initial_conditions"]):
         if not ic["velocity"] and not ic["displacement"]:
             checker.error(("initial_conditions", i), "give velocity or displacement")
+    names = set()
+    for i, ind in enumerate(case["indenters"]):
+        _check_indenter(ind, i, dim, names, checker)
     out = case["output"]
     if out["every_time"] is not None and out["every_steps"] is not None:
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
         out["every_time"] = case["time"]["end"] / 50.0
+
+
+def _check_indenter(ind: dict, i: int, dim: int, names: set, checker: _Checker):
+    """An indenter's vectors have the case's dimension, its shape has what it needs, names are unique."""
+    where = ("indenters", i)
+    name = ind["name"]
+    if name is not None:
+        if not NAME_PATTERN.match(name):
+            checker.error(where + ("name",), "letters, digits and '_', not starting with a digit "
+                          "(it names history.csv columns)")
+        if name in names:
+            checker.error(where + ("name",), f"'{name}' is used twice; give each indenter its own name")
+        names.add(name)
+    for key in ("centre", "velocity", "normal", "axis"):
+        vector = ind[key]
+        if vector is None:
+            continue
+        if len(vector) not in ((2, 3) if dim == 2 else (3,)):
+            checker.error(where + (key,), f"expected {'2 or 3' if dim == 2 else '3'} components, got {len(vector)}")
+            continue
+        ind[key] = [float(c) for c in vector] + [0.0] * (3 - len(vector))
+        if key in ("normal", "axis") and not any(ind[key]):
+            checker.error(where + (key,), "must be a non-zero direction")
+    shape = ind["shape"]
+    if shape in ("sphere", "cylinder") and ind["radius"] is None:
+        checker.error(where + ("radius",), f"a {shape} indenter needs radius [m]")
+    if shape == "plane" and ind["normal"] is None:
+        checker.error(where + ("normal",), "a plane indenter needs normal, pointing towards the body it pushes")

@@ -122,6 +122,7 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
 
     if do_figures:
         from .energy_plot import plot_energy
+        from .indenter_plot import indenter_names, plot_indenter_forces
         from .maps import displacement_range, plot_map
         from .probe import plot_probe
         from .timestep_plot import plot_timestep
@@ -133,6 +134,10 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
         path = os.path.join(fig_dir, "timestep.png")
         plot_timestep(history, case, path)
         written.append(path)
+        if indenter_names(history):  # only when the case has indenters (formats.md §4)
+            path = os.path.join(fig_dir, "indenter_force.png")
+            plot_indenter_forces(history, case, path)
+            written.append(path)
         shared = displacement_range([kept[i] for i in selected], case.component)
         for number, (t_requested, index) in enumerate(zip(requested, selected)):
             for quantity in ("damage", "displacement"):

@@ -8,9 +8,11 @@ from .plotting import new_figure, save_figure
 
 
 def energy_balance(history: dict) -> np.ndarray:
-    """kinetic + strain + damping work − external work [J]: constant in an exact integration."""
-    return (history["kinetic_energy"] + history["strain_energy"] + history["damping_work"]
-            - history["external_work"])
+    """kinetic + strain (+ contact) + damping work − external work [J]: constant in an exact
+    integration without breaking. contact_energy is there only when the case has contact or
+    indenters (formats.md §4)."""
+    return (history["kinetic_energy"] + history["strain_energy"] + history.get("contact_energy", 0.0)
+            + history["damping_work"] - history["external_work"])
 
 
 def plot_energy(history: dict, case: CaseSettings, path: str):
@@ -23,7 +25,11 @@ def plot_energy(history: dict, case: CaseSettings, path: str):
     top.plot(t, history["strain_energy"], label="strain energy")
     top.plot(t, history["external_work"], label="external work")
     top.plot(t, history["damping_work"], label="damping work")
-    top.plot(t, balance, "k--", label="balance: kinetic + strain + damping − external")
+    contact = "contact_energy" in history
+    if contact:
+        top.plot(t, history["contact_energy"], label="contact energy")
+    top.plot(t, balance, "k--", label="balance: kinetic + strain + " + ("contact + " if contact else "") +
+             "damping − external")
     top.set_ylabel("energy [J]")
     top.set_title(f"{case.heading}: energy")
     top.legend(fontsize="small")

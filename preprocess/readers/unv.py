@@ -91,6 +91,10 @@ def _ints(lines: _Lines, lineno: int, line: str, count: int | None, what: str) -
     if count is not None and len(values) != count:
         raise lines.error(lineno, f"bad record for {what}: expected {count} integers, got {len(values)}: "
                           f"'{line.strip()}'")
+    # Labels and counts become int64 arrays; a larger value would raise OverflowError there (fuzzing).
+    for v in values:
+        if abs(v) >= 2 ** 62:
+            raise lines.error(lineno, f"bad record for {what}: {v} is too large for a label or a count")
     return values
 
 

@@ -3,8 +3,13 @@
 #include <iostream>
 #include <string>
 
+#include "build_info.hpp"
 #include "core/error.hpp"
 #include "run.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace {
 
@@ -20,7 +25,38 @@ const char* const kUsage =
     "  --max-steps N   stop after N steps at most\n"
     "  --quiet         print nothing on stdout and no progress line (run.log is still written)\n"
     "  --help          this text\n"
-    "  --version       the solver version\n";
+    "  --version       the solver version and how it was built (compiler, flags, OpenMP, sanitizers)\n"
+    "\n"
+    "Exit codes: 0 done; 1 bad input (reported before any output file is written); 2 bad command\n"
+    "line; 3 the run failed (e.g. the state became non-finite; the last valid frame is kept).\n";
+
+#ifdef _OPENMP
+// The specification version of an _OPENMP date (OpenMP's own table).
+std::string openmp_version(long date) {
+  switch (date) {
+    case 201307: return "4.0";
+    case 201511: return "4.5";
+    case 201811: return "5.0";
+    case 202011: return "5.1";
+    case 202111: return "5.2";
+    default: return std::to_string(date);
+  }
+}
+#endif
+
+// --version: enough to tell which binary, built how, produced a result.
+void print_version() {
+  std::cout << "pdsolve " << pd::build::kVersion << "\n"
+            << "build type: " << (*pd::build::kBuildType ? pd::build::kBuildType : "(none)") << "\n"
+            << "compiler: " << pd::build::kCompiler << "\n"
+            << "flags: " << pd::build::kFlags << "\n"
+#ifdef _OPENMP
+            << "OpenMP: " << openmp_version(_OPENMP) << " (up to " << omp_get_max_threads() << " threads here)\n"
+#else
+            << "OpenMP: off\n"
+#endif
+            << "sanitizers: " << pd::build::kSanitizers << "\n";
+}
 
 [[noreturn]] void usage_error(const std::string& what) {
   std::cerr << "pdsolve: " << what << "\n" << kUsage;
@@ -65,7 +101,7 @@ int main(int argc, char** argv) {
       std::cout << kUsage;
       return pd::kOk;
     } else if (arg == "--version") {
-      std::cout << "pdsolve " PD_VERSION "\n";
+      print_version();
       return pd::kOk;
     } else if (arg == "--threads") {
       options.threads = static_cast<int>(parse_integer(arg, value()));

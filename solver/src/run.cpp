@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/work_plan.hpp"
 #include "forces/pmb.hpp"
 #include "integrators/integrator.hpp"
 #include "io/case_reader.hpp"
@@ -115,7 +116,13 @@ int run(const RunOptions& opt) {
   if (first_non_finite(state) >= 0) throw Error(c.file.string() + ": the initial state is not finite");
 
   // ---- output starts here
-  OutputWriter out(c.output_dir);
+  // The scene's own history columns (formats.md §4): only when it has contact or indenters.
+  std::vector<std::string> extra_columns;
+  if (model.contact.pairs || !model.indenters.empty()) extra_columns.push_back("contact_energy");
+  if (model.contact.pairs) extra_columns.push_back("contact_rebuilds");
+  for (const auto& ind : model.indenters)
+    for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("indenter_" + ind.name + "_" + axis);
+  OutputWriter out(c.output_dir, extra_columns);
   RunLog log(c.output_dir / "run.log", opt.quiet);
   log.line("pdsolve " PD_VERSION ": case " + (c.name.empty() ? opt.case_file.string() : c.name) + " (" +
            opt.case_file.string() + ")");
@@ -135,6 +142,7 @@ int run(const RunOptions& opt) {
            "), integrator " + integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
   if (c.time.dt_rule == "fixed" && dt > dt_stable)
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
+  for (const auto& text : work_summary(model, c)) log.line(text);
   log.line("end time " + format("%.6g", end) + " s, steps expected " + std::to_string(steps_expected) +
            (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
 
@@ -153,6 +161,11 @@ int run(const RunOptions& opt) {
     r.damping_work = state.damping_work;
     r.broken_bonds = broken;
     r.wall_time = seconds_since(loop_start);
+    if (model.contact.pairs || !model.indenters.empty()) r.extra.push_back(state.contact_energy);
+    if (model.contact.pairs) r.extra.push_back(static_cast<double>(model.contact_list.rebuilds()));
+    for (std::size_t k = 0; k < model.indenters.size(); ++k)
+      for (std::size_t d = 0; d < 3; ++d)  // the reaction on the indenter: minus its force on the body
+        r.extra.push_back(k < state.indenter_force.size() ? -state.indenter_force[k][d] : 0.0);
     out.history(r);
   };
   std::int64_t next_frame_index = 1;  // every_time: frame k at t ≥ k·every_time
@@ -206,6 +219,10 @@ int run(const RunOptions& opt) {
            format("%.6g", t) + " s in " + format("%.3f", wall) + " s wall (" +
            format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
            std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds");
+  if (model.contact.pairs)
+    log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
+             std::to_string(step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
+             std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
   if (status == kOk && step >= max_steps && t < end * (1.0 - 1e-12))
     log.line("note: stopped at max_steps " + std::to_string(max_steps) + " before the end time");
   return status;

@@ -92,3 +92,14 @@ def test_energy_is_dissipated_and_balanced(membrane_run):
     assert np.abs(balance - balance[0]).max() < 1e-3 * balance[0]
     assert np.all(np.diff(history["time"]) > 0)
     assert np.all(history["broken_bonds"] == 0)  # no fracture_energy: unbreakable
+
+
+def test_a_single_body_runs_no_contact_search(membrane_run):
+    # One block, no self_contact, no indenters: the solver plans no contact work and writes no
+    # contact columns (formats.md §4).
+    log = (membrane_run / "run.log").read_text()
+    assert "work: no contact search (one body and no self_contact)" in log
+    assert "work: no indenters" in log
+    assert "work: no breakage test (every block unbreakable)" in log
+    header = (membrane_run / "history.csv").read_text().splitlines()[0].split(",")
+    assert "contact_rebuilds" not in header and "contact_energy" not in header

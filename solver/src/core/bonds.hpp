@@ -20,6 +20,7 @@ struct BondList {
   std::vector<std::int32_t> neighbour;  // j, ascending within a row
   std::vector<double> length;           // |ξ| = |x_j − x_i| in the reference configuration
   std::vector<std::uint8_t> broken;     // 1 once the bond has broken (never heals)
+  std::vector<double> volume_factor;    // ν: the share of V_j inside the horizon (validation.md F3); 1 by default
 
   std::size_t nodes() const { return offsets.empty() ? 0 : offsets.size() - 1; }
   std::size_t directed() const { return neighbour.size(); }  // each bond counted twice

@@ -1,5 +1,6 @@
 // The resolved case (pipeline/formats.md §3) as plain values, after io/case_reader checked them.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -27,16 +28,45 @@ struct InitialCondition {
 struct TimeSettings {
   double end = 0.0;
   std::string integrator = "verlet";
-  std::string dt_rule = "stable";  // "stable" or "fixed"
+  std::string dt_rule = "stable";  // "stable", "exact" or "fixed"
   double dt_value = 0.0;           // the number when dt_rule == "fixed"
   double safety_factor = 0.8;
   std::int64_t max_steps = 100000000;
+};
+
+// adaptive: the mixed explicit–implicit step of thesis §2.2 (integrators/adaptive.hpp).
+struct AdaptiveSettings {
+  double tol = 1e-3;  // TOL of eq. 2.7
+  int kd = 20;        // K_d, the desired number of fixed-point iterations
+  double p = 3.0;     // the exponent p of eq. 2.8
+  double phi = 1.0;   // φ: weight of the end-of-step force (1 thesis, ½ trapezoidal)
+  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: derived from eq. 2.5
 };
 
 struct OutputSettings {
   std::optional<double> every_time;        // s
   std::optional<std::int64_t> every_steps;
   std::int64_t history_every = 1;
+};
+
+// contact: short-range forces between nodes (validation.md F4).
+struct ContactSettings {
+  std::string enabled = "auto";   // auto | on | off
+  bool self_contact = false;      // also between nodes of the same block (fragments)
+  double skin = 0.0;              // Verlet-list skin [m]; 0 → half the grid spacing
+  double stiffness_factor = 15.0; // c_s = factor·c (Silling's EMU value 15, as LAMMPS)
+};
+
+// A rigid indenter (LAMMPS fix indent): force density K·(R − r)² on nodes inside it.
+struct IndenterSettings {
+  std::string name;
+  std::string shape;                 // sphere | cylinder | plane (registry in forces/indenter)
+  double radius = 0.0;               // R [m] (sphere, cylinder)
+  std::array<double, 3> centre{};    // at t = 0 [m]; a point of the plane
+  std::array<double, 3> velocity{};  // [m/s]
+  std::array<double, 3> normal{};    // plane: unit normal out of the indenter, towards the body
+  std::array<double, 3> axis{};      // cylinder: unit axis (z for a disk in a 2D case)
+  double stiffness = 0.0;            // K [N/m⁵]
 };
 
 struct Case {
@@ -48,12 +78,16 @@ struct Case {
   double thickness = 0.0;  // h [m], 2D only
   double grid_spacing = 0.0;
   double horizon = 0.0;
+  std::string partial_volume = "none";  // validation.md F3: none | lammps | hhb
   std::vector<BlockMaterial> blocks;
   std::vector<std::string> no_fail_sets, node_sets;
   std::vector<BoundaryCondition> boundary_conditions;
   std::vector<InitialCondition> initial_conditions;
   double damping = 0.0;  // α [1/s]
+  ContactSettings contact;
+  std::vector<IndenterSettings> indenters;
   TimeSettings time;
+  AdaptiveSettings adaptive;
   OutputSettings output;
 };
 

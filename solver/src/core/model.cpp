@@ -7,6 +7,8 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/partial_volume.hpp"
+#include "core/work_plan.hpp"
 
 namespace pd {
 
@@ -31,6 +33,7 @@ Model build_model(const Case& c, Nodes nodes) {
 
   Model m;
   m.horizon = c.horizon;
+  m.grid_spacing = c.grid_spacing;
   m.damping = c.damping;
   m.material = make_material_table(c.blocks, c.analysis, c.horizon, c.thickness);
   m.density.resize(n);
@@ -49,7 +52,13 @@ Model build_model(const Case& c, Nodes nodes) {
     for (std::size_t i = 0; i < n; ++i) m.no_fail[i] |= set->member[i];
   }
   m.conditions = make_conditions(c, nodes);
-  m.bonds = build_bonds(nodes.x, c.horizon);
+  // A partial-volume rule may widen the family (HHB) and weights each bond by ν (validation.md F3).
+  const PartialVolumeRule& rule = partial_volume_registry().get(c.partial_volume);
+  const double cutoff = bond_cutoff(rule, c.horizon, c.grid_spacing);
+  m.bonds = build_bonds(nodes.x, cutoff);
+  apply_partial_volume(rule, c.horizon, c.grid_spacing, m.bonds);
+  m.contact = plan_contact(c, m.block_index, cutoff * (1.0 + kHorizonTolerance));
+  m.indenters = c.indenters;
   m.nodes = std::move(nodes);
   return m;
 }
@@ -66,7 +75,13 @@ double stable_time_step(const Model& m) {
     for (std::int64_t k = m.bonds.offsets[static_cast<std::size_t>(i)]; k < m.bonds.offsets[static_cast<std::size_t>(i) + 1]; ++k) {
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
       const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
-      sum += m.nodes.volume[j] * c / m.bonds.length[static_cast<std::size_t>(k)];
+      const auto kk = static_cast<std::size_t>(k);
+      sum += m.nodes.volume[j] * m.bonds.volume_factor[kk] * c / m.bonds.length[kk];
+      // With contact, a node pressed into a surface meets about as many contact partners as it has
+      // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
+      // 15c needs extra margin in impacts).
+      if (m.contact.pairs && m.bonds.length[kk] <= m.contact.distance)
+        sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
     }
     if (sum > 0.0) dt = std::min(dt, std::sqrt(2.0 * m.density[static_cast<std::size_t>(i)] / sum));
   }

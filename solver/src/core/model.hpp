@@ -8,6 +8,7 @@
 #include "core/conditions.hpp"
 #include "core/material.hpp"
 #include "core/nodes.hpp"
+#include "core/verlet_list.hpp"
 
 namespace pd {
 
@@ -16,11 +17,19 @@ struct Model {
   BondList bonds;  // the only part that changes: bonds break
   MaterialTable material;
   double horizon = 0.0;  // δ [m]
+  double grid_spacing = 0.0;  // dx [m]
   double damping = 0.0;  // α [1/s]
   std::vector<double> density;             // ρ per node [kg/m³]
   std::vector<std::int32_t> block_index;   // block id − 1 per node (row of the pair tables)
   std::vector<std::uint8_t> no_fail;       // 1: bonds with this end never break
   Conditions conditions;
+  // Short-range contact (validation.md F4) and rigid indenters: what the scene needs is decided
+  // once from the case (core/work_plan); contact.pairs is false when nothing can touch.
+  ContactParameters contact;
+  std::vector<IndenterSettings> indenters;
+  // A cache of the proximity search, not state: the forces are the same whether or not it was
+  // rebuilt (tested), so it may change behind a const Model.
+  mutable VerletList contact_list;
 };
 
 // Checks the node file against the case (blocks in range, sets present) and builds the bonds.
@@ -28,6 +37,8 @@ Model build_model(const Case& c, Nodes nodes);
 
 // Stable step of the explicit scheme, thesis eq. 2.5 (validation.md F2):
 // Δt = min_i √(2ρ_i / Σ_p V_p c_ip/|ξ_p|), without safety factor; +inf if no node has a bond.
+// ν_p (partial volume) multiplies V_p; with contact, every bond shorter than 2r_s adds a contact
+// spring V_p·c_s/δ to the sum.
 double stable_time_step(const Model& model);
 
 }  // namespace pd

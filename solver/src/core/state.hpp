@@ -1,5 +1,8 @@
 // The time-dependent state: displacement u, velocity v, force density f, and the energy ledger.
 #pragma once
+#include <array>
+#include <vector>
+
 #include "core/nodes.hpp"
 
 namespace pd {
@@ -9,6 +12,8 @@ struct State {
   Vec3Array v;  // velocity [m/s]
   Vec3Array f;  // force density of the conservative terms (bonds + body force) at u [N/m³]
   std::vector<double> w;  // strain-energy density W_i at u, from the last force evaluation [J/m³]
+  double contact_energy = 0.0;  // potential of contact pairs and indenters at u [J]
+  std::vector<std::array<double, 3>> indenter_force;  // force of each indenter on the body at u [N]
 
   // Work ledger, integrated with the trapezoidal rule over each step.
   double external_power = 0.0;  // body-force + reaction power at the current state [W]

@@ -12,6 +12,7 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
   a.neighbour = m.bonds.neighbour.data();
   a.length = m.bonds.length.data();
   a.broken = m.bonds.broken.data();
+  a.volume_factor = m.bonds.volume_factor.data();
   for (int d = 0; d < 3; ++d) {
     a.x[d] = m.nodes.x[static_cast<std::size_t>(d)].data();
     a.u[d] = u[static_cast<std::size_t>(d)].data();
@@ -54,7 +55,7 @@ void add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f
       // y > 0 always for an intact bond that has not been crushed to a point; a crushed bond
       // (y = 0) would give 0/0, so it is guarded by the same select.
       const double intact = a.broken[k] ? 0.0 : 1.0;
-      const double c_vj = intact * c_row[a.block[j]] * a.volume[j];
+      const double c_vj = intact * c_row[a.block[j]] * a.volume[j] * a.volume_factor[k];
       const double scale = (y > 0.0) ? c_vj * s / y : 0.0;
       energy += 0.25 * c_vj * s * s * a.length[k];
       s0 += scale * e0;
@@ -115,7 +116,7 @@ std::vector<double> strain_energy_density(const Model& m, const Vec3Array& u) {
       const std::int64_t j = a.neighbour[k];
       // ¼ c s² |ξ| V_j: each bond is visited from both ends, so each end takes half of the
       // bond's ½ c s² |ξ| V_i V_j (validation.md C4).
-      sum += 0.25 * c_row[a.block[j]] * s * s * a.length[k] * a.volume[j];
+      sum += 0.25 * c_row[a.block[j]] * s * s * a.length[k] * a.volume[j] * a.volume_factor[k];
     }
     w[static_cast<std::size_t>(i)] = sum;
   }

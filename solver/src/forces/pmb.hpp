@@ -21,6 +21,7 @@ struct PmbArrays {
   const std::int32_t* neighbour;
   const double* length;        // |ξ|
   const std::uint8_t* broken;
+  const double* volume_factor; // ν per bond (validation.md F3; 1 for full volumes)
   const double* x[3];          // reference positions
   const double* u[3];          // displacements
   const double* volume;
@@ -32,10 +33,10 @@ struct PmbArrays {
 
 PmbArrays pmb_arrays(const Model& model, const Vec3Array& u);
 
-// f_i += Σ_j c·s·(y_j − y_i)/|y_j − y_i|·V_j over intact bonds, s = (|ξ+η| − |ξ|)/|ξ|
+// f_i += Σ_j c·s·(y_j − y_i)/|y_j − y_i|·ν_j·V_j over intact bonds, s = (|ξ+η| − |ξ|)/|ξ|
 // (thesis eqs. 1.9, 1.10, 2.1). Each node writes only its own f_i: parallel over nodes,
 // schedule static, bitwise the same for any thread count. Accumulates; never clears f.
-// If w is not null, also stores the strain-energy density W_i = Σ_j ¼ c s² |ξ| V_j of every node
+// If w is not null, also stores the strain-energy density W_i = Σ_j ¼ c s² |ξ| ν_j V_j of every node
 // (validation.md C4; overwritten, not accumulated): a few flops per bond, so the energy needs no
 // second pass over the bonds.
 void add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w = nullptr);

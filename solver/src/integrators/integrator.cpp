@@ -4,7 +4,9 @@
 #include <algorithm>
 
 #include "forces/body_force.hpp"
+#include "forces/contact.hpp"
 #include "forces/damping.hpp"
+#include "forces/indenter.hpp"
 #include "forces/pmb.hpp"
 #include "integrators/verlet.hpp"
 
@@ -22,6 +24,10 @@ const Registry<IntegratorFactory>& integrator_registry() {
 void evaluate_forces(const Model& model, State& state, double t) {
   for (auto& fc : state.f) std::fill(fc.begin(), fc.end(), 0.0);
   PmbBondForce(model).AddMult(state.u, state.f, state.w.data());
+  state.contact_energy = 0.0;
+  if (model.contact.pairs) state.contact_energy += ShortRangeForce(model).AddMult(state.u, state.f);
+  if (!model.indenters.empty())
+    state.contact_energy += IndenterForce(model).AddMult(t, state.u, state.f, state.indenter_force);
   BodyForceTerm(model).AddMult(t, state.f);
 }
 
@@ -41,6 +47,10 @@ void impose_prescribed_motion(const Model& model, State& state, double t) {
 
 double external_power(const Model& model, const State& state, double t) {
   double p = BodyForceTerm(model).power(t, state.v);
+  // A moving indenter works on the body at the rate (force on the body)·(indenter velocity): the
+  // contact potential depends on y − c(t), so d(KE + potential)/dt = F·ċ.
+  for (std::size_t k = 0; k < model.indenters.size() && k < state.indenter_force.size(); ++k)
+    for (std::size_t d = 0; d < 3; ++d) p += state.indenter_force[k][d] * model.indenters[k].velocity[d];
   for (const auto& bc : model.conditions.prescribed) {
     const auto c = static_cast<std::size_t>(bc.component);
     const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;

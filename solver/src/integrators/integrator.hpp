@@ -4,8 +4,10 @@
 // energy bookkeeping every integrator shares.
 #pragma once
 #include <memory>
+#include <stdexcept>
 #include <string>
 
+#include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/registry.hpp"
 #include "core/state.hpp"
@@ -16,12 +18,22 @@ struct StepReport {
   int iterations = 1;         // fixed-point iterations K of the accepted step (1 for Verlet)
   int rejected = 0;           // rejected attempts before acceptance (0 for Verlet)
   std::int64_t broken_now = 0;  // bonds broken during the step, each counted once
+  int force_evaluations = 1;  // evaluate_forces calls of the step, rejected attempts included
+  double next_dt = 0.0;       // the step the integrator proposes next [s]; 0: no proposal (fixed dt)
+};
+
+// Thrown by step() when no step can be taken (the adaptive step does not converge at dt_min);
+// the state is left as it was at t, so the caller can keep it as the last good state.
+struct StepFailed : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual std::string name() const = 0;
+  // Reads the integrator's own settings from the case (the adaptive section); Verlet has none.
+  virtual void configure(const Case&) {}
   // Imposes the prescribed motion at t and evaluates f and the powers there; call once first.
   virtual void initialize(State& state, double t) = 0;
   virtual void step(State& state, double& t, double& dt) = 0;
@@ -34,13 +46,15 @@ class Integrator {
 using IntegratorFactory = std::unique_ptr<Integrator> (*)(Model&);
 const Registry<IntegratorFactory>& integrator_registry();
 
-// f = bond forces + body forces at (u, t): clears f, then every force term adds into it.
+// f = bond forces + contact forces + indenter forces + body forces at (u, t): clears f, then
+// every force term the scene needs adds into it; also sets state.w, state.contact_energy and
+// state.indenter_force. The one force path every integrator calls.
 void evaluate_forces(const Model& model, State& state, double t);
 
 // Imposes the prescribed displacement / velocity at t (used at the start of a run).
 void impose_prescribed_motion(const Model& model, State& state, double t);
 
-// Body-force power plus the power of the reactions at prescribed components, Σ V (ρa − f)·v
+// Body-force power plus the power of moving indenters, plus the power of the reactions at prescribed components, Σ V (ρa − f)·v
 // where a is the prescribed acceleration (the slope of a velocity table; 0 for a piecewise-linear
 // displacement — the impulses at its kinks are not counted) [W].
 double external_power(const Model& model, const State& state, double t);

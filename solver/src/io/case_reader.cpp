@@ -2,6 +2,7 @@
 #include "io/case_reader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -10,6 +11,8 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/partial_volume.hpp"
+#include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
 
 namespace pd {
@@ -180,6 +183,67 @@ InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
   return ic;
 }
 
+ContactSettings read_contact(const Checker& ck, const json& j) {
+  ck.object(j, "contact");
+  ck.known_keys(j, "contact", {"enabled", "self_contact", "skin", "stiffness_factor"});
+  ContactSettings s;
+  if (const json* e = ck.optional(j, "enabled")) {
+    s.enabled = ck.string(*e, "contact.enabled");
+    if (s.enabled != "auto" && s.enabled != "on" && s.enabled != "off")
+      ck.fail("contact.enabled", "unknown value '" + s.enabled + "'; known: auto, on, off");
+  }
+  if (const json* e = ck.optional(j, "self_contact")) {
+    if (!e->is_boolean()) ck.fail("contact.self_contact", "must be true or false, got " + show(*e));
+    s.self_contact = e->get<bool>();
+  }
+  if (const json* e = ck.optional(j, "skin"); e && !e->is_null()) s.skin = ck.positive(*e, "contact.skin");
+  if (const json* e = ck.optional(j, "stiffness_factor")) s.stiffness_factor = ck.positive(*e, "contact.stiffness_factor");
+  return s;
+}
+
+std::array<double, 3> read_vector(const Checker& ck, const json& j, const std::string& key) {
+  const std::vector<double> v = ck.numbers(j, key);
+  if (v.size() != 3) ck.fail(key, "must have 3 components, got " + std::to_string(v.size()));
+  return {v[0], v[1], v[2]};
+}
+
+// A direction given as any non-zero vector, returned as a unit vector.
+std::array<double, 3> read_direction(const Checker& ck, const json& j, const std::string& key) {
+  std::array<double, 3> v = read_vector(ck, j, key);
+  const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(norm > 0.0) || !std::isfinite(norm)) ck.fail(key, "must be a non-zero vector");
+  for (double& c : v) c /= norm;
+  return v;
+}
+
+IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) {
+  const std::string where = "indenters[" + std::to_string(k) + "]";
+  ck.object(j, where);
+  ck.known_keys(j, where, {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"});
+  IndenterSettings ind;
+  ind.name = ck.string(ck.required(j, "name", where + ".name"), where + ".name");
+  const bool name_ok = !ind.name.empty() && !std::isdigit(static_cast<unsigned char>(ind.name[0])) &&
+                       std::all_of(ind.name.begin(), ind.name.end(),
+                                   [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
+  if (!name_ok) ck.fail(where + ".name", "must be letters, digits and '_', not starting with a digit (it names history.csv columns)");
+  ind.shape = ck.string(ck.required(j, "shape", where + ".shape"), where + ".shape");
+  if (!indenter_shape_registry().contains(ind.shape))
+    ck.fail(where + ".shape", indenter_shape_registry().unknown_message(ind.shape));
+  ind.centre = read_vector(ck, ck.required(j, "centre", where + ".centre"), where + ".centre");
+  if (const json* v = ck.optional(j, "velocity"); v && !v->is_null()) ind.velocity = read_vector(ck, *v, where + ".velocity");
+  ind.stiffness = ck.positive(ck.required(j, "stiffness", where + ".stiffness"), where + ".stiffness");
+  if (ind.shape == "plane") {
+    ind.normal = read_direction(ck, ck.required(j, "normal", where + ".normal"), where + ".normal");
+  } else {
+    ind.radius = ck.positive(ck.required(j, "radius", where + ".radius"), where + ".radius");
+    if (ind.shape == "cylinder") {
+      ind.axis = {0.0, 0.0, 1.0};
+      if (const json* a = ck.optional(j, "axis"); a && !a->is_null()) ind.axis = read_direction(ck, *a, where + ".axis");
+    }
+  }
+  return ind;
+}
+
 }  // namespace
 
 Case parse_case(const std::string& text, const std::filesystem::path& path) {
@@ -187,7 +251,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e800 (fuzzing)
     throw Error(file + ": not valid JSON: " + e.what());
   }
   const Checker ck(file);
@@ -195,7 +259,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   ck.known_keys(root, "", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension",
                            "analysis", "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets",
                            "node_sets", "boundary_conditions", "initial_conditions", "damping", "time",
-                           "adaptive", "output", "figures"});
+                           "adaptive", "output", "figures", "partial_volume", "contact", "indenters"});
   Case c;
   c.file = path;
   const std::int64_t version = ck.integer(ck.required(root, "format_version", "format_version"), "format_version", 0, 1 << 30);
@@ -226,6 +290,12 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   c.grid_spacing = ck.positive(ck.required(root, "grid_spacing", "grid_spacing"), "grid_spacing");
   c.horizon = ck.positive(ck.required(root, "horizon", "horizon"), "horizon");
 
+  if (const json* j = ck.optional(root, "partial_volume")) {
+    c.partial_volume = ck.string(*j, "partial_volume");
+    if (!partial_volume_registry().contains(c.partial_volume))
+      ck.fail("partial_volume", partial_volume_registry().unknown_message(c.partial_volume));
+  }
+
   const json& blocks = ck.array(ck.required(root, "blocks", "blocks"), "blocks");
   if (blocks.empty()) ck.fail("blocks", "needs at least one block");
   for (std::size_t k = 0; k < blocks.size(); ++k) c.blocks.push_back(read_block(ck, blocks[k], k));
@@ -239,6 +309,14 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
     for (std::size_t k = 0; k < ck.array(*j, "initial_conditions").size(); ++k)
       c.initial_conditions.push_back(read_initial(ck, (*j)[k], k));
   if (const json* j = ck.optional(root, "damping")) c.damping = ck.non_negative(*j, "damping");
+  if (const json* j = ck.optional(root, "contact"); j && !j->is_null()) c.contact = read_contact(ck, *j);
+  if (const json* j = ck.optional(root, "indenters"))
+    for (std::size_t k = 0; k < ck.array(*j, "indenters").size(); ++k) {
+      c.indenters.push_back(read_indenter(ck, (*j)[k], k));
+      for (std::size_t q = 0; q < k; ++q)
+        if (c.indenters[q].name == c.indenters[k].name)
+          ck.fail("indenters[" + std::to_string(k) + "].name", "'" + c.indenters[k].name + "' is used twice");
+    }
 
   const json& time = ck.object(ck.required(root, "time", "time"), "time");
   ck.known_keys(time, "time", {"end", "integrator", "dt", "safety_factor", "max_steps"});

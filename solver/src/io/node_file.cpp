@@ -24,9 +24,9 @@ const VtuArray& require(const VtuGrid& g, const std::vector<VtuArray>& section, 
 
 }  // namespace
 
-Nodes read_node_file(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  const VtuGrid g = read_vtu(path);
+namespace {
+
+Nodes nodes_of(const VtuGrid& g, const std::string& file) {
   Nodes nodes;
 
   auto scalar_field = [&](const std::string& name, const std::string& type) -> const VtuArray& {
@@ -104,6 +104,12 @@ Nodes read_node_file(const std::filesystem::path& path) {
   if (!g.cell_data.empty()) throw Error(file + ": unexpected CellData array '" + g.cell_data[0].name + "'");
   return nodes;
 }
+
+}  // namespace
+
+Nodes read_node_file(const std::filesystem::path& path) { return nodes_of(read_vtu(path), path.string()); }
+
+Nodes parse_node_file(const std::string& text, const std::string& file) { return nodes_of(parse_vtu(text, file), file); }
 
 void write_node_file(const std::filesystem::path& path, const Nodes& nodes) {
   const std::size_t n = nodes.size();

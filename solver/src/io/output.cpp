@@ -53,7 +53,8 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
   write_vtu(path, g);
 }
 
-OutputWriter::OutputWriter(std::filesystem::path output_dir) : dir_(std::move(output_dir)) {
+OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns)
+    : dir_(std::move(output_dir)) {
   std::error_code ec;
   std::filesystem::create_directories(dir_ / "frames", ec);
   if (ec) throw Error((dir_ / "frames").string() + ": cannot create the directory: " + ec.message());
@@ -64,7 +65,9 @@ OutputWriter::OutputWriter(std::filesystem::path output_dir) : dir_(std::move(ou
       std::filesystem::remove(entry.path());
   history_.open(dir_ / "history.csv.part", std::ios::trunc);
   if (!history_) throw Error((dir_ / "history.csv.part").string() + ": cannot open for writing");
-  history_ << kHistoryHeader << '\n';
+  history_ << kHistoryHeader;
+  for (const auto& name : extra_columns) history_ << ',' << name;
+  history_ << '\n';
 }
 
 OutputWriter::~OutputWriter() {
@@ -97,7 +100,16 @@ void OutputWriter::history(const HistoryRow& r) {
                 static_cast<long long>(r.step), r.time, r.dt, r.iterations, r.rejected, r.kinetic_energy,
                 r.strain_energy, r.external_work, r.damping_work, static_cast<long long>(r.broken_bonds),
                 r.wall_time);
-  history_ << line;
+  std::string text = line;
+  if (!r.extra.empty()) {
+    text.pop_back();  // the newline
+    for (double value : r.extra) {
+      std::snprintf(line, sizeof line, ",%.17g", value);
+      text += line;
+    }
+    text += '\n';
+  }
+  history_ << text;
 }
 
 void OutputWriter::finish() {

@@ -20,6 +20,7 @@ struct HistoryRow {
   double kinetic_energy = 0.0, strain_energy = 0.0, external_work = 0.0, damping_work = 0.0;
   std::int64_t broken_bonds = 0;
   double wall_time = 0.0;
+  std::vector<double> extra;  // the scene's own columns, after wall_time (formats.md §4)
 };
 
 // The header line of history.csv, exactly the columns of formats.md §4.
@@ -32,8 +33,10 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
 
 class OutputWriter {
  public:
-  // Creates output_dir/frames and removes frame files left by an earlier run there.
-  explicit OutputWriter(std::filesystem::path output_dir);
+  // Creates output_dir/frames and removes frame files left by an earlier run there. extra_columns
+  // name the HistoryRow::extra values (contact and indenter columns, present only when the scene
+  // has contact or indenters).
+  explicit OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns = {});
   ~OutputWriter();
 
   void frame(const Model& model, const State& state, double time, std::int64_t step);  // + frames.pvd

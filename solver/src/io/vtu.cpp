@@ -179,7 +179,14 @@ std::uint64_t parse_count(const TagScanner& scan, const Tag& tag, const std::str
   const std::string& s = it->second;
   if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos)
     scan.fail("<" + tag.name + "> " + key + "=\"" + s + "\" is not a non-negative integer");
-  return std::stoull(s);
+  // Digit by digit with a bound: std::stoull would throw std::out_of_range past 2^64 (found by fuzzing).
+  constexpr std::uint64_t kLimit = std::uint64_t{1} << 62;
+  std::uint64_t value = 0;
+  for (const char digit : s) {
+    value = 10 * value + static_cast<std::uint64_t>(digit - '0');
+    if (value > kLimit) scan.fail("<" + tag.name + "> " + key + "=\"" + s.substr(0, 40) + "\" is too large");
+  }
+  return value;
 }
 
 struct PendingArray {
@@ -195,7 +202,11 @@ VtuGrid read_vtu(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(file + ": cannot open for reading");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_vtu(text, file);
+}
+
+VtuGrid parse_vtu(const std::string& text, const std::string& file) {
   if (text.empty()) throw Error(file + ": the file is empty");
 
   const std::size_t appended = text.find("<AppendedData");
@@ -225,6 +236,9 @@ VtuGrid read_vtu(const std::filesystem::path& path) {
       stack.pop_back();
       continue;
     }
+    // An element after </VTKFile> has no parent: stack.back() below would read before the vector
+    // (found by fuzzing; invisible to ASan because libstdc++'s string copy is not instrumented).
+    if (stack.empty()) scan.fail("<" + tag.name + "> after </VTKFile>");
     if (tag.name == "Piece") {
       if (++pieces > 1) scan.fail("more than one <Piece>; the format has exactly one");
       n_points = parse_count(scan, tag, "NumberOfPoints");
@@ -245,8 +259,10 @@ VtuGrid read_vtu(const std::filesystem::path& path) {
       const std::string format = at.count("format") ? at.at("format") : "(missing)";
       if (format != "appended")
         scan.fail(label + " has format=\"" + format + "\"; every array must be format=\"appended\" (pipeline/formats.md §1)");
-      p.array.components = at.count("NumberOfComponents") ? static_cast<int>(parse_count(scan, tag, "NumberOfComponents")) : 1;
-      if (p.array.components < 1) scan.fail(label + " has NumberOfComponents < 1");
+      const std::uint64_t components = at.count("NumberOfComponents") ? parse_count(scan, tag, "NumberOfComponents") : 1;
+      // Bounded before the cast to int; VTK's own arrays have at most 9 components (a tensor).
+      if (components < 1 || components > 1024) scan.fail(label + " has NumberOfComponents outside 1..1024");
+      p.array.components = static_cast<int>(components);
       p.offset = parse_count(scan, tag, "offset");
       if (p.section == "FieldData") p.tuples = parse_count(scan, tag, "NumberOfTuples");
       arrays.push_back(std::move(p));

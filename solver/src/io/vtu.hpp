@@ -63,6 +63,9 @@ void write_vtu(const std::filesystem::path& path, const VtuGrid& grid);
 // (wrong header, compressed or non-appended data, truncated data, sizes that do not match).
 VtuGrid read_vtu(const std::filesystem::path& path);
 
+// The same from the file's bytes (`file` only names it in messages); the fuzz targets call this.
+VtuGrid parse_vtu(const std::string& text, const std::string& file);
+
 // Writes `text` to `path` through a temporary file and a rename.
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 

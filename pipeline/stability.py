@@ -1,0 +1,153 @@
+"""Checks of a discretized case before the solver runs: bonds per node and the stable time step.
+
+Hand-edited case files mix units (g/cm³ for kg/m³, MPa or GPa for Pa, mm for m). Each mistake
+moves the stable time step of thesis eq. 2.5 by orders of magnitude, so the run either never
+ends (10¹² steps) or is over in a single step. Computing that step here, from the node cloud and
+the materials exactly as the solver will, turns such a mistake into an error before any work,
+naming the file, the line and the key. Messages that could be false alarms are warnings.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .yaml_lines import CaseError
+
+# A run needing more steps than this is a unit mistake, not a plan: at 10⁸ node-steps per second
+# it would take years for even a small cloud.
+MAX_STEPS = 1.0e9
+# Stable steps are computed exactly (the solver's eq. 2.5 sum) on at most this many nodes; the
+# minimum over a subset is an upper bound of the solver's, so "too many steps" is never a false alarm.
+SAMPLE = 20000
+# The solver's bond rule |ξ| ≤ δ·(1 + 1e-12) (solver/README.md).
+BOND_SLACK = 1.0 + 1e-12
+# Densities [kg/m³] and moduli [Pa] below these look like g/cm³ and MPa/GPa: warned about only,
+# since foams and gels are real.
+LOW_DENSITY = 50.0
+LOW_MODULUS = 1.0e5
+
+
+def micromodulus(analysis: str, youngs_modulus: float, horizon: float, thickness: float | None) -> float:
+    """c of validation.md F1 (thesis eq. 1.11), as solver/src/core/material.cpp computes it."""
+    if analysis == "3d":
+        return 12.0 * youngs_modulus / (math.pi * horizon ** 4)
+    if analysis == "plane_stress":
+        return 9.0 * youngs_modulus / (math.pi * thickness * horizon ** 3)
+    if analysis == "plane_strain":
+        return 48.0 * youngs_modulus / (5.0 * math.pi * thickness * horizon ** 3)
+    raise ValueError(f"unknown analysis {analysis!r}")
+
+
+def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, density: np.ndarray,
+                     c_pair: np.ndarray, horizon: float, tree: cKDTree | None = None) -> tuple[float, int]:
+    """min over nodes of √(2ρ_i / Σ_j V_j c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the node
+    where it is reached; over an evenly spread subset of SAMPLE nodes for large clouds. block is
+    1-based; density[b-1] and c_pair[a-1, b-1] (the solver's arithmetic mean of the two blocks' c).
+    (inf, -1) when no sampled node has a bond."""
+    n = len(points)
+    tree = tree if tree is not None else cKDTree(points)
+    sample = np.arange(n) if n <= SAMPLE else np.unique(np.linspace(0, n - 1, SAMPLE).astype(np.int64))
+    pairs = cKDTree(points[sample]).sparse_distance_matrix(tree, horizon * BOND_SLACK, output_type="coo_matrix")
+    rows, cols, dist = pairs.row, pairs.col, pairs.data
+    keep = dist > 0  # the node itself (coincident nodes are rejected earlier)
+    rows, cols, dist = rows[keep], cols[keep], dist[keep]
+    i = sample[rows]
+    stiffness = volume[cols] * c_pair[block[i] - 1, block[cols] - 1] / dist
+    total = np.bincount(rows, weights=stiffness, minlength=len(sample))
+    bonded = total > 0
+    if not np.any(bonded):
+        return math.inf, -1
+    dt = np.full(len(sample), np.inf)
+    dt[bonded] = np.sqrt(2.0 * density[block[sample[bonded]] - 1] / total[bonded])
+    k = int(np.argmin(dt))
+    return float(dt[k]), int(sample[k])
+
+
+def _where(case: dict, *keypath) -> str:
+    """'file:line: key' for messages; a key absent from the file takes its section's line."""
+    lines = case.get("_lines", {})
+    path = tuple(keypath)
+    while path and path not in lines:
+        path = path[:-1]
+    dotted = ".".join(str(p) for p in keypath)
+    return f"{case.get('_path', '<case>')}:{lines.get(path, 1)}: {dotted}"
+
+
+def _fmt(p) -> str:
+    return "(" + ", ".join(f"{v:.6g}" for v in p) + ")"
+
+
+def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
+    """Raise CaseError for a case that cannot run sensibly; return warnings (strings) otherwise.
+
+    case: the validated case (pipeline.case.load_case); resolved: its case.json dictionary
+    (pipeline.resolve); cloud: the NodeCloud it was resolved against.
+    """
+    warnings: list[str] = []
+    errors: list[str] = []
+    horizon = float(resolved["horizon"])
+    dx = float(resolved["grid_spacing"])
+    horizon_key = ("discretization", "horizon" if case["discretization"]["horizon"] is not None
+                   else "horizon_factor")
+    if not horizon >= dx:
+        raise CaseError(f"{_where(case, *horizon_key)}: the horizon {horizon:.6g} m is smaller than the node "
+                        f"spacing {dx:.6g} m: no node would have a bond; use about 3 × the spacing")
+
+    names = list(case["materials"])
+    for name in names:
+        m = case["materials"][name]
+        if m["density"] < LOW_DENSITY:
+            warnings.append(f"{_where(case, 'materials', name, 'density')}: {m['density']:g} kg/m³ is lighter "
+                            f"than most foams; was it given in g/cm³? (SI: kg/m³, e.g. 7850 for steel)")
+        if m["youngs_modulus"] < LOW_MODULUS:
+            warnings.append(f"{_where(case, 'materials', name, 'youngs_modulus')}: {m['youngs_modulus']:g} Pa "
+                            f"is softer than rubber; was it given in MPa or GPa? (SI: Pa, e.g. 2.1e11 for steel)")
+
+    points, volume = np.asarray(cloud.points), np.asarray(cloud.volume)
+    block = np.asarray(cloud.block, dtype=np.int64)
+    tree = cKDTree(points)
+    # Isolated nodes: no partner within the horizon, so no force ever acts on them.
+    dist, _ = tree.query(points, k=2, distance_upper_bound=horizon * BOND_SLACK)
+    isolated = ~np.isfinite(dist[:, 1])
+    if np.all(isolated):
+        raise CaseError(f"{_where(case, *horizon_key)}: no node has a bond: every neighbour lies farther than "
+                        f"the horizon {horizon:.6g} m; use a horizon of about 3 × the node spacing")
+    if np.any(isolated):
+        first = int(np.nonzero(isolated)[0][0])
+        warnings.append(f"{_where(case, *horizon_key)}: {int(isolated.sum())} node(s) have no bond (no other node "
+                        f"within the horizon {horizon:.6g} m), e.g. node {first} at {_fmt(points[first])}; "
+                        f"no force acts on them: refine the mesh there or enlarge the horizon")
+
+    c = np.array([micromodulus(case["analysis"], case["materials"][n]["youngs_modulus"], horizon,
+                               case["thickness"]) for n in names])
+    c_pair = 0.5 * (c[:, None] + c[None, :])
+    density = np.array([case["materials"][n]["density"] for n in names], dtype=np.float64)
+    dt_stable, node = stable_time_step(points, volume, block, density, c_pair, horizon, tree)
+    if node < 0:  # no sampled node has a bond; the isolated-node warning says so
+        return warnings
+    time = case["time"]
+    end = float(time["end"])
+    fixed = not isinstance(time["dt"], str)
+    dt = float(time["dt"]) if fixed else dt_stable * float(time["safety_factor"])
+    material = names[int(block[node]) - 1]
+    m = case["materials"][material]
+    origin = (f"thesis eq. 2.5 gives a stable step of {dt_stable:.3g} s at node {node} {_fmt(points[node])}, "
+              f"from material '{material}' ({_where(case, 'materials', material)}): ρ = {m['density']:g} kg/m³, "
+              f"E = {m['youngs_modulus']:g} Pa, with horizon {horizon:.6g} m")
+    units = "check the units (SI: kg/m³, Pa, m, s)"
+    steps = end / dt
+    if steps > MAX_STEPS:
+        key = ("time", "dt") if fixed else ("time", "end")
+        errors.append(f"{_where(case, *key)}: the run would need {steps:.3g} steps of {dt:.3g} s to reach "
+                      f"time.end = {end:g} s (more than {MAX_STEPS:.0e}); {origin}; {units}")
+    if not fixed and end < dt_stable:
+        errors.append(f"{_where(case, 'time', 'end')}: time.end = {end:g} s is shorter than one stable time "
+                      f"step: {origin}; nothing can happen in such a run; {units}")
+    if fixed and dt > dt_stable:
+        warnings.append(f"{_where(case, 'time', 'dt')}: {dt:g} s exceeds the stable step: {origin}; the run "
+                        f"will likely blow up; use dt: stable")
+    if errors:
+        raise CaseError("\n".join(errors))
+    return warnings

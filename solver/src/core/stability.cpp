@@ -1,0 +1,155 @@
+// Lanczos on the linearised PMB operator for ω_max², and the exact explicit step 2/ω_max.
+#include "core/stability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace pd {
+
+namespace {
+
+// Minimum image of a bond component on a periodic axis (period p > 0); unchanged otherwise.
+inline double wrap(double d, double p) { return p > 0.0 ? d - p * std::nearbyint(d / p) : d; }
+
+// Serial sums in node order: the Lanczos coefficients, and so dt, do not depend on the thread count.
+double dot(const Vec3Array& a, const Vec3Array& b) {
+  double s = 0.0;
+  for (std::size_t d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < a[d].size(); ++i) s += a[d][i] * b[d][i];
+  return s;
+}
+
+// Number of eigenvalues of the symmetric tridiagonal (alpha, beta) below x (Sturm sequence).
+int count_below(const std::vector<double>& alpha, const std::vector<double>& beta, double x) {
+  int count = 0;
+  double q = 1.0;
+  for (std::size_t k = 0; k < alpha.size(); ++k) {
+    const double b2 = k == 0 ? 0.0 : beta[k - 1] * beta[k - 1];
+    q = alpha[k] - x - (k == 0 ? 0.0 : b2 / q);
+    if (q == 0.0) q = -1e-300;  // the standard nudge off an exact zero pivot
+    if (q < 0.0) ++count;
+  }
+  return count;
+}
+
+// Largest eigenvalue of the tridiagonal by bisection inside its Gershgorin interval.
+double tridiagonal_max(const std::vector<double>& alpha, const std::vector<double>& beta) {
+  double lo = std::numeric_limits<double>::max(), hi = -lo;
+  for (std::size_t k = 0; k < alpha.size(); ++k) {
+    const double r = (k > 0 ? std::fabs(beta[k - 1]) : 0.0) + (k + 1 < alpha.size() ? std::fabs(beta[k]) : 0.0);
+    lo = std::min(lo, alpha[k] - r);
+    hi = std::max(hi, alpha[k] + r);
+  }
+  const int n = static_cast<int>(alpha.size());
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * std::max(std::fabs(hi), std::fabs(lo)); ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (count_below(alpha, beta, mid) == n) hi = mid;  // every eigenvalue is below mid
+    else lo = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+void apply_symmetric_operator(const Model& m, const std::array<double, 3>& period, const Vec3Array& x,
+                              Vec3Array& y) {
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i64 = 0; i64 < n; ++i64) {
+    const auto i = static_cast<std::size_t>(i64);
+    const double inv_sqrt_mi = 1.0 / std::sqrt(m.density[i] * m.nodes.volume[i]);
+    const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
+    double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      if (m.bonds.broken[ku]) continue;
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
+      const double len = m.bonds.length[ku];
+      const double e0 = wrap(m.nodes.x[0][j] - m.nodes.x[0][i], period[0]) / len;
+      const double e1 = wrap(m.nodes.x[1][j] - m.nodes.x[1][i], period[1]) / len;
+      const double e2 = wrap(m.nodes.x[2][j] - m.nodes.x[2][i], period[2]) / len;
+      const double inv_sqrt_mj = 1.0 / std::sqrt(m.density[j] * m.nodes.volume[j]);
+      // bond stiffness k_ij = c ν V_i V_j/|ξ| (force per unit relative displacement along e; ν the
+      // partial-volume factor of validation.md F3, 1 when the bond list carries none)
+      const double nu = m.bonds.volume_factor.empty() ? 1.0 : m.bonds.volume_factor[ku];
+      const double kij = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] * nu *
+                         m.nodes.volume[i] * m.nodes.volume[j] / len;
+      const double d0 = x[0][i] * inv_sqrt_mi - x[0][j] * inv_sqrt_mj;
+      const double d1 = x[1][i] * inv_sqrt_mi - x[1][j] * inv_sqrt_mj;
+      const double d2 = x[2][i] * inv_sqrt_mi - x[2][j] * inv_sqrt_mj;
+      const double along = kij * (e0 * d0 + e1 * d1 + e2 * d2);
+      y0 += along * e0;
+      y1 += along * e1;
+      y2 += along * e2;
+    }
+    y[0][i] = y0 * inv_sqrt_mi;
+    y[1][i] = y1 * inv_sqrt_mi;
+    y[2][i] = y2 * inv_sqrt_mi;
+  }
+}
+
+LanczosReport largest_eigenvalue(const Model& m, std::array<double, 3> period) {
+  const std::size_t n = m.nodes.size();
+  LanczosReport report;
+  if (n == 0 || m.bonds.directed() == 0) return report;
+  // Lanczos without re-orthogonalisation: the extreme Ritz value converges first and loss of
+  // orthogonality only duplicates converged values, it does not spoil the largest one.
+  Vec3Array v = make_vec3(n), v_prev = make_vec3(n), w = make_vec3(n);
+  // A fixed pseudo-random start (a hash of the index): reproducible, and not orthogonal to the
+  // top mode, which a smooth or constant start on a lattice could be.
+  double norm = 0.0;
+  for (std::size_t d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint64_t h = (i * 3 + d + 1) * 0x9E3779B97F4A7C15ull;
+      h ^= h >> 31;
+      h *= 0xBF58476D1CE4E5B9ull;
+      h ^= h >> 29;
+      v[d][i] = static_cast<double>(h >> 11) * 0x1.0p-53 - 0.5;
+    }
+  norm = std::sqrt(dot(v, v));
+  for (auto& c : v)
+    for (double& x : c) x /= norm;
+
+  std::vector<double> alpha, beta;
+  constexpr int kMaxIterations = 600;
+  const int max_iterations = static_cast<int>(std::min<std::size_t>(kMaxIterations, 3 * n));
+  double previous = 0.0, theta = 0.0;
+  int stable_for = 0;
+  double beta_prev = 0.0;
+  for (int it = 0; it < max_iterations; ++it) {
+    apply_symmetric_operator(m, period, v, w);
+    ++report.iterations;
+    const double a = dot(w, v);
+    for (std::size_t d = 0; d < 3; ++d)
+      for (std::size_t i = 0; i < n; ++i) w[d][i] -= a * v[d][i] + beta_prev * v_prev[d][i];
+    alpha.push_back(a);
+    const double b = std::sqrt(dot(w, w));
+    theta = tridiagonal_max(alpha, beta);
+    // Converged when the largest Ritz value has not moved by 1e-10 relative for 10 iterations,
+    // or when the Krylov space is invariant (b = 0: the Ritz values are exact).
+    stable_for = std::fabs(theta - previous) <= 1e-10 * theta ? stable_for + 1 : 0;
+    previous = theta;
+    if (stable_for >= 10 || b <= 1e-14 * std::max(theta, 1e-300)) {
+      report.converged = true;
+      break;
+    }
+    beta.push_back(b);
+    beta_prev = b;
+    std::swap(v_prev, v);
+    for (std::size_t d = 0; d < 3; ++d)
+      for (std::size_t i = 0; i < n; ++i) v[d][i] = w[d][i] / b;
+  }
+  report.lambda_max = theta;
+  return report;
+}
+
+double exact_time_step(const Model& m) {
+  const LanczosReport r = largest_eigenvalue(m);
+  if (!(r.lambda_max > 0.0)) return std::numeric_limits<double>::infinity();
+  return 2.0 / std::sqrt(r.lambda_max);  // velocity Verlet on ü = −ω²u: stable for ωΔt < 2
+}
+
+}  // namespace pd

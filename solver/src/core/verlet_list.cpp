@@ -1,0 +1,96 @@
+// Builds and refreshes the contact Verlet list (see verlet_list.hpp).
+#include "core/verlet_list.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "core/cell_grid.hpp"
+#include "core/error.hpp"
+
+namespace pd {
+
+ContactPairs VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
+                                const ContactParameters& p) {
+  const std::size_t n = x[0].size();
+  ContactPairs out;
+  out.offsets.assign(n + 1, 0);
+  if (n == 0) return out;
+  Vec3Array y = make_vec3(n);
+  for (std::size_t d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < n; ++i) y[d][i] = x[d][i] + u[d][i];
+  const double reach = p.distance + p.skin;
+  const double* const yp[3] = {y[0].data(), y[1].data(), y[2].data()};
+  // Bins of edge ≥ contact distance + skin: every candidate lies in the neighbouring bins.
+  const CellGrid grid = make_cell_grid(yp, n, reach);
+  const double reach2 = reach * reach;
+  const double bonded2 = p.bond_cutoff * p.bond_cutoff;
+
+  auto for_each = [&](std::size_t i, auto&& visit) {
+    const double pi[3] = {y[0][i], y[1][i], y[2][i]};
+    grid.for_each_near(pi, i, [&](std::size_t j) {
+      if (!p.self_contact && block[i] == block[j]) return;
+      const double e0 = y[0][j] - pi[0], e1 = y[1][j] - pi[1], e2 = y[2][j] - pi[2];
+      if (e0 * e0 + e1 * e1 + e2 * e2 > reach2) return;
+      // Reference length from x_j − x_i: bitwise the same from both ends, so d_ij = d_ji.
+      const double x0 = x[0][j] - x[0][i], x1 = x[1][j] - x[1][i], x2 = x[2][j] - x[2][i];
+      const double xi2 = x0 * x0 + x1 * x1 + x2 * x2;
+      visit(static_cast<std::int32_t>(j), contact_distance(std::sqrt(xi2), xi2 <= bonded2, p.distance));
+    });
+  };
+  // Two passes (count, then fill) so that each row is written by one thread only.
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+    std::int64_t count = 0;
+    for_each(static_cast<std::size_t>(i), [&](std::int32_t, double) { ++count; });
+    out.offsets[static_cast<std::size_t>(i) + 1] = count;
+  }
+  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] += out.offsets[i];
+  out.neighbour.resize(static_cast<std::size_t>(out.offsets[n]));
+  out.distance.resize(out.neighbour.size());
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+    std::vector<std::pair<std::int32_t, double>> row;
+    for_each(static_cast<std::size_t>(i), [&](std::int32_t j, double d) { row.emplace_back(j, d); });
+    std::sort(row.begin(), row.end());  // ascending j: the sums do not depend on the bin layout
+    auto k = static_cast<std::size_t>(out.offsets[static_cast<std::size_t>(i)]);
+    for (const auto& [j, d] : row) {
+      out.neighbour[k] = j;
+      out.distance[k] = d;
+      ++k;
+    }
+  }
+  return out;
+}
+
+bool VerletList::update(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
+                        const ContactParameters& p) {
+  const auto n = static_cast<std::int64_t>(x[0].size());
+  bool stale = rebuilds_ == 0 || static_cast<std::int64_t>(u_build_[0].size()) != n;
+  if (!stale) {
+    // The Verlet-skin criterion: rebuild once any node has moved more than skin/2 (max is exact,
+    // so the decision does not depend on the thread count).
+    const double limit2 = 0.25 * p.skin * p.skin;
+    int moved = 0;  // 1: moved too far; 2: non-finite
+#pragma omp parallel for schedule(static) reduction(max : moved)
+    for (std::int64_t i = 0; i < n; ++i) {
+      const auto s = static_cast<std::size_t>(i);
+      const double d0 = u[0][s] - u_build_[0][s], d1 = u[1][s] - u_build_[1][s], d2 = u[2][s] - u_build_[2][s];
+      const double r2 = d0 * d0 + d1 * d1 + d2 * d2;
+      if (!std::isfinite(r2)) moved = 2;
+      else if (r2 > limit2) moved = std::max(moved, 1);
+    }
+    // A non-finite state cannot be binned; the time loop stops on it after this step anyway.
+    if (moved == 2) return false;
+    stale = moved != 0;
+  }
+  if (!stale) return false;
+  const auto start = std::chrono::steady_clock::now();
+  pairs_ = search(x, u, block, p);
+  u_build_ = u;
+  ++rebuilds_;
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return true;
+}
+
+}  // namespace pd

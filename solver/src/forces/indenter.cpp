@@ -1,0 +1,98 @@
+// The indenter shapes, their registry and the indenter force term (see indenter.hpp).
+#include "forces/indenter.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pd {
+
+namespace {
+
+// Sphere: r = |y − c|, h = R − r, pushed radially out (LAMMPS fix indent sphere).
+double sphere(const IndenterSettings& ind, const double c[3], const double y[3], double n[3]) {
+  const double d[3] = {y[0] - c[0], y[1] - c[1], y[2] - c[2]};
+  const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(r < ind.radius) || r == 0.0) return 0.0;  // a node at the very centre has no direction
+  for (int k = 0; k < 3; ++k) n[k] = d[k] / r;
+  return ind.radius - r;
+}
+
+// Cylinder: r = distance to the axis through c, h = R − r (LAMMPS fix indent cylinder; in a 2D
+// case the axis is z and the cylinder is a disk).
+double cylinder(const IndenterSettings& ind, const double c[3], const double y[3], double n[3]) {
+  double d[3] = {y[0] - c[0], y[1] - c[1], y[2] - c[2]};
+  const double along = d[0] * ind.axis[0] + d[1] * ind.axis[1] + d[2] * ind.axis[2];
+  for (int k = 0; k < 3; ++k) d[k] -= along * ind.axis[k];
+  const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(r < ind.radius) || r == 0.0) return 0.0;
+  for (int k = 0; k < 3; ++k) n[k] = d[k] / r;
+  return ind.radius - r;
+}
+
+// Plane through c with unit normal n out of the indenter: h = −(y − c)·n where negative
+// (LAMMPS fix indent plane).
+double plane(const IndenterSettings& ind, const double c[3], const double y[3], double n[3]) {
+  const double s = (y[0] - c[0]) * ind.normal[0] + (y[1] - c[1]) * ind.normal[1] + (y[2] - c[2]) * ind.normal[2];
+  if (!(s < 0.0)) return 0.0;
+  for (int k = 0; k < 3; ++k) n[k] = ind.normal[k];
+  return -s;
+}
+
+// Chunks of this many nodes are summed in node order and the chunk sums added in chunk order: the
+// reaction is the same for any thread count.
+constexpr std::int64_t kChunk = 4096;
+
+}  // namespace
+
+const Registry<IndenterShape>& indenter_shape_registry() {
+  static const Registry<IndenterShape> registry = [] {
+    Registry<IndenterShape> r("indenter shape");
+    r.add("sphere", &sphere).add("cylinder", &cylinder).add("plane", &plane);
+    return r;
+  }();
+  return registry;
+}
+
+std::array<double, 3> indenter_position(const IndenterSettings& ind, double t) {
+  return {ind.centre[0] + ind.velocity[0] * t, ind.centre[1] + ind.velocity[1] * t, ind.centre[2] + ind.velocity[2] * t};
+}
+
+double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
+                              std::vector<std::array<double, 3>>& force_on_body) const {
+  const Model& m = model_;
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  const std::int64_t chunks = (n + kChunk - 1) / kChunk;
+  force_on_body.assign(m.indenters.size(), {0.0, 0.0, 0.0});
+  double energy = 0.0;
+  for (std::size_t k = 0; k < m.indenters.size(); ++k) {
+    const IndenterSettings& ind = m.indenters[k];
+    const IndenterShape shape = indenter_shape_registry().get(ind.shape);
+    const std::array<double, 3> c = indenter_position(ind, t);
+    std::vector<double> sums(static_cast<std::size_t>(chunks) * 4, 0.0);  // Fx, Fy, Fz, energy
+#pragma omp parallel for schedule(static)
+    for (std::int64_t b = 0; b < chunks; ++b) {
+      double* s = &sums[static_cast<std::size_t>(b) * 4];
+      for (std::int64_t i = b * kChunk; i < std::min(n, (b + 1) * kChunk); ++i) {
+        const auto q = static_cast<std::size_t>(i);
+        const double y[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
+        double dir[3];
+        const double h = shape(ind, c.data(), y, dir);
+        if (!(h > 0.0)) continue;
+        const double magnitude = ind.stiffness * h * h;  // force density [N/m³]
+        const double vol = m.nodes.volume[q];
+        for (std::size_t d = 0; d < 3; ++d) {
+          f[d][q] += magnitude * dir[d];
+          s[d] += vol * magnitude * dir[d];
+        }
+        s[3] += vol * ind.stiffness * h * h * h / 3.0;
+      }
+    }
+    for (std::int64_t b = 0; b < chunks; ++b) {
+      for (std::size_t d = 0; d < 3; ++d) force_on_body[k][d] += sums[static_cast<std::size_t>(b) * 4 + d];
+      energy += sums[static_cast<std::size_t>(b) * 4 + 3];
+    }
+  }
+  return energy;
+}
+
+}  // namespace pd

@@ -1,0 +1,37 @@
+// Rigid indenters (LAMMPS fix indent): a sphere, a cylinder (a disk in 2D) or a plane moving at a
+// prescribed velocity pushes every node inside it out along the surface normal with the force
+// density K·h², h the depth of the node below the indenter surface (LAMMPS: F(r) = −K(r − R)²
+// for r < R). In a PERI model LAMMPS's f is a force density, so K is in N/m⁵ here too.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/case.hpp"
+#include "core/model.hpp"
+#include "core/registry.hpp"
+
+namespace pd {
+
+// Depth h ≥ 0 of point y inside the indenter (0 outside) and the unit push direction n.
+// `centre` is where the indenter is now (centre at t = 0 + velocity·t).
+using IndenterShape = double (*)(const IndenterSettings& ind, const double centre[3], const double y[3], double n[3]);
+const Registry<IndenterShape>& indenter_shape_registry();
+
+// Where an indenter's centre (or plane point) is at time t.
+std::array<double, 3> indenter_position(const IndenterSettings& ind, double t);
+
+class IndenterForce {
+ public:
+  explicit IndenterForce(const Model& model) : model_(model) {}
+  // f_i += K·h_i²·n_i for every node inside every indenter. force_on_body[k] = Σ_i V_i·K h_i² n_i
+  // [N], the force indenter k exerts on the body (its reaction is the negative), summed in fixed
+  // chunks of nodes so that it does not depend on the thread count. Returns the potential
+  // Σ_k Σ_i V_i·K h_i³/3 [J] (−d/dh of it is the force).
+  double AddMult(double t, const Vec3Array& u, Vec3Array& f, std::vector<std::array<double, 3>>& force_on_body) const;
+
+ private:
+  const Model& model_;
+};
+
+}  // namespace pd

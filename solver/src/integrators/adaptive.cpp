@@ -1,0 +1,187 @@
+// One adaptive step of thesis §2.2: predictor, fixed-point iterations with eqs. 2.6–2.8, retries.
+#include "integrators/adaptive.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "forces/pmb.hpp"
+
+namespace pd {
+
+namespace {
+
+std::string number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+
+}  // namespace
+
+void AdaptiveStep::configure(const Case& c) {
+  settings_ = c.adaptive;
+  // Defaults from eq. 2.5: Δt_max = Δt_SA keeps the iteration near its contraction range
+  // (validation.md §3: keep Δt ≤ Δt_SA), Δt_min = 1e-6·Δt_SA is far below any useful step.
+  const double dt_sa = stable_time_step(model_);
+  const double scale = std::isfinite(dt_sa) ? dt_sa : c.time.end;
+  dt_max_ = settings_.dt_max.value_or(scale);
+  dt_min_ = settings_.dt_min.value_or(std::min(1e-6 * scale, dt_max_));
+}
+
+void AdaptiveStep::initialize(State& state, double t) {
+  if (dt_max_ <= 0.0) {  // not configured (tests that build the integrator bare): the defaults
+    Case defaults;
+    defaults.time.end = 1.0;
+    configure(defaults);
+  }
+  impose_prescribed_motion(model_, state, t);
+  evaluate_forces(model_, state, t);
+  update_work(model_, state, t, 0.0);
+  const std::size_t n = state.size();
+  trial_ = State(n);
+  u_new_ = make_vec3(n);
+  v_new_ = make_vec3(n);
+  correction_.assign(n, 0.0);
+  motion_.assign(n, 0.0);
+  report_ = StepReport{};
+  proposal_ = 0.0;
+}
+
+void AdaptiveStep::update(const State& s, const Vec3Array& f_imp, double t, double t1, double dt) {
+  const auto n = static_cast<std::int64_t>(s.size());
+  const double phi = settings_.phi, alpha = model_.damping;
+  const double keep = 1.0 - (1.0 - phi) * alpha * dt;  // damping weights, see adaptive.hpp
+  const double divide = 1.0 / (1.0 + phi * alpha * dt);
+  const double* rho = model_.density.data();
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double* u0 = s.u[d].data();
+    const double* v0 = s.v[d].data();
+    const double* f0 = s.f[d].data();
+    const double* f1 = f_imp[d].data();
+    const std::uint8_t* fx = model_.conditions.fixed[d].data();
+    double* u = u_new_[d].data();
+    double* v = v_new_[d].data();
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (fx[i]) continue;
+      v[i] = (keep * v0[i] + dt * (phi * f1[i] + (1.0 - phi) * f0[i]) / rho[i]) * divide;
+      u[i] = u0[i] + dt * v[i];
+    }
+  }
+  // Prescribed components follow their tables exactly as in Verlet (the same at every iterate).
+  for (const auto& p : model_.conditions.prescribed) {
+    const auto c = static_cast<std::size_t>(p.component);
+    if (p.kind == Kinematic::displacement) {
+      const double u1 = p.table.value(t1), mean_v = (u1 - p.table.value(t)) / dt;
+      for (std::int32_t i : p.nodes) {
+        u_new_[c][static_cast<std::size_t>(i)] = u1;
+        v_new_[c][static_cast<std::size_t>(i)] = mean_v;
+      }
+    } else {
+      const double du = p.table.integral(t, t1), v1 = p.table.value(t1);
+      for (std::int32_t i : p.nodes) {
+        u_new_[c][static_cast<std::size_t>(i)] = s.u[c][static_cast<std::size_t>(i)] + du;
+        v_new_[c][static_cast<std::size_t>(i)] = v1;
+      }
+    }
+  }
+}
+
+void AdaptiveStep::step(State& state, double& t, double& dt) {
+  const auto n = static_cast<std::int64_t>(state.size());
+  const double tol = settings_.tol, p = settings_.p;
+  const int kd = settings_.kd;
+  const bool shortened = proposal_ > 0.0 && dt < proposal_;  // the caller cut it to land on a time
+  report_ = StepReport{};
+  report_.force_evaluations = 0;
+  double h = dt;
+  for (;;) {
+    const double t1 = t + h;
+    // K = 0: the explicit predictor (f(u^n) in place of the implicit force; no evaluation).
+    update(state, state.f, t, t1, h);
+    double c_prev = 0.0, c_prev2 = 0.0, phi_k = 1.0;
+    bool accepted = false, diverged = false;
+    int k = 1;
+    for (; k <= kd; ++k) {
+      std::swap(trial_.u, u_new_);  // u^{n+1,K−1} → trial
+      evaluate_forces(model_, trial_, t1);
+      ++report_.force_evaluations;
+      update(state, trial_.f, t, t1, h);  // → u^{n+1,K}
+      // Eq. 2.6, per node first and summed serially, so accept/reject decisions (and every result)
+      // are the same for any thread count.
+#pragma omp parallel for schedule(static)
+      for (std::int64_t i = 0; i < n; ++i) {
+        double dc = 0.0, dm = 0.0;
+        for (std::size_t d = 0; d < 3; ++d) {
+          const double a = u_new_[d][static_cast<std::size_t>(i)];
+          const double b = trial_.u[d][static_cast<std::size_t>(i)] - a;
+          const double m = state.u[d][static_cast<std::size_t>(i)] - a;
+          dc += b * b;
+          dm += m * m;
+        }
+        correction_[static_cast<std::size_t>(i)] = std::sqrt(dc);
+        motion_[static_cast<std::size_t>(i)] = std::sqrt(dm);
+      }
+      double c = 0.0, m = 0.0;
+      for (std::int64_t i = 0; i < n; ++i) {
+        c += correction_[static_cast<std::size_t>(i)];
+        m += motion_[static_cast<std::size_t>(i)];
+      }
+      if (!std::isfinite(c) || !std::isfinite(m)) {
+        phi_k = 0.01;
+        diverged = true;
+        break;
+      }
+      // Nothing moves (a body at rest): the step is exact, ω_K = 0.
+      const double omega = m > 0.0 ? c / m : 0.0;
+      // Eq. 2.8 with ω_0 = 1 (see adaptive.hpp); ω_K = 0 proposes an unbounded step, capped below.
+      phi_k = omega > 0.0 ? std::pow(tol, 1.0 / (p * kd)) / std::pow(omega, 1.0 / (p * k)) : HUGE_VAL;
+      if (omega <= tol) {  // eq. 2.7: Z_K ≤ 1
+        accepted = true;
+        break;
+      }
+      if (k >= 3 && c > c_prev && c_prev > c_prev2) {
+        const double growth = c / c_prev;
+        phi_k = std::min(0.5, std::pow(std::pow(tol, 1.0 / kd) / growth, 1.0 / p));
+        diverged = true;
+        break;
+      }
+      c_prev2 = c_prev;
+      c_prev = c;
+    }
+    if (accepted) {
+      report_.iterations = k;
+      std::swap(state.u, u_new_);
+      std::swap(state.v, v_new_);
+      // Bonds break on the accepted state only, then the force there for the next step.
+      report_.broken_now = update_broken_bonds(model_, state.u);
+      evaluate_forces(model_, state, t1);
+      ++report_.force_evaluations;
+      update_work(model_, state, t1, h);
+      t = t1;
+      dt = h;
+      double next = std::min(phi_k * h, dt_max_);
+      if (shortened && report_.rejected == 0 && phi_k >= 1.0) next = std::max(next, std::min(proposal_, dt_max_));
+      next = std::max(next, dt_min_);
+      report_.next_dt = next;
+      proposal_ = next;
+      return;
+    }
+    // Rejected (Z > 1 at K_d, or diverging): redo from t with a smaller step.
+    if (h <= dt_min_ * (1.0 + 1e-12)) {
+      report_.iterations = std::min(k, kd);
+      throw StepFailed("the adaptive step did not converge at dt_min = " + number(dt_min_) + " s (t = " + number(t) +
+                       " s, " + std::to_string(report_.rejected + 1) + " attempts" +
+                       (diverged ? ", the fixed-point iteration diverged" : "") +
+                       "); the motion is too violent for TOL = " + number(tol) +
+                       " at this dt_min: raise adaptive.tol, lower adaptive.dt_min, or look for a load or "
+                       "contact that makes the state jump");
+    }
+    ++report_.rejected;
+    h = std::max(std::min(phi_k, 0.9) * h, dt_min_);
+  }
+}
+
+}  // namespace pd

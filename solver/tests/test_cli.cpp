@@ -1,0 +1,90 @@
+// The command line: --help documents every option main.cpp accepts, --version says how the binary
+// was built, and a bad option is a usage error (exit code 2).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out;
+};
+
+Result run_solver(const std::string& args) {
+  const fs::path log = fs::temp_directory_path() / ("pd_test_cli_" + std::to_string(::getpid()) + ".txt");
+  const std::string command = std::string(PDSOLVE_PATH) + " " + args + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream in(log);
+  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+           {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}};
+  fs::remove(log);
+  return r;
+}
+
+// Every option main.cpp compares an argument with, e.g. `arg == "--threads"`.
+std::set<std::string> options_in_source() {
+  std::ifstream in(fs::path(PD_SOURCE_DIR) / "src" / "main.cpp");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  static const std::regex option(R"(arg == "(-{1,2}[A-Za-z][A-Za-z0-9-]*)\")");
+  std::set<std::string> out;
+  for (std::sregex_iterator it(text.begin(), text.end(), option), end; it != end; ++it) out.insert((*it)[1]);
+  return out;
+}
+
+bool built_with_address_sanitizer() {
+#if defined(__SANITIZE_ADDRESS__)
+  return true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  return true;
+#endif
+#endif
+  return false;
+}
+
+}  // namespace
+
+TEST(CommandLine, HelpDocumentsEveryOption) {
+  const Result r = run_solver("--help");
+  EXPECT_EQ(r.code, 0);
+  const auto options = options_in_source();
+  ASSERT_GE(options.size(), 6u) << "the scan of main.cpp found too few options; did its style change?";
+  for (const auto& o : options) {
+    if (o == "-h") continue;  // the short form of --help
+    // Documented on a line of its own: two spaces, the option, then its description.
+    EXPECT_NE(r.out.find("\n  " + o + " "), std::string::npos) << o << " is not documented in --help:\n" << r.out;
+  }
+  EXPECT_NE(r.out.find("Exit codes"), std::string::npos);
+}
+
+TEST(CommandLine, VersionNamesTheBuild) {
+  const Result r = run_solver("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind(std::string("pdsolve ") + PD_VERSION + "\n", 0), 0u) << r.out;
+  for (const char* line : {"\nbuild type: ", "\ncompiler: ", "\nflags: ", "\nOpenMP: ", "\nsanitizers: "})
+    EXPECT_NE(r.out.find(line), std::string::npos) << "missing '" << line + 1 << "' in:\n" << r.out;
+  // The sanitizer line tells the truth about this very build (the test shares pdsolve's flags).
+  const std::string want = built_with_address_sanitizer() ? "\nsanitizers: address,undefined\n" : "\nsanitizers: off\n";
+  EXPECT_NE(r.out.find(want), std::string::npos) << r.out;
+}
+
+TEST(CommandLine, BadOptionsAreUsageErrors) {
+  Result r = run_solver("--thread 4 case.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("unknown option '--thread'"), std::string::npos) << r.out;
+  r = run_solver("case.json --threads zero");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--threads needs an integer"), std::string::npos) << r.out;
+  r = run_solver("");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("no case file given"), std::string::npos) << r.out;
+}
