@@ -2,7 +2,11 @@
 #   make case=membrane        mesh → node cloud → solve → figures and Gmsh views, in out/membrane/
 #   make figures case=X       redraw figures and Gmsh views from existing results
 #   make case=X config=Y      run cases/X/Y.yaml (a variant of case X) into out/X-Y/
-#   make test                 build everything and run every test
+#   make test                 build everything and run every test (then test-asan)
+#   make validate             full plate_with_hole, traction, branching runs + checks → out/validate/report.md
+#   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
+#   make fuzz                 libFuzzer on the solver's readers, FUZZ_SECONDS (60) each (clang)
+#   make bench                speed of the bond kernel on 3D bricks → out/bench/speed.csv (docs/performance.md)
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
@@ -25,7 +29,7 @@ PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
 POST_SOURCES   := $(wildcard postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
 
-.PHONY: all run figures test solver deps check clean clean-case
+.PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench validate
 .DELETE_ON_ERROR:
 
 all: run
@@ -71,6 +75,50 @@ figures: | $(DEPS)
 test: $(SOLVER) | $(DEPS)
 	ctest --test-dir build/solver --output-on-failure -j$(JOBS)
 	$(PYTEST) -q tests
+	@$(MAKE) --no-print-directory test-asan
+
+# The solver and its tests under AddressSanitizer + UBSan (+ libstdc++ assertions): any report fails
+# the test that caused it (UBSan halts instead of printing and going on). -O2 without NDEBUG: at -O0
+# the physics tests run 10-50 times slower under ASan (one took 11 min), asserts stay on.
+ASAN_DIR := build/solver-asan
+test-asan: | $(DEPS)
+	cmake -S solver -B $(ASAN_DIR) -DPD_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g"
+	cmake --build $(ASAN_DIR) -j$(JOBS) --target pdsolve pd_tests
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	    ctest --test-dir $(ASAN_DIR) --output-on-failure -j$(JOBS)
+
+# libFuzzer (clang) on the solver's readers, FUZZ_SECONDS each; a crash leaves its input in
+# $(FUZZ_DIR)/artifacts/: fix the reader and add the input to solver/fuzz/regressions/<target>/.
+FUZZ_DIR     := build/solver-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case
+fuzz: | $(DEPS)
+	cmake -S solver -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DPD_FUZZ=ON -DPD_BUILD_TESTS=OFF \
+	    -DCMAKE_BUILD_TYPE=RelWithDebInfo
+	cmake --build $(FUZZ_DIR) -j$(JOBS) --target pd_fuzz
+	@mkdir -p $(FUZZ_DIR)/artifacts
+	@for t in $(FUZZ_TARGETS); do \
+	    case $$t in pd_fuzz_case) dict=case.dict;; *) dict=vtu.dict;; esac; \
+	    mkdir -p $(FUZZ_DIR)/work/$$t; \
+	    echo "fuzzing $$t for $(FUZZ_SECONDS) s (log: $(FUZZ_DIR)/$$t.log)"; \
+	    $(FUZZ_DIR)/fuzz/$$t -max_total_time=$(FUZZ_SECONDS) -max_len=16384 -timeout=10 -rss_limit_mb=2048 \
+	        -dict=solver/fuzz/$$dict -artifact_prefix=$(FUZZ_DIR)/artifacts/$$t- \
+	        $(FUZZ_DIR)/work/$$t $(FUZZ_DIR)/fuzz/corpus/$$t solver/fuzz/regressions/$$t \
+	        > $(FUZZ_DIR)/$$t.log 2>&1 \
+	    || { tail -n 40 $(FUZZ_DIR)/$$t.log; echo "$$t: failure, input in $(FUZZ_DIR)/artifacts/"; exit 1; }; \
+	    grep '^Done' $(FUZZ_DIR)/$$t.log; \
+	done
+
+# A benchmark, not a timed test: bricks of 64,000, ~10⁵ and 10⁶ nodes with 1 and 2 threads
+# (BENCH_SIDES to change), then the cost of output in the built cases. Prints the load average.
+BENCH_SIDES ?= 40 46 100
+bench: $(SOLVER)
+	$(PY) solver/bench/speed.py --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
+
+# The full cases with quantitative checks (validation/): out/validate/report.md and a PNG per case.
+validate: $(SOLVER) | $(DEPS)
+	$(PY) -m validation
 
 clean-case:
 	rm -rf $(OUT)

@@ -41,6 +41,8 @@ def check_set_names(case: dict, existing: list[str]):
         missing(name, ("no_fail", i))
     for name in case["node_sets"]:
         missing(name, ("node_sets", name))
+    for i, name in enumerate(case["output"]["reactions"]):
+        missing(name, ("output", "reactions", i))
     if problems:
         raise CaseError("\n".join(problems))
 
@@ -89,14 +91,21 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "node_sets": sorted(node_sets),
         "boundary_conditions": boundary,
         "initial_conditions": initial,
+        "cracks": [{"from": _point3(c["from"]), "to": _point3(c["to"])} for c in case["cracks"]],
         "damping": case["damping"],
         "partial_volume": case["discretization"]["partial_volume"],
         "contact": contact,
         "indenters": indenters,
         "time": time,
+        "adaptive": dict(case["adaptive"]),
         "output": dict(case["output"]),
         "figures": figures,
     }
+
+
+def _point3(point: list[float]) -> list[float]:
+    """[x, y] or [x, y, z] as [x, y, z] (z = 0 in 2D)."""
+    return [float(c) for c in point] + [0.0] * (3 - len(point))
 
 
 def _unit(vector: list[float]) -> list[float]:

@@ -84,6 +84,11 @@ INDENTER = {
                      "as in LAMMPS PERI)", default=REQUIRED, unit="N/m⁵", above=0.0),
 }
 
+CRACK = {
+    "from": Key("numbers", "one end of the crack segment, [x, y(, z)]", default=REQUIRED, unit="m"),
+    "to": Key("numbers", "the other end, [x, y(, z)]", default=REQUIRED, unit="m"),
+}
+
 CASE = {
     "title": Key("string", "a one-line description, shown in figures", default=""),
     "dimension": Key("choice", "spatial dimension of the geometry", default=REQUIRED, choices=(2, 3)),
@@ -124,6 +129,9 @@ CASE = {
                                fields=BOUNDARY_CONDITION),
     "initial_conditions": Key("list", "state at t = 0 (the rest of the body starts at rest)",
                               default=[], fields=INITIAL_CONDITION),
+    "cracks": Key("list", "pre-cracks (notches): every bond whose reference segment crosses the segment "
+                  "from–to in the xy plane (in 3D: the plane through it parallel to z) starts broken; "
+                  "lay it between two rows of nodes", default=[], fields=CRACK),
     "damping": Key("number", "velocity damping α: force density −ρ·α·v (the thesis's damping "
                    "correction); 0 for none", default=0.0, unit="1/s", minimum=0.0),
     "contact": section(
@@ -144,11 +152,35 @@ CASE = {
     "time": section(
         "time integration",
         end=Key("number", "simulated end time", default=REQUIRED, unit="s", above=0.0),
-        integrator=Key("choice", "time integrator", default="verlet", choices=("verlet",)),
+        integrator=Key("choice", "time integrator: verlet (velocity Verlet, thesis eq. 2.4) or adaptive "
+                       "(the mixed explicit–implicit step of thesis §2.2, settings in adaptive:)",
+                       default="verlet", choices=("verlet", "adaptive")),
         dt=Key("number_or_choice", "time step: 'stable' (thesis eq. 2.5, minimised over nodes, times "
-               "safety_factor) or a number", default="stable", unit="s", choices=("stable",), above=0.0),
+               "safety_factor), 'exact' (2/ω_max, ω_max² the largest eigenvalue of the linearised PMB "
+               "operator M⁻¹K, times safety_factor: about 1.7× 'stable' in 2D, 2× in 3D), or a number; "
+               "for adaptive, the initial step unless adaptive.dt_initial is set",
+               default="stable", unit="s", choices=("stable", "exact"), above=0.0),
         safety_factor=Key("number", "fraction of the stable time step used", default=0.8, above=0.0),
         max_steps=Key("integer", "stop after this many steps", default=100_000_000, minimum=1),
+    ),
+    "adaptive": section(
+        "the adaptive step of thesis §2.2 (time.integrator: adaptive): fixed-point iterations with "
+        "error ω_K (eq. 2.6) and step factor Φ_K (eq. 2.8)",
+        tol=Key("number", "TOL of eq. 2.7: a step is accepted once the last correction is this fraction "
+                "of the step's motion", default=1e-3, above=0.0),
+        kd=Key("integer", "K_d: the iterations the step size is aimed at; a step not converged after "
+               "K_d iterations is redone with a smaller Δt", default=20, minimum=1),
+        p=Key("number", "exponent p of eq. 2.8 (the correction shrinks like Δt^p per iteration; "
+              "2 for the linear problem, thesis 3)", default=3.0, above=0.0),
+        phi=Key("number", "φ: weight of the end-of-step force and velocity; 1 the thesis form "
+                "(first order, dissipative), 0.5 the trapezoidal rule (second order)", default=1.0,
+                minimum=0.5),
+        dt_initial=Key("number", "the first step (default: from time.dt)", default=None, unit="s",
+                       above=0.0),
+        dt_min=Key("number", "smallest step; not converging there stops the run (default: 1e-6 × "
+                   "eq. 2.5)", default=None, unit="s", above=0.0),
+        dt_max=Key("number", "largest step (default: eq. 2.5 without safety factor)", default=None,
+                   unit="s", above=0.0),
     ),
     "output": section(
         "what the solver writes and how often",
@@ -157,6 +189,9 @@ CASE = {
         every_steps=Key("integer", "a frame every this many steps (instead of every_time)",
                         default=None, minimum=1),
         history_every=Key("integer", "a history.csv row every this many steps", default=1, minimum=1),
+        reactions=Key("names", "node sets whose reaction force (the force the prescribed displacement or "
+                      "velocity applies to the set) goes to history.csv as reaction_<set>_fx, _fy, _fz",
+                      default=[], unit="N"),
     ),
     "figures": section(
         "what postprocess draws",

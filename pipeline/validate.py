@@ -259,11 +259,33 @@ def _check_context(case: dict, checker: _Checker):
     names = set()
     for i, ind in enumerate(case["indenters"]):
         _check_indenter(ind, i, dim, names, checker)
+    for i, crack in enumerate(case["cracks"]):
+        _check_crack(crack, i, dim, checker)
+    adaptive = case["adaptive"]
+    if adaptive["phi"] is not None and adaptive["phi"] > 1.0:
+        checker.error(("adaptive", "phi"), f"must be between 0.5 and 1, got {adaptive['phi']:g}")
+    if adaptive["tol"] is not None and adaptive["tol"] >= 1.0:
+        checker.error(("adaptive", "tol"), f"must be below 1 (a relative error), got {adaptive['tol']:g}")
+    for low, high in (("dt_min", "dt_max"), ("dt_min", "dt_initial"), ("dt_initial", "dt_max")):
+        if adaptive[low] is not None and adaptive[high] is not None and adaptive[low] > adaptive[high]:
+            checker.error(("adaptive", low), f"{low} {adaptive[low]:g} s is larger than {high} "
+                          f"{adaptive[high]:g} s")
     out = case["output"]
     if out["every_time"] is not None and out["every_steps"] is not None:
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
         out["every_time"] = case["time"]["end"] / 50.0
+
+
+def _check_crack(crack: dict, i: int, dim: int, checker: _Checker):
+    """A pre-crack is two distinct points of the case's dimension (z = 0 is filled in for 2D)."""
+    for key in ("from", "to"):
+        point = crack[key]
+        if point is not None and len(point) not in ((2, 3) if dim == 2 else (3,)):
+            checker.error(("cracks", i, key), f"expected {'2 or 3' if dim == 2 else '3'} components, got {len(point)}")
+            return
+    if crack["from"] is not None and crack["to"] is not None and crack["from"][:2] == crack["to"][:2]:
+        checker.error(("cracks", i), "from and to are the same point in the xy plane")
 
 
 def _check_indenter(ind: dict, i: int, dim: int, names: set, checker: _Checker):

@@ -138,6 +138,11 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
             path = os.path.join(fig_dir, "indenter_force.png")
             plot_indenter_forces(history, case, path)
             written.append(path)
+        from .reaction_plot import plot_reactions, reaction_sets
+        if reaction_sets(history):  # only when the case lists output.reactions (formats.md §4)
+            path = os.path.join(fig_dir, "reaction_force.png")
+            plot_reactions(history, case, case_json, path)
+            written.append(path)
         shared = displacement_range([kept[i] for i in selected], case.component)
         for number, (t_requested, index) in enumerate(zip(requested, selected)):
             for quantity in ("damage", "displacement"):

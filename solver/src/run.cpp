@@ -13,8 +13,11 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/reactions.hpp"
 #include "core/work_plan.hpp"
 #include "forces/pmb.hpp"
+#include "core/stability.hpp"
+#include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
 #include "io/case_reader.hpp"
 #include "io/node_file.hpp"
@@ -91,15 +94,24 @@ int run(const RunOptions& opt) {
   const std::size_t n = model.nodes.size();
 
   const double dt_stable = stable_time_step(model);
-  double dt = 0.0;
+  double dt = 0.0, dt_exact = 0.0;  // dt_exact: computed when time.dt is "exact" or a run fails
   if (c.time.dt_rule == "stable") {
     if (!std::isfinite(dt_stable))
       throw Error(c.file.string() + ": time.dt: \"stable\" needs bonds, but no node has a partner within the horizon " +
                   format("%.6g", c.horizon) + " m");
     dt = dt_stable * c.time.safety_factor;
+  } else if (c.time.dt_rule == "exact") {
+    // The largest eigenvalue of the linearised operator (core/stability): the true linear limit.
+    dt_exact = exact_time_step(model);
+    if (!std::isfinite(dt_exact))
+      throw Error(c.file.string() + ": time.dt: \"exact\" needs bonds, but no node has a partner within the horizon " +
+                  format("%.6g", c.horizon) + " m");
+    dt = dt_exact * c.time.safety_factor;
   } else {
     dt = c.time.dt_value;
   }
+  // The adaptive step starts from adaptive.dt_initial when given, else from the time.dt rule.
+  if (c.time.integrator == "adaptive" && c.adaptive.dt_initial) dt = *c.adaptive.dt_initial;
   std::int64_t max_steps = c.time.max_steps;
   if (opt.max_steps) max_steps = std::min(max_steps, *opt.max_steps);
   const double end = c.time.end;
@@ -108,6 +120,7 @@ int run(const RunOptions& opt) {
   const auto steps_for_end = static_cast<std::int64_t>(std::ceil(end / dt * (1.0 - kLastStepSlack)));
   const std::int64_t steps_expected = std::min(steps_for_end, max_steps);
   std::unique_ptr<Integrator> integrator = integrator_registry().get(c.time.integrator)(model);
+  integrator->configure(c);
 
   State state(n);
   apply_initial_conditions(c, model.nodes, state.u, state.v);
@@ -122,6 +135,12 @@ int run(const RunOptions& opt) {
   if (model.contact.pairs) extra_columns.push_back("contact_rebuilds");
   for (const auto& ind : model.indenters)
     for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("indenter_" + ind.name + "_" + axis);
+  // Energy of broken bonds (validation.md C4 with breaking): when some block pair can break.
+  const bool breakable = std::any_of(model.material.critical_pair.begin(), model.material.critical_pair.end(),
+                                     [](double s0) { return std::isfinite(s0); });
+  if (breakable) extra_columns.push_back("broken_bond_energy");
+  for (const auto& set : c.output.reactions)
+    for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("reaction_" + set + "_" + axis);
   OutputWriter out(c.output_dir, extra_columns);
   RunLog log(c.output_dir / "run.log", opt.quiet);
   log.line("pdsolve " PD_VERSION ": case " + (c.name.empty() ? opt.case_file.string() : c.name) + " (" +
@@ -138,16 +157,25 @@ int run(const RunOptions& opt) {
                                                                    : format("%.6g", model.material.block[b].critical_stretch)));
   log.line("dt " + format("%.6g", dt) + " s (" +
            (c.time.dt_rule == "stable" ? "stable " + format("%.6g", dt_stable) + " s × safety factor " + format("%g", c.time.safety_factor)
-                                       : "fixed; stable " + format("%.6g", dt_stable) + " s") +
+            : c.time.dt_rule == "exact" ? "exact limit " + format("%.6g", dt_exact) + " s = " + format("%.4g", dt_exact / dt_stable) +
+                                              " × eq. 2.5, × safety factor " + format("%g", c.time.safety_factor)
+                                        : "fixed; stable " + format("%.6g", dt_stable) + " s") +
+           (c.time.integrator == "adaptive" ? ", the initial step" : "") +
            "), integrator " + integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
   if (c.time.dt_rule == "fixed" && dt > dt_stable)
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
   for (const auto& text : work_summary(model, c)) log.line(text);
+  if (const auto* adaptive = dynamic_cast<const AdaptiveStep*>(integrator.get()))
+    log.line("adaptive (thesis §2.2): TOL " + format("%g", adaptive->settings().tol) + ", Kd " +
+             std::to_string(adaptive->settings().kd) + ", p " + format("%g", adaptive->settings().p) + ", phi " +
+             format("%g", adaptive->settings().phi) + ", dt_min " + format("%.6g", adaptive->dt_min()) + " s, dt_max " +
+             format("%.6g", adaptive->dt_max()) + " s");
   log.line("end time " + format("%.6g", end) + " s, steps expected " + std::to_string(steps_expected) +
            (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
 
   const auto loop_start = Clock::now();
   std::int64_t step = 0, broken = broken_bond_count(model), last_frame_step = -1;
+  double broken_energy = 0.0;  // Σ energy of bonds at the moment they broke [J]
   auto history_row = [&](double dt_taken) {
     HistoryRow r;
     r.step = step;
@@ -166,6 +194,9 @@ int run(const RunOptions& opt) {
     for (std::size_t k = 0; k < model.indenters.size(); ++k)
       for (std::size_t d = 0; d < 3; ++d)  // the reaction on the indenter: minus its force on the body
         r.extra.push_back(k < state.indenter_force.size() ? -state.indenter_force[k][d] : 0.0);
+    if (breakable) r.extra.push_back(broken_energy);
+    for (const auto& set : c.output.reactions)
+      for (double component : reaction_force(model, state, set, t)) r.extra.push_back(component);
     out.history(r);
   };
   std::int64_t next_frame_index = 1;  // every_time: frame k at t ≥ k·every_time
@@ -180,19 +211,73 @@ int run(const RunOptions& opt) {
   const bool progress = !opt.quiet && isatty(fileno(stderr));
   auto last_progress = Clock::now();
   int status = kOk;
+  bool state_valid = true;  // false after a blow-up: that state is never written
   double dt_taken = 0.0;
+  std::int64_t force_evaluations = 0;
+  // Blow-up watch: an explicit step above its limit makes the energy grow geometrically (×47 per
+  // step at 1.5× the limit); physical loading does not keep up ×1.5 per step for 20 steps.
+  constexpr double kGrowthPerStep = 1.5;
+  constexpr int kGrowthSteps = 20;
+  double energy_before = -1.0, energy_streak_start = 0.0;
+  int growth_streak = 0;
+  // Why a run blew up, from the true stability limit (computed now if not yet known).
+  auto likely_cause = [&](double h) {
+    if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
+    const double ratio = h / dt_exact;
+    std::string text = "dt = " + format("%.6g", h) + " s is " + format("%.3g", ratio) + " × the exact stability limit " +
+                       format("%.6g", dt_exact) + " s (eq. 2.5: " + format("%.6g", dt_stable) + " s): ";
+    if (ratio > 1.0 && c.time.integrator == "verlet")
+      return text + "the time step is above the stability limit; use time.dt: stable or exact with safety_factor < 1";
+    return text + "the step is within the linear limit, so look for contact stiffness, large deformation or a load "
+                  "that makes the state jump";
+  };
   while (step < max_steps && t < end * (1.0 - 1e-12)) {
+    // Land exactly on the end time and on every output time (t = k·every_time): the step that would
+    // cross one is shortened (or stretched by at most kLastStepSlack); dt itself is kept for the
+    // steps after it.
+    double target = end;
+    if (c.output.every_time) target = std::min(end, static_cast<double>(next_frame_index) * *c.output.every_time);
     double h = dt;
-    if (end - t <= dt * (1.0 + kLastStepSlack)) h = end - t;  // land exactly on the end time
-    integrator->step(state, t, h);
+    const bool landing = target - t <= dt * (1.0 + kLastStepSlack);
+    if (landing) h = target - t;
+    const double requested = h;
+    try {
+      integrator->step(state, t, h);
+    } catch (const StepFailed& e) {
+      log.error("pdsolve: error: step " + std::to_string(step + 1) + ": " + e.what() +
+                "; stopped, the last accepted state is kept");
+      status = kRunFailed;
+      break;
+    }
+    if (landing && h == requested) t = target;  // exact, not t + (target − t) with its round-off
     dt_taken = h;
     ++step;
     broken += integrator->last_step().broken_now;
+    broken_energy += integrator->last_step().broken_energy_now;
+    force_evaluations += integrator->last_step().force_evaluations;
+    if (integrator->last_step().next_dt > 0.0) dt = integrator->last_step().next_dt;
     if (const std::int64_t bad = first_non_finite(state); bad >= 0) {
       log.error("pdsolve: error: non-finite displacement or velocity at node " + std::to_string(bad) + " after step " +
-                std::to_string(step) + " (t = " + format("%.6g", t) + " s, dt = " + format("%.6g", h) +
-                " s, stable dt " + format("%.6g", dt_stable) + " s); stopped without writing this state");
+                std::to_string(step) + " (t = " + format("%.6g", t) + " s); " + likely_cause(h) +
+                "; stopped without writing this state");
       status = kRunFailed;
+      state_valid = false;
+      break;
+    }
+    const double energy = kinetic_energy(model, state) + stored_strain_energy(model, state) + state.contact_energy;
+    if (energy_before > 0.0 && energy > kGrowthPerStep * energy_before) {
+      if (growth_streak++ == 0) energy_streak_start = energy_before;
+    } else {
+      growth_streak = 0;
+    }
+    energy_before = energy;
+    if (growth_streak >= kGrowthSteps) {
+      log.error("pdsolve: error: the energy grew from " + format("%.3g", energy_streak_start) + " J to " +
+                format("%.3g", energy) + " J in the " + std::to_string(kGrowthSteps) + " steps up to and after step " +
+                std::to_string(step) + " (t = " + format("%.6g", t) + " s), at least ×" + format("%g", kGrowthPerStep) +
+                " every step: the run is unstable; " + likely_cause(h) + "; stopped without writing this state");
+      status = kRunFailed;
+      state_valid = false;
       break;
     }
     const bool frame_due = c.output.every_steps ? step % *c.output.every_steps == 0
@@ -210,7 +295,7 @@ int run(const RunOptions& opt) {
     }
   }
   if (progress) std::fprintf(stderr, "\r%70s\r", "");
-  if (status == kOk && last_frame_step != step) frame(dt_taken);
+  if (state_valid && last_frame_step != step) frame(dt_taken);
   out.finish();
 
   const double wall = seconds_since(loop_start);
@@ -218,7 +303,8 @@ int run(const RunOptions& opt) {
   log.line(std::string(status == kOk ? "done" : "stopped") + ": " + std::to_string(step) + " steps to t = " +
            format("%.6g", t) + " s in " + format("%.3f", wall) + " s wall (" +
            format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
-           std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds");
+           std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds, " +
+           std::to_string(force_evaluations) + " force evaluations");
   if (model.contact.pairs)
     log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
              std::to_string(step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +

@@ -45,7 +45,8 @@ TEST(Bonds, EachBondStoredFromBothEndsWithTheSameLength) {
   std::map<std::pair<int, int>, double> length;
   for (std::size_t i = 0; i < b.nodes(); ++i)
     for (auto k = b.offsets[i]; k < b.offsets[i + 1]; ++k)
-      length[{static_cast<int>(i), b.neighbour[static_cast<std::size_t>(k)]}] = b.length[static_cast<std::size_t>(k)];
+      length[{static_cast<int>(i), b.neighbour[static_cast<std::size_t>(k)]}] =
+          pd::bond_length(nodes.x, i, static_cast<std::size_t>(b.neighbour[static_cast<std::size_t>(k)]));
   for (const auto& [key, r] : length) {
     auto it = length.find({key.second, key.first});
     ASSERT_NE(it, length.end());

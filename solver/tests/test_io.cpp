@@ -184,9 +184,14 @@ TEST(CaseFile, ReadsTheFormatsExample) {
 TEST(CaseFile, RejectsBadValuesNamingTheKey) {
   expect_case_error("\"safety_factor\": 0.8", "\"safety_factor\": -1", {"time.safety_factor: must be > 0"});
   expect_case_error("\"safety_factor\": 0.8", "\"safty_factor\": 0.8", {"time.safty_factor: unknown key (did you mean 'safety_factor'?)"});
-  expect_case_error("\"dt\": \"stable\"", "\"dt\": \"exact\"", {"time.dt: \"exact\"", "not implemented"});
+  expect_case_error("\"dt\": \"stable\"", "\"dt\": \"exakt\"", {"time.dt: unknown rule 'exakt'; known: stable, exact"});
+  expect_case_error("\"phi\": 1.0", "\"phi\": 0.2", {"adaptive.phi: must be between 0.5 and 1"});
+  expect_case_error("\"kd\": 20", "\"kd\": 0", {"adaptive.kd: must be between 1 and 1000"});
+  expect_case_error("\"tol\": 1e-3", "\"tol\": 1.5", {"adaptive.tol: must be below 1"});
+  expect_case_error("\"dt_min\": null, \"dt_max\": null", "\"dt_min\": 1.0, \"dt_max\": 0.5", {"adaptive.dt_min: is larger than adaptive.dt_max"});
+  expect_case_error("\"p\": 3.0", "\"p\": 3.0, \"pp\": 1", {"adaptive.pp: unknown key (did you mean 'p'?)"});
   expect_case_error("\"dt\": \"stable\"", "\"dt\": -1e-6", {"time.dt: must be > 0"});
-  expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: verlet"});
+  expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: adaptive, verlet"});
   expect_case_error("\"analysis\": \"plane_stress\"", "\"analysis\": \"planar\"", {"analysis: unknown analysis 'planar'; known: 3d, plane_strain, plane_stress"});
   expect_case_error("\"analysis\": \"plane_stress\"", "\"analysis\": \"3d\"", {"analysis: '3d' does not fit dimension 2"});
   expect_case_error("\"density\": 1200.0", "\"density\": \"heavy\"", {"blocks[0].density: must be a number"});

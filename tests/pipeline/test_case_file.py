@@ -165,3 +165,31 @@ def test_membrane_case_is_valid():
 def test_case_file_reference_is_generated_from_schema():
     with open(os.path.join(ROOT, "docs", "case-file.md"), encoding="utf-8") as stream:
         assert stream.read() == schema.markdown(), "regenerate: /usr/bin/python3 -m pipeline.schema > docs/case-file.md"
+
+
+def test_adaptive_section_defaults_and_resolution(tmp_path):
+    case = load_case(write(tmp_path, MINIMAL.replace("  end: 1.0e-3", "  end: 1.0e-3\n  integrator: adaptive")))
+    assert case["time"]["integrator"] == "adaptive"
+    assert case["adaptive"] == {"tol": 1e-3, "kd": 20, "p": 3.0, "phi": 1.0,
+                                "dt_initial": None, "dt_min": None, "dt_max": None}
+    resolved = resolve(case, node_sets=[], grid_spacing=0.001, nodes_file="nodes.vtu")
+    assert resolved["adaptive"]["kd"] == 20 and resolved["time"]["integrator"] == "adaptive"
+
+
+def test_bad_adaptive_values_name_line_and_range(tmp_path):
+    text = MINIMAL + "adaptive:\n  phi: 0.3\n  kd: 0\n  tol: 2.0\n  dt_min: 1.0e-6\n  dt_max: 1.0e-7\n"
+    message = error_of(tmp_path, text)
+    assert "plate.yaml:12: adaptive.phi: must be at least 0.5, got 0.3" in message
+    assert "plate.yaml:13: adaptive.kd: must be at least 1, got 0" in message
+    text = MINIMAL + "adaptive:\n  phi: 1.5\n  tol: 2.0\n  dt_min: 1.0e-6\n  dt_max: 1.0e-7\n"
+    message = error_of(tmp_path, text)
+    assert "plate.yaml:12: adaptive.phi: must be between 0.5 and 1, got 1.5" in message
+    assert "plate.yaml:13: adaptive.tol: must be below 1" in message
+    assert "plate.yaml:14: adaptive.dt_min: dt_min 1e-06 s is larger than dt_max 1e-07 s" in message
+
+
+def test_dt_exact_is_a_known_rule(tmp_path):
+    case = load_case(write(tmp_path, MINIMAL.replace("  end: 1.0e-3", "  end: 1.0e-3\n  dt: exact")))
+    assert case["time"]["dt"] == "exact"
+    message = error_of(tmp_path, MINIMAL.replace("  end: 1.0e-3", "  end: 1.0e-3\n  dt: exakt"))
+    assert "time.dt: 'exakt' is not one of 'stable', 'exact'" in message

@@ -13,7 +13,7 @@ namespace pd {
 
 namespace {
 
-// Calls visit(j, |ξ|) for every partner j of node i (unordered).
+// Calls visit(j) for every partner j of node i (unordered).
 template <class Visit>
 void for_each_partner(const Vec3Array& x, const CellGrid& grid, double cutoff2, std::size_t i,
                       Visit&& visit) {
@@ -26,7 +26,7 @@ void for_each_partner(const Vec3Array& x, const CellGrid& grid, double cutoff2, 
     if (r2 > cutoff2) return;
     if (r2 == 0.0)
       throw Error("nodes " + std::to_string(i) + " and " + std::to_string(j) + " have the same reference position");
-    visit(static_cast<std::int32_t>(j), std::sqrt(r2));
+    visit(static_cast<std::int32_t>(j));
   });
 }
 
@@ -51,7 +51,7 @@ BondList build_bonds(const Vec3Array& x, double horizon) {
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
     try {
       std::int64_t count = 0;
-      for_each_partner(x, grid, cutoff2, static_cast<std::size_t>(i), [&](std::int32_t, double) { ++count; });
+      for_each_partner(x, grid, cutoff2, static_cast<std::size_t>(i), [&](std::int32_t) { ++count; });
       bonds.offsets[static_cast<std::size_t>(i) + 1] = count;
     } catch (const Error& e) {
 #pragma omp critical(pd_bond_error)
@@ -62,22 +62,14 @@ BondList build_bonds(const Vec3Array& x, double horizon) {
   for (std::size_t i = 0; i < n; ++i) bonds.offsets[i + 1] += bonds.offsets[i];
   const auto total = static_cast<std::size_t>(bonds.offsets[n]);
   bonds.neighbour.resize(total);
-  bonds.length.resize(total);
   bonds.broken.assign(total, 0);
-  bonds.volume_factor.assign(total, 1.0);
 
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-    std::vector<std::pair<std::int32_t, double>> row;
-    for_each_partner(x, grid, cutoff2, static_cast<std::size_t>(i),
-                     [&](std::int32_t j, double r) { row.emplace_back(j, r); });
-    std::sort(row.begin(), row.end());  // ascending j: deterministic order, better locality
-    auto k = static_cast<std::size_t>(bonds.offsets[static_cast<std::size_t>(i)]);
-    for (const auto& [j, r] : row) {
-      bonds.neighbour[k] = j;
-      bonds.length[k] = r;
-      ++k;
-    }
+    std::int32_t* row = bonds.neighbour.data() + bonds.offsets[static_cast<std::size_t>(i)];
+    std::int32_t* end = row;
+    for_each_partner(x, grid, cutoff2, static_cast<std::size_t>(i), [&](std::int32_t j) { *end++ = j; });
+    std::sort(row, end);  // ascending j: deterministic order, better locality
   }
   return bonds;
 }

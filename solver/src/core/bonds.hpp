@@ -1,5 +1,7 @@
 // The bond list in CSR form, built once from the reference configuration with a cell list.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -12,15 +14,34 @@ namespace pd {
 // without admitting any other lattice distance.
 constexpr double kHorizonTolerance = 1e-12;
 
+// |ξ| = |x_j − x_i| of bond i→j, computed exactly as build_bonds computed it: x_j − x_i is the
+// exact negative of x_i − x_j, so both copies of a bond see bitwise the same length.
+inline double bond_length(const Vec3Array& x, std::size_t i, std::size_t j) {
+  const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
+  return std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+}
+
+// ν(|ξ|), the share of V_j inside the horizon (validation.md F3): every rule we have is
+// ν = clamp((outer − |ξ|)/dx, 0, 1) — LAMMPS's (δ − |ξ|)/dx + ½ and HHB's (δ − |ξ| + dx/2)/dx
+// both have outer = δ + dx/2; full volumes have outer = +∞, so ν = 1. Two numbers instead of
+// eight bytes per bond (core/partial_volume sets them).
+struct VolumeWeight {
+  double outer = HUGE_VAL;  // [m]
+  double inv_dx = 1.0;      // [1/m]
+  double operator()(double length) const { return std::min(1.0, std::max(0.0, (outer - length) * inv_dx)); }
+};
+
 // Every bond is stored from both ends (i→j in i's row and j→i in j's row), so a loop over nodes
 // writes only its own node's force: no atomics, the same result for any thread count
 // (LAMMPS PERI stores partners the same way).
+// Five bytes per directed bond (docs/performance.md): bond data is streamed once per force
+// evaluation, so what is cheaper to recompute than to load is not stored: |ξ| comes from the
+// reference positions (bond_length, bitwise what the builder saw), ν from |ξ| (VolumeWeight).
 struct BondList {
   std::vector<std::int64_t> offsets;    // row i is [offsets[i], offsets[i+1])
   std::vector<std::int32_t> neighbour;  // j, ascending within a row
-  std::vector<double> length;           // |ξ| = |x_j − x_i| in the reference configuration
   std::vector<std::uint8_t> broken;     // 1 once the bond has broken (never heals)
-  std::vector<double> volume_factor;    // ν: the share of V_j inside the horizon (validation.md F3); 1 by default
+  VolumeWeight volume_weight;           // ν(|ξ|) of every bond; full volumes unless a rule set it
 
   std::size_t nodes() const { return offsets.empty() ? 0 : offsets.size() - 1; }
   std::size_t directed() const { return neighbour.size(); }  // each bond counted twice

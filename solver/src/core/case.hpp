@@ -47,6 +47,13 @@ struct OutputSettings {
   std::optional<double> every_time;        // s
   std::optional<std::int64_t> every_steps;
   std::int64_t history_every = 1;
+  std::vector<std::string> reactions;      // node sets whose reaction force goes to history.csv
+};
+
+// A pre-crack: bonds crossing the segment from–to (in the xy plane; in 3D the plane through it
+// parallel to z) start broken (core/cracks.hpp).
+struct CrackSegment {
+  std::array<double, 3> from{}, to{};  // [m]
 };
 
 // contact: short-range forces between nodes (validation.md F4).
@@ -83,6 +90,7 @@ struct Case {
   std::vector<std::string> no_fail_sets, node_sets;
   std::vector<BoundaryCondition> boundary_conditions;
   std::vector<InitialCondition> initial_conditions;
+  std::vector<CrackSegment> cracks;
   double damping = 0.0;  // α [1/s]
   ContactSettings contact;
   std::vector<IndenterSettings> indenters;

@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "core/cracks.hpp"
 #include "core/error.hpp"
 #include "core/partial_volume.hpp"
 #include "core/work_plan.hpp"
@@ -57,6 +58,7 @@ Model build_model(const Case& c, Nodes nodes) {
   const double cutoff = bond_cutoff(rule, c.horizon, c.grid_spacing);
   m.bonds = build_bonds(nodes.x, cutoff);
   apply_partial_volume(rule, c.horizon, c.grid_spacing, m.bonds);
+  cut_crossing_bonds(c.cracks, nodes.x, m.bonds);  // pre-cracks (notches) start broken
   m.contact = plan_contact(c, m.block_index, cutoff * (1.0 + kHorizonTolerance));
   m.indenters = c.indenters;
   m.nodes = std::move(nodes);
@@ -75,12 +77,12 @@ double stable_time_step(const Model& m) {
     for (std::int64_t k = m.bonds.offsets[static_cast<std::size_t>(i)]; k < m.bonds.offsets[static_cast<std::size_t>(i) + 1]; ++k) {
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
       const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
-      const auto kk = static_cast<std::size_t>(k);
-      sum += m.nodes.volume[j] * m.bonds.volume_factor[kk] * c / m.bonds.length[kk];
+      const double length = bond_length(m.nodes.x, static_cast<std::size_t>(i), j);
+      sum += m.nodes.volume[j] * m.bonds.volume_weight(length) * c / length;
       // With contact, a node pressed into a surface meets about as many contact partners as it has
       // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
       // 15c needs extra margin in impacts).
-      if (m.contact.pairs && m.bonds.length[kk] <= m.contact.distance)
+      if (m.contact.pairs && length <= m.contact.distance)
         sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
     }
     if (sum > 0.0) dt = std::min(dt, std::sqrt(2.0 * m.density[static_cast<std::size_t>(i)] / sum));

@@ -1,37 +1,29 @@
 // The partial-volume rules of validation.md F3 and their registry.
 #include "core/partial_volume.hpp"
 
-#include <algorithm>
-
 namespace pd {
 
-namespace {
-
-// Full volumes (FA): every neighbour within δ counts wholly.
-double full_volume(double, double, double) { return 1.0; }
-
-// LAMMPS peri/pmb: ν = (δ − |ξ|)/dx + ½ on [δ − dx/2, δ], else 1, so ν = ½ at |ξ| = δ
-// (validation.md F3/F5; LAMMPS pair_peri_pmb documentation).
-double lammps(double length, double horizon, double dx) {
-  if (length < horizon - 0.5 * dx) return 1.0;
-  return std::clamp((horizon - length) / dx + 0.5, 0.0, 1.0);
+// none: full volumes (FA), every neighbour within δ counts wholly.
+// lammps: LAMMPS peri/pmb, ν = (δ − |ξ|)/dx + ½ on [δ − dx/2, δ], else 1, so ν = ½ at |ξ| = δ
+//   (validation.md F3/F5; LAMMPS pair_peri_pmb documentation).
+// hhb: PA-HHB, the family is |ξ| − dx/2 ≤ δ; on the outer shell the weight is (δ − |ξ| + dx/2)/dx
+//   (validation.md F3), i.e. the part of the node's cell, of width dx, that lies inside δ.
+// lammps and hhb share ν = clamp((δ + dx/2 − |ξ|)/dx, 0, 1) and differ only in the family.
+VolumeWeight PartialVolumeRule::weight(double horizon, double dx) const {
+  VolumeWeight w;
+  if (shell_weight) {
+    w.outer = horizon + 0.5 * dx;
+    w.inv_dx = 1.0 / dx;
+  }
+  return w;
 }
-
-// PA-HHB: the family is |ξ| − dx/2 ≤ δ; on the outer shell the weight is (δ − |ξ| + dx/2)/dx
-// (validation.md F3), i.e. the part of the node's cell, of width dx, that lies inside δ.
-double hhb(double length, double horizon, double dx) {
-  if (length <= horizon - 0.5 * dx) return 1.0;
-  return std::clamp((horizon - length + 0.5 * dx) / dx, 0.0, 1.0);
-}
-
-}  // namespace
 
 const Registry<PartialVolumeRule>& partial_volume_registry() {
   static const Registry<PartialVolumeRule> registry = [] {
     Registry<PartialVolumeRule> r("partial_volume rule");
-    r.add("none", {0.0, &full_volume});
-    r.add("lammps", {0.0, &lammps});
-    r.add("hhb", {0.5, &hhb});
+    r.add("none", {0.0, false});
+    r.add("lammps", {0.0, true});
+    r.add("hhb", {0.5, true});
     return r;
   }();
   return registry;
@@ -42,9 +34,7 @@ double bond_cutoff(const PartialVolumeRule& rule, double horizon, double dx) {
 }
 
 void apply_partial_volume(const PartialVolumeRule& rule, double horizon, double dx, BondList& bonds) {
-  bonds.volume_factor.resize(bonds.length.size());
-  for (std::size_t k = 0; k < bonds.length.size(); ++k)
-    bonds.volume_factor[k] = rule.factor(bonds.length[k], horizon, dx);
+  bonds.volume_weight = rule.weight(horizon, dx);
 }
 
 }  // namespace pd

@@ -67,14 +67,17 @@ void apply_symmetric_operator(const Model& m, const std::array<double, 3>& perio
       const auto ku = static_cast<std::size_t>(k);
       if (m.bonds.broken[ku]) continue;
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
-      const double len = m.bonds.length[ku];
-      const double e0 = wrap(m.nodes.x[0][j] - m.nodes.x[0][i], period[0]) / len;
-      const double e1 = wrap(m.nodes.x[1][j] - m.nodes.x[1][i], period[1]) / len;
-      const double e2 = wrap(m.nodes.x[2][j] - m.nodes.x[2][i], period[2]) / len;
+      // |ξ| of the minimum image (core/bonds.hpp stores no lengths; without a period this is
+      // bitwise bond_length).
+      const double xi0 = wrap(m.nodes.x[0][j] - m.nodes.x[0][i], period[0]);
+      const double xi1 = wrap(m.nodes.x[1][j] - m.nodes.x[1][i], period[1]);
+      const double xi2 = wrap(m.nodes.x[2][j] - m.nodes.x[2][i], period[2]);
+      const double len = std::sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2);
+      const double e0 = xi0 / len, e1 = xi1 / len, e2 = xi2 / len;
       const double inv_sqrt_mj = 1.0 / std::sqrt(m.density[j] * m.nodes.volume[j]);
       // bond stiffness k_ij = c ν V_i V_j/|ξ| (force per unit relative displacement along e; ν the
-      // partial-volume factor of validation.md F3, 1 when the bond list carries none)
-      const double nu = m.bonds.volume_factor.empty() ? 1.0 : m.bonds.volume_factor[ku];
+      // partial-volume factor of validation.md F3, from |ξ|)
+      const double nu = m.bonds.volume_weight(len);
       const double kij = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] * nu *
                          m.nodes.volume[i] * m.nodes.volume[j] / len;
       const double d0 = x[0][i] * inv_sqrt_mi - x[0][j] * inv_sqrt_mj;

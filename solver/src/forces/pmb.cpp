@@ -10,9 +10,8 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
   PmbArrays a;
   a.offsets = m.bonds.offsets.data();
   a.neighbour = m.bonds.neighbour.data();
-  a.length = m.bonds.length.data();
   a.broken = m.bonds.broken.data();
-  a.volume_factor = m.bonds.volume_factor.data();
+  a.volume_weight = m.bonds.volume_weight;
   for (int d = 0; d < 3; ++d) {
     a.x[d] = m.nodes.x[static_cast<std::size_t>(d)].data();
     a.u[d] = u[static_cast<std::size_t>(d)].data();
@@ -27,78 +26,198 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
 
 namespace {
 
-// Stretch of bond k from node i: thesis eq. 1.9, zeroed near machine precision (thesis §2.2).
-// Also returns the current bond vector y_j − y_i and its length.
-inline double bond_stretch(const PmbArrays& a, std::int64_t i, std::int64_t k, double& e0, double& e1,
-                           double& e2, double& y) {
-  const std::int64_t j = a.neighbour[k];
-  e0 = (a.x[0][j] + a.u[0][j]) - (a.x[0][i] + a.u[0][i]);
-  e1 = (a.x[1][j] + a.u[1][j]) - (a.x[1][i] + a.u[1][i]);
-  e2 = (a.x[2][j] + a.u[2][j]) - (a.x[2][i] + a.u[2][i]);
-  y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-  const double s = (y - a.length[k]) / a.length[k];
-  return std::fabs(s) > kStretchZero ? s : 0.0;
+// What every pass needs of bond i→j: the reference length |ξ| (recomputed exactly as
+// build_bonds computed it), the current bond vector e = y_j − y_i, its length y, and the stretch
+// s = (y − |ξ|)/|ξ| (thesis eq. 1.9), zeroed near machine precision (thesis §2.2). Every pass
+// computes it this one way, so both copies of a bond (y_j − y_i is the exact negative of y_i − y_j)
+// and the force and breaking passes see bitwise the same stretch.
+struct BondTerms {
+  double e0, e1, e2, y, length, s, inv_y;  // inv_y = 1/y (1 for a bond crushed to a point, y = 0)
+};
+
+inline BondTerms bond_terms(const PmbArrays& a, const double xi[3], const double yi[3], std::int64_t j) {
+  BondTerms b;
+  const double d0 = a.x[0][j] - xi[0], d1 = a.x[1][j] - xi[1], d2 = a.x[2][j] - xi[2];
+  b.length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);  // core/bonds.hpp bond_length
+  b.e0 = (a.x[0][j] + a.u[0][j]) - yi[0];
+  b.e1 = (a.x[1][j] + a.u[1][j]) - yi[1];
+  b.e2 = (a.x[2][j] + a.u[2][j]) - yi[2];
+  b.y = std::sqrt(b.e0 * b.e0 + b.e1 * b.e1 + b.e2 * b.e2);
+  const double s = (b.y - b.length) / b.length;
+  b.s = std::fabs(s) > kStretchZero ? s : 0.0;
+  // A bond crushed to a point (y = 0) has e = 0 and no direction: 1/y is replaced by 1, so its
+  // force is 0, without a branch around the division.
+  b.inv_y = 1.0 / (b.y > 0.0 ? b.y : 1.0);
+  return b;
+}
+
+// A candidate for breaking: an intact bond stretched beyond s0 of its block pair. Bitwise &, so
+// that the force loop stays free of branches; no-fail ends are left to break_row (a byte gather
+// would keep the force loop from vectorising).
+inline bool over_critical(const PmbArrays& a, std::int64_t k, double s, double s0) {
+  return (a.broken[k] == 0) & (s > s0);
+}
+
+// The breaking criterion, in one place: a bond over its critical stretch breaks unless an end is in a
+// no-fail set. Breaks such bonds of row i: sets their flags (only row i's, so no other thread writes
+// them), sets br.lost[i], adds the number of bonds i < j broken now to once and returns the number
+// of row i's flags it set.
+std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i, std::int64_t& once) {
+  const double* c_row = a.c_pair + a.block[i] * a.blocks;
+  const double* s0_row = br.s0_pair + a.block[i] * a.blocks;
+  const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
+  const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
+  std::int64_t set = 0;
+  double lost = 0.0;
+  const std::int64_t end = br.no_fail[i] ? a.offsets[i] : a.offsets[i + 1];  // a no-fail node: nothing
+  for (std::int64_t k = a.offsets[i]; k < end; ++k) {
+    const std::int64_t j = a.neighbour[k];
+    const BondTerms b = bond_terms(a, xi, yi, j);
+    if (!over_critical(a, k, b.s, s0_row[a.block[j]]) || br.no_fail[j]) continue;
+    br.broken[k] = 1;
+    ++set;
+    if (i < j) {
+      ++once;
+      // ½ c s² |ξ| ν V_i V_j: the two ¼-shares that W_i and W_j held (validation.md C4).
+      lost += 0.5 * c_row[a.block[j]] * b.s * b.s * b.length * a.volume_weight(b.length) * a.volume[i] * a.volume[j];
+    }
+  }
+  if (br.lost) br.lost[i] = lost;
+  return set;
+}
+
+// Bonds per chunk of a row: the chunk's terms are computed by a loop the compiler vectorises
+// (no reduction in it), then summed in bond order by a short scalar loop.
+constexpr int kChunk = 64;
+
+// One binary for every x86-64 machine, each running the widest code it can: GCC compiles the row
+// twice, for baseline x86-64 (SSE2) and for x86-64-v3 (AVX2: hardware gathers, 4 lanes), and picks
+// one at load time. Both do the same IEEE operations in the same order (no FMA contraction, no
+// reassociation), so results are bitwise the same on any CPU — unlike -march=native, whose binary
+// may not run on the CI machine and whose FMAs would change the last bits (docs/performance.md).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define PD_KERNEL_CLONES __attribute__((target_clones("default", "arch=x86-64-v3")))
+#else
+#define PD_KERNEL_CLONES
+#endif
+
+struct RowSums {
+  double f0, f1, f2, w;    // Σ over the row of the force density components and of W_i's terms
+  std::int64_t over = 0;   // bonds over their critical stretch (kBreaking only)
+};
+
+// Row i of the kernel from the current flags; kBreaking also counts the bonds over their critical
+// stretch, kOneBlock skips the gathers of the far end's block. Compile-time switches, so that the
+// loop has no branch in it and vectorises in every variant.
+template <bool kBreaking, bool kOneBlock>
+PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
+  const double* c_row = a.c_pair + a.block[i] * a.blocks;
+  const double* s0_row = kBreaking ? s0_pair + a.block[i] * a.blocks : nullptr;
+  const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
+  const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
+  double sum0 = 0.0, sum1 = 0.0, sum2 = 0.0, energy = 0.0;
+  std::int64_t over = 0;
+  const std::int64_t end = a.offsets[i + 1];
+  for (std::int64_t k0 = a.offsets[i]; k0 < end; k0 += kChunk) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - k0));
+    double t0[kChunk], t1[kChunk], t2[kChunk], te[kChunk];
+    for (int q = 0; q < m; ++q) {
+      const std::int64_t k = k0 + q;
+      const std::int64_t j = a.neighbour[k];
+      const BondTerms b = bond_terms(a, xi, yi, j);
+      const std::int64_t bj = kOneBlock ? 0 : a.block[j];
+      if constexpr (kBreaking) over += over_critical(a, k, b.s, s0_row[bj]);
+      // Broken bonds are multiplied by 0 rather than skipped: no branch, so the loop vectorises.
+      const double intact = a.broken[k] == 0 ? 1.0 : 0.0;
+      const double c_vj = intact * c_row[bj] * a.volume[j] * a.volume_weight(b.length);
+      const double scale = c_vj * b.s * b.inv_y;  // c s ν V_j / y
+      t0[q] = scale * b.e0;
+      t1[q] = scale * b.e1;
+      t2[q] = scale * b.e2;
+      te[q] = 0.25 * c_vj * b.s * b.s * b.length;
+    }
+    for (int q = 0; q < m; ++q) {  // in bond order: the same sums for any thread count
+      sum0 += t0[q];
+      sum1 += t1[q];
+      sum2 += t2[q];
+      energy += te[q];
+    }
+  }
+  return RowSums{sum0, sum1, sum2, energy, over};
 }
 
 }  // namespace
 
-void add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w) {
-#pragma omp parallel for schedule(static)
+std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w,
+                                   const PmbBreaking* breaking) {
+  std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
+  const double* s0_pair = breaking ? breaking->s0_pair : nullptr;
+#pragma omp parallel for schedule(static) reduction(+ : newly)
   for (std::int64_t i = 0; i < a.nodes; ++i) {
-    const double* c_row = a.c_pair + a.block[i] * a.blocks;
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, energy = 0.0;
-    for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
-      double e0, e1, e2, y;
-      const double s = bond_stretch(a, i, k, e0, e1, e2, y);
-      const std::int64_t j = a.neighbour[k];
-      // Broken bonds are multiplied by 0 rather than skipped: no branch, so the loop vectorises.
-      // y > 0 always for an intact bond that has not been crushed to a point; a crushed bond
-      // (y = 0) would give 0/0, so it is guarded by the same select.
-      const double intact = a.broken[k] ? 0.0 : 1.0;
-      const double c_vj = intact * c_row[a.block[j]] * a.volume[j] * a.volume_factor[k];
-      const double scale = (y > 0.0) ? c_vj * s / y : 0.0;
-      energy += 0.25 * c_vj * s * s * a.length[k];
-      s0 += scale * e0;
-      s1 += scale * e1;
-      s2 += scale * e2;
+    const bool test_breaking = breaking != nullptr && breaking->no_fail[i] == 0;
+    RowSums r;
+    if (a.blocks == 1) r = test_breaking ? pmb_row<true, true>(a, i, s0_pair) : pmb_row<false, true>(a, i, s0_pair);
+    else r = test_breaking ? pmb_row<true, false>(a, i, s0_pair) : pmb_row<false, false>(a, i, s0_pair);
+    if (r.over > 0) {  // rare: near a crack tip or a no-fail set
+      // A bond that breaks now adds no force (it breaks before the force at this state, thesis
+      // §2.2 order): the row again, from the new flags, so the result is bitwise that of
+      // update_broken_bonds followed by the force.
+      if (break_row(a, *breaking, i, newly) > 0) r = pmb_row<false, false>(a, i, s0_pair);
+    } else if (breaking && breaking->lost) {
+      breaking->lost[i] = 0.0;
     }
-    f0[i] += s0;
-    f1[i] += s1;
-    f2[i] += s2;
-    if (w) w[i] = energy;
+    f0[i] += r.f0;
+    f1[i] += r.f1;
+    f2[i] += r.f2;
+    if (w) w[i] = r.w;
   }
+  return newly;
 }
 
 void PmbBondForce::AddMult(const Vec3Array& u, Vec3Array& f, double* energy_density) const {
   add_pmb_force_density(pmb_arrays(model_, u), f[0].data(), f[1].data(), f[2].data(), energy_density);
 }
 
-std::int64_t update_broken_bonds(Model& m, const Vec3Array& u) {
-  // Nothing can break when every block pair is unbreakable: skip the pass over the bonds.
-  if (std::all_of(m.material.critical_pair.begin(), m.material.critical_pair.end(),
-                  [](double s0) { return std::isinf(s0); }))
-    return 0;
+namespace {
+
+// Nothing can break when every block pair is unbreakable: then no pass looks at breaking at all.
+bool nothing_can_break(const Model& m) {
+  return std::all_of(m.material.critical_pair.begin(), m.material.critical_pair.end(),
+                     [](double s0) { return std::isinf(s0); });
+}
+
+PmbBreaking pmb_breaking(Model& m, double* lost) {
+  return PmbBreaking{m.bonds.broken.data(), m.material.critical_pair.data(), m.no_fail.data(), lost};
+}
+
+}  // namespace
+
+std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
+  if (nothing_can_break(m)) return 0;
   const PmbArrays a = pmb_arrays(m, u);
-  std::uint8_t* broken = m.bonds.broken.data();
-  const double* s0_pair = m.material.critical_pair.data();
-  const std::uint8_t* no_fail = m.no_fail.data();
+  // Energy of the bonds broken now, per node i (the i < j copy of each bond), summed serially below.
+  std::vector<double> lost(energy ? static_cast<std::size_t>(a.nodes) : 0, 0.0);
+  const PmbBreaking br = pmb_breaking(m, energy ? lost.data() : nullptr);
   std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
 #pragma omp parallel for schedule(static) reduction(+ : newly)
-  for (std::int64_t i = 0; i < a.nodes; ++i) {
-    if (no_fail[i]) continue;
-    const double* s0_row = s0_pair + a.block[i] * a.blocks;
-    for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
-      if (broken[k]) continue;
-      const std::int64_t j = a.neighbour[k];
-      if (no_fail[j]) continue;
-      double e0, e1, e2, y;
-      const double s = bond_stretch(a, i, k, e0, e1, e2, y);
-      if (s > s0_row[a.block[j]]) {
-        broken[k] = 1;
-        if (i < j) ++newly;
-      }
-    }
+  for (std::int64_t i = 0; i < a.nodes; ++i) break_row(a, br, i, newly);
+  if (energy && newly > 0)
+    for (double e : lost) *energy += e;
+  return newly;
+}
+
+std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Array& f, double* energy_density,
+                                           double* broken_energy) {
+  const PmbArrays a = pmb_arrays(m, u);
+  if (nothing_can_break(m)) {
+    add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density);
+    return 0;
   }
+  std::vector<double> lost(broken_energy ? static_cast<std::size_t>(a.nodes) : 0, 0.0);
+  const PmbBreaking br = pmb_breaking(m, broken_energy ? lost.data() : nullptr);
+  const std::int64_t newly = add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br);
+  if (broken_energy && newly > 0)
+    for (double e : lost) *broken_energy += e;  // serially in node order, as update_broken_bonds
   return newly;
 }
 
@@ -108,15 +227,16 @@ std::vector<double> strain_energy_density(const Model& m, const Vec3Array& u) {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < a.nodes; ++i) {
     const double* c_row = a.c_pair + a.block[i] * a.blocks;
+    const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
+    const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
     double sum = 0.0;
     for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
       if (a.broken[k]) continue;
-      double e0, e1, e2, y;
-      const double s = bond_stretch(a, i, k, e0, e1, e2, y);
       const std::int64_t j = a.neighbour[k];
+      const BondTerms b = bond_terms(a, xi, yi, j);
       // ¼ c s² |ξ| V_j: each bond is visited from both ends, so each end takes half of the
       // bond's ½ c s² |ξ| V_i V_j (validation.md C4).
-      sum += 0.25 * c_row[a.block[j]] * s * s * a.length[k] * a.volume[j] * a.volume_factor[k];
+      sum += 0.25 * c_row[a.block[j]] * b.s * b.s * b.length * a.volume[j] * a.volume_weight(b.length);
     }
     w[static_cast<std::size_t>(i)] = sum;
   }

@@ -19,10 +19,9 @@ constexpr double kStretchZero = 4.0 * DBL_EPSILON;
 struct PmbArrays {
   const std::int64_t* offsets;
   const std::int32_t* neighbour;
-  const double* length;        // |ξ|
   const std::uint8_t* broken;
-  const double* volume_factor; // ν per bond (validation.md F3; 1 for full volumes)
-  const double* x[3];          // reference positions
+  VolumeWeight volume_weight;  // ν(|ξ|) (validation.md F3; 1 for full volumes)
+  const double* x[3];          // reference positions; |ξ| is recomputed from them (core/bonds.hpp)
   const double* u[3];          // displacements
   const double* volume;
   const std::int32_t* block;   // block index (0-based) per node
@@ -33,13 +32,29 @@ struct PmbArrays {
 
 PmbArrays pmb_arrays(const Model& model, const Vec3Array& u);
 
+// Bond breaking fused into the force pass (see add_pmb_force_density).
+struct PmbBreaking {
+  std::uint8_t* broken;         // the model's flags: the same array as PmbArrays::broken
+  const double* s0_pair;        // critical stretch per block pair (+inf: unbreakable)
+  const std::uint8_t* no_fail;  // per node: 1 if its bonds never break
+  double* lost;                 // per node, or null: i's share of the energy of bonds broken now [J]
+};
+
 // f_i += Σ_j c·s·(y_j − y_i)/|y_j − y_i|·ν_j·V_j over intact bonds, s = (|ξ+η| − |ξ|)/|ξ|
 // (thesis eqs. 1.9, 1.10, 2.1). Each node writes only its own f_i: parallel over nodes,
 // schedule static, bitwise the same for any thread count. Accumulates; never clears f.
 // If w is not null, also stores the strain-energy density W_i = Σ_j ¼ c s² |ξ| ν_j V_j of every node
 // (validation.md C4; overwritten, not accumulated): a few flops per bond, so the energy needs no
 // second pass over the bonds.
-void add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w = nullptr);
+// If breaking is not null, every intact bond whose stretch exceeds s0 of its block pair (and with
+// no end in a no-fail set) first breaks for good, as update_broken_bonds would break it on the same
+// u, and then adds no force: breaking costs no second sweep over the bonds. lost[i] is set to the
+// energy ½ c s² |ξ| ν V_i V_j of the bonds i < j broken now (0 if none). Returns the number of
+// bonds broken now, each counted once (0 without breaking).
+// Bonds are summed in row order in fixed-size chunks, so the sums are the same for any thread
+// count and any vector width the compiler picks (docs/performance.md).
+std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w = nullptr,
+                                   const PmbBreaking* breaking = nullptr);
 
 // The force term as a small class with one verb (MFEM's AddMult).
 class PmbBondForce {
@@ -55,8 +70,16 @@ class PmbBondForce {
 // good, unless an end is in a no-fail set. The stretch is computed from y_j − y_i, which is the
 // exact negative of y_i − y_j in IEEE arithmetic, so both stored copies of a bond see bitwise the
 // same stretch and break in the same call: symmetric and deterministic without a reverse index.
-// Returns the number of bonds broken now, each counted once.
-std::int64_t update_broken_bonds(Model& model, const Vec3Array& u);
+// Returns the number of bonds broken now, each counted once. If energy is not null, adds to it the
+// energy the broken bonds held at the moment they broke, Σ ½ c s² |ξ| ν V_i V_j over the bonds
+// broken now (each once; the strain energy loses exactly this, validation.md C4 with breaking),
+// summed per node and then serially, so the value does not depend on the thread count.
+std::int64_t update_broken_bonds(Model& model, const Vec3Array& u, double* energy = nullptr);
+
+// update_broken_bonds followed by PmbBondForce::AddMult, in one sweep over the bonds (the path the
+// integrators take after each state update; bitwise the same flags, forces, W and energy).
+std::int64_t break_bonds_and_add_pmb_force(Model& model, const Vec3Array& u, Vec3Array& f,
+                                           double* energy_density = nullptr, double* broken_energy = nullptr);
 
 // U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
 // summed serially in node order, so the value does not depend on the thread count.

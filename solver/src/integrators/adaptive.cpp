@@ -67,7 +67,7 @@ void AdaptiveStep::update(const State& s, const Vec3Array& f_imp, double t, doub
     for (std::int64_t i = 0; i < n; ++i) {
       if (fx[i]) continue;
       v[i] = (keep * v0[i] + dt * (phi * f1[i] + (1.0 - phi) * f0[i]) / rho[i]) * divide;
-      u[i] = u0[i] + dt * v[i];
+      u[i] = u0[i] + dt * ((1.0 - phi) * v0[i] + phi * v[i]);  // the same θ-weight φ as v
     }
   }
   // Prescribed components follow their tables exactly as in Verlet (the same at every iterate).
@@ -156,8 +156,7 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
       std::swap(state.u, u_new_);
       std::swap(state.v, v_new_);
       // Bonds break on the accepted state only, then the force there for the next step.
-      report_.broken_now = update_broken_bonds(model_, state.u);
-      evaluate_forces(model_, state, t1);
+      break_bonds_and_evaluate_forces(model_, state, t1, report_);
       ++report_.force_evaluations;
       update_work(model_, state, t1, h);
       t = t1;

@@ -1,13 +1,17 @@
 // The mixed explicit–implicit adaptive step of thesis §2.2 (Zohdi's staggered fixed-point
 // iteration with step-size control, eqs. 2.6–2.8; validation.md §3).
 //
-// The step n → n+1 solves, by fixed-point iteration K = 1, 2, …,
+// The step n → n+1 is the θ-method with θ = φ on (u, v), solved by fixed-point iteration K = 1, 2, …:
 //   v^{n+1,K} = v^n + Δt/ρ·[φ f(u^{n+1,K−1}) + (1−φ) f(u^n)]        (damping: see below)
-//   u^{n+1,K} = u^n + Δt·v^{n+1,K} = u^n + Δt v^n + Δt²/ρ·[φ f(u^{n+1,K−1}) + (1−φ) f(u^n)]
-// which is Newmark's method with β = γ = φ: φ = 1 is the thesis form (backward Euler on (u, v):
-// first order, numerically dissipative), φ = ½ is second order and conserves the energy of a
-// linear system; both are unconditionally stable once the iteration has converged. The iteration
-// itself contracts only while φ·Δt²·ω_max² < 1 (validation.md §3), which the controller finds.
+//   u^{n+1,K} = u^n + Δt·[(1−φ) v^n + φ v^{n+1,K}]
+// φ = 1 gives u^{n+1} = u^n + Δt v^n + Δt²/ρ·f(u^{n+1}), the thesis's update (§2.2): backward Euler
+// on (u, v), first order and numerically dissipative. φ = ½ is the trapezoidal rule (Newmark
+// β = ¼, γ = ½): second order, and it conserves the energy of a linear system. (Weighting only the
+// force by φ while keeping the thesis's Δt² in u would be first order in u for every φ: its Taylor
+// coefficient of the acceleration must be ½, and it is 1.) In Newmark terms β = φ², γ = φ, so every
+// φ in [½, 1] is unconditionally stable once the iteration has converged. The iteration contracts
+// only while φ²·Δt²·ω_max² < 1 (validation.md §3): Δt < Δt_exact/(2φ), where Δt_exact = 2/ω_max is
+// the Verlet limit; the controller finds this by itself.
 //
 // Error and control (eqs. 2.6–2.8): ω_K = Σ_i‖u_i^{K} − u_i^{K−1}‖ / Σ_i‖u_i^{K} − u_i^n‖, Z_K = ω_K/TOL,
 // Φ_K = (TOL/ω_0)^{1/(p K_d)} / (ω_K/ω_0)^{1/(p K)}. Z_K ≤ 1 at any K ≤ K_d accepts the step and
@@ -18,7 +22,7 @@
 // u^{n+1,0} = u^n + Δt v^n + Δt² f(u^n)/ρ, which costs no force evaluation (f(u^n) is known), and
 // ω_0 = 1 is the normalised size of that zeroth increment measured against itself. Then
 // ω_K ≈ (S Δt^p)^K·ω_0 holds from K = 1 on (each iteration multiplies the correction by about
-// φΔt²ω²), which is the model eq. 2.8 is derived from, and a smooth motion can be accepted after
+// φ²Δt²ω²), which is the model eq. 2.8 is derived from, and a smooth motion can be accepted after
 // a single iteration.
 //
 // Additions to the thesis rules, each for a case it does not cover:
@@ -34,7 +38,7 @@
 // a step costs K + 1 force evaluations, plus K per rejected attempt.
 //
 // Damping −ρ α v enters the velocity with the same weight φ, solved per node in closed form:
-//   (1 + φαΔt) v^{n+1} = (1 − (1−φ)αΔt) v^n + Δt/ρ·[φ f^{n+1} + (1−φ) f^n].
+//   (1 + φαΔt) v^{n+1} = (1 − (1−φ)αΔt) v^n + Δt/ρ·[φ f^{n+1} + (1−φ) f^n] (Crank–Nicolson at φ = ½).
 #pragma once
 #include "integrators/integrator.hpp"
 

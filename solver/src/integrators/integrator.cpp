@@ -8,6 +8,7 @@
 #include "forces/damping.hpp"
 #include "forces/indenter.hpp"
 #include "forces/pmb.hpp"
+#include "integrators/adaptive.hpp"
 #include "integrators/verlet.hpp"
 
 namespace pd {
@@ -16,19 +17,36 @@ const Registry<IntegratorFactory>& integrator_registry() {
   static const Registry<IntegratorFactory> registry = [] {
     Registry<IntegratorFactory> r("integrator");
     r.add("verlet", [](Model& m) -> std::unique_ptr<Integrator> { return std::make_unique<VelocityVerlet>(m); });
+    r.add("adaptive", [](Model& m) -> std::unique_ptr<Integrator> { return std::make_unique<AdaptiveStep>(m); });
     return r;
   }();
   return registry;
 }
 
-void evaluate_forces(const Model& model, State& state, double t) {
-  for (auto& fc : state.f) std::fill(fc.begin(), fc.end(), 0.0);
-  PmbBondForce(model).AddMult(state.u, state.f, state.w.data());
+namespace {
+
+// Every force term after the bonds, added into f that already holds the bond forces.
+void add_non_bond_forces(const Model& model, State& state, double t) {
   state.contact_energy = 0.0;
   if (model.contact.pairs) state.contact_energy += ShortRangeForce(model).AddMult(state.u, state.f);
   if (!model.indenters.empty())
     state.contact_energy += IndenterForce(model).AddMult(t, state.u, state.f, state.indenter_force);
   BodyForceTerm(model).AddMult(t, state.f);
+}
+
+}  // namespace
+
+void evaluate_forces(const Model& model, State& state, double t) {
+  for (auto& fc : state.f) std::fill(fc.begin(), fc.end(), 0.0);
+  PmbBondForce(model).AddMult(state.u, state.f, state.w.data());
+  add_non_bond_forces(model, state, t);
+}
+
+void break_bonds_and_evaluate_forces(Model& model, State& state, double t, StepReport& report) {
+  for (auto& fc : state.f) std::fill(fc.begin(), fc.end(), 0.0);
+  report.broken_now +=
+      break_bonds_and_add_pmb_force(model, state.u, state.f, state.w.data(), &report.broken_energy_now);
+  add_non_bond_forces(model, state, t);
 }
 
 void impose_prescribed_motion(const Model& model, State& state, double t) {

@@ -1,6 +1,6 @@
 // The integrator contract (MFEM's ODESolver::Step): step(state, t, dt) advances the state from t;
 // on return t is the new time and dt the step actually taken, which a step-size controller
-// (the adaptive Zohdi scheme, a later issue) may have changed. Plus the force evaluation and
+// (the adaptive Zohdi scheme, integrators/adaptive.hpp) may have changed. Plus the force evaluation and
 // energy bookkeeping every integrator shares.
 #pragma once
 #include <memory>
@@ -18,6 +18,7 @@ struct StepReport {
   int iterations = 1;         // fixed-point iterations K of the accepted step (1 for Verlet)
   int rejected = 0;           // rejected attempts before acceptance (0 for Verlet)
   std::int64_t broken_now = 0;  // bonds broken during the step, each counted once
+  double broken_energy_now = 0.0;  // energy those bonds held when they broke [J] (forces/pmb.hpp)
   int force_evaluations = 1;  // evaluate_forces calls of the step, rejected attempts included
   double next_dt = 0.0;       // the step the integrator proposes next [s]; 0: no proposal (fixed dt)
 };
@@ -50,6 +51,12 @@ const Registry<IntegratorFactory>& integrator_registry();
 // every force term the scene needs adds into it; also sets state.w, state.contact_energy and
 // state.indenter_force. The one force path every integrator calls.
 void evaluate_forces(const Model& model, State& state, double t);
+
+// update_broken_bonds (bonds break after the state update, before the force at the new state)
+// followed by evaluate_forces, with the breaking done inside the bond-force sweep: one pass over
+// the bonds instead of two (docs/performance.md), bitwise the same result. Adds the bonds broken
+// now and their energy to report.broken_now and report.broken_energy_now.
+void break_bonds_and_evaluate_forces(Model& model, State& state, double t, StepReport& report);
 
 // Imposes the prescribed displacement / velocity at t (used at the start of a run).
 void impose_prescribed_motion(const Model& model, State& state, double t);

@@ -55,8 +55,7 @@ void VelocityVerlet::step(State& state, double& t, double& dt) {
 
   // Bonds break after the state update, before the force at t^{n+1} is evaluated.
   report_ = StepReport{};
-  report_.broken_now = update_broken_bonds(model_, state.u);
-  evaluate_forces(model_, state, t1);
+  break_bonds_and_evaluate_forces(model_, state, t1, report_);
 
   for (std::size_t d = 0; d < 3; ++d) {
     double* v = state.v[d].data();

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/partial_volume.hpp"
@@ -216,6 +217,19 @@ std::array<double, 3> read_direction(const Checker& ck, const json& j, const std
   return v;
 }
 
+// A pre-crack segment (core/cracks.hpp): two distinct points.
+CrackSegment read_crack(const Checker& ck, const json& j, std::size_t k) {
+  const std::string where = "cracks[" + std::to_string(k) + "]";
+  ck.object(j, where);
+  ck.known_keys(j, where, {"from", "to"});
+  CrackSegment crack;
+  crack.from = read_vector(ck, ck.required(j, "from", where + ".from"), where + ".from");
+  crack.to = read_vector(ck, ck.required(j, "to", where + ".to"), where + ".to");
+  if (crack.from[0] == crack.to[0] && crack.from[1] == crack.to[1])
+    ck.fail(where, "from and to are the same point in the xy plane");
+  return crack;
+}
+
 IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "indenters[" + std::to_string(k) + "]";
   ck.object(j, where);
@@ -244,6 +258,34 @@ IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) 
   return ind;
 }
 
+// The adaptive section (integrators/adaptive.hpp): every value in the range the scheme needs.
+AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
+  ck.object(j, "adaptive");
+  ck.known_keys(j, "adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"});
+  AdaptiveSettings a;
+  if (const json* v = ck.optional(j, "tol")) {
+    a.tol = ck.positive(*v, "adaptive.tol");
+    if (!(a.tol < 1.0)) ck.fail("adaptive.tol", "must be below 1 (a relative error), got " + show(*v));
+  }
+  if (const json* v = ck.optional(j, "kd")) a.kd = static_cast<int>(ck.integer(*v, "adaptive.kd", 1, 1000));
+  if (const json* v = ck.optional(j, "p")) a.p = ck.positive(*v, "adaptive.p");
+  if (const json* v = ck.optional(j, "phi")) {
+    a.phi = ck.number(*v, "adaptive.phi");
+    // Newmark with β = γ = φ is unconditionally stable only for φ ≥ ½.
+    if (a.phi < 0.5 || a.phi > 1.0) ck.fail("adaptive.phi", "must be between 0.5 and 1, got " + show(*v));
+  }
+  for (auto [name, slot] : {std::pair{"dt_initial", &a.dt_initial}, std::pair{"dt_min", &a.dt_min},
+                            std::pair{"dt_max", &a.dt_max}})
+    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("adaptive.") + name);
+  if (a.dt_min && a.dt_max && *a.dt_min > *a.dt_max)
+    ck.fail("adaptive.dt_min", "is larger than adaptive.dt_max");
+  if (a.dt_initial && a.dt_max && *a.dt_initial > *a.dt_max)
+    ck.fail("adaptive.dt_initial", "is larger than adaptive.dt_max");
+  if (a.dt_initial && a.dt_min && *a.dt_initial < *a.dt_min)
+    ck.fail("adaptive.dt_initial", "is smaller than adaptive.dt_min");
+  return a;
+}
+
 }  // namespace
 
 Case parse_case(const std::string& text, const std::filesystem::path& path) {
@@ -259,7 +301,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   ck.known_keys(root, "", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension",
                            "analysis", "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets",
                            "node_sets", "boundary_conditions", "initial_conditions", "damping", "time",
-                           "adaptive", "output", "figures", "partial_volume", "contact", "indenters"});
+                           "adaptive", "output", "figures", "partial_volume", "contact", "indenters", "cracks"});
   Case c;
   c.file = path;
   const std::int64_t version = ck.integer(ck.required(root, "format_version", "format_version"), "format_version", 0, 1 << 30);
@@ -308,6 +350,8 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(root, "initial_conditions"))
     for (std::size_t k = 0; k < ck.array(*j, "initial_conditions").size(); ++k)
       c.initial_conditions.push_back(read_initial(ck, (*j)[k], k));
+  if (const json* j = ck.optional(root, "cracks"))
+    for (std::size_t k = 0; k < ck.array(*j, "cracks").size(); ++k) c.cracks.push_back(read_crack(ck, (*j)[k], k));
   if (const json* j = ck.optional(root, "damping")) c.damping = ck.non_negative(*j, "damping");
   if (const json* j = ck.optional(root, "contact"); j && !j->is_null()) c.contact = read_contact(ck, *j);
   if (const json* j = ck.optional(root, "indenters"))
@@ -329,11 +373,9 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(time, "dt")) {
     if (j->is_string()) {
       const std::string rule = j->get<std::string>();
-      if (rule == "exact")
-        ck.fail("time.dt", "\"exact\" (largest eigenvalue of the linearised operator) is not implemented yet; "
-                           "use \"stable\" or a number of seconds");
-      if (rule != "stable") ck.fail("time.dt", "unknown rule '" + rule + "'; known: stable, exact, or a number [s]");
-      c.time.dt_rule = "stable";
+      if (rule != "stable" && rule != "exact")
+        ck.fail("time.dt", "unknown rule '" + rule + "'; known: stable, exact, or a number [s]");
+      c.time.dt_rule = rule;
     } else {
       c.time.dt_rule = "fixed";
       c.time.dt_value = ck.positive(*j, "time.dt");
@@ -343,11 +385,11 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(time, "max_steps"))
     c.time.max_steps = ck.integer(*j, "time.max_steps", 1, std::numeric_limits<std::int64_t>::max());
 
-  if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) ck.object(*j, "adaptive");  // a later issue
+  if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) c.adaptive = read_adaptive(ck, *j);
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 
   const json& output = ck.object(ck.required(root, "output", "output"), "output");
-  ck.known_keys(output, "output", {"every_time", "every_steps", "history_every"});
+  ck.known_keys(output, "output", {"every_time", "every_steps", "history_every", "reactions"});
   if (const json* j = ck.optional(output, "every_time"); j && !j->is_null())
     c.output.every_time = ck.positive(*j, "output.every_time");
   if (const json* j = ck.optional(output, "every_steps"); j && !j->is_null())
@@ -356,6 +398,12 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
     ck.fail("output", "exactly one of every_time and every_steps must be set (not null)");
   if (const json* j = ck.optional(output, "history_every"))
     c.output.history_every = ck.integer(*j, "output.history_every", 1, std::numeric_limits<std::int64_t>::max());
+  if (const json* j = ck.optional(output, "reactions")) {
+    c.output.reactions = ck.strings(*j, "output.reactions");
+    for (const auto& name : c.output.reactions)
+      if (std::find(c.node_sets.begin(), c.node_sets.end(), name) == c.node_sets.end())
+        ck.fail("output.reactions", "'" + name + "' is not in node_sets");
+  }
   return c;
 }
 

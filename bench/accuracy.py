@@ -1,0 +1,210 @@
+"""Run time against error (make bench-accuracy): Verlet at several safety factors of eq. 2.5 and at
+the exact limit, and the adaptive step of thesis §2.2 over a sweep of TOL for φ = 1 and φ = ½, on an
+elastic wave in a strip and on a plate with a hole pulled to fracture; each against a Verlet run at
+1/16 of the stable step (validation.md §4). A benchmark, not a test: it asserts nothing.
+
+Writes out/bench/accuracy.csv (a row per run) and out/bench/accuracy.png (log-log error against
+wall time and against force evaluations).
+
+    /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 2] [--quick]
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from postprocess.series import read_frame, read_series  # noqa: E402
+from preprocess.cloud import NodeCloud  # noqa: E402
+from preprocess.node_file import write_node_file  # noqa: E402
+
+DX = 1.0e-3
+
+
+def strip_problem(directory: str) -> dict:
+    """An elastic wave: a 120 × 6 strip, the left grip moved by a smooth velocity pulse (a Hann
+    pulse as an 11-point table), the wave runs along the strip; 11 frames over 20 µs."""
+    nx, ny = 120, 6
+    x, y = np.meshgrid(np.arange(nx) * DX, np.arange(ny) * DX, indexing="xy")
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    grip = points[:, 0] < 2.5 * DX
+    cloud = NodeCloud(points=points, volume=np.full(len(points), DX * DX * 1e-3), block=np.ones(len(points), np.int32),
+                      sets={"grip": grip}, grid_spacing=DX, dimension=2)
+    write_node_file(os.path.join(directory, "nodes.vtu"), cloud)
+    times = np.linspace(0.0, 8e-6, 11)
+    pulse = 2.0 * np.sin(np.pi * times / 8e-6) ** 2  # m/s
+    return {
+        "dimension": 2, "analysis": "plane_stress", "thickness": 1e-3, "grid_spacing": DX, "horizon": 3.015 * DX,
+        "blocks": [{"id": 1, "name": "glass", "model": "pmb", "density": 2440.0, "youngs_modulus": 7.2e10,
+                    "fracture_energy": None}],
+        "node_sets": ["grip"],
+        "boundary_conditions": [{"set": "grip", "kind": "velocity", "component": 0, "times": times.tolist(),
+                                 "values": pulse.tolist()}],
+        "end": 2e-5, "every_time": 2e-6, "measure": "displacement",
+    }
+
+
+def hole_problem(directory: str) -> dict:
+    """Fracture: an 80 × 40 plate with a hole of radius 6 dx, both ends pulled apart fast enough that
+    cracks start at the hole within the run; the error is measured on the final damage field."""
+    nx, ny = 80, 40
+    x, y = np.meshgrid(np.arange(nx) * DX, np.arange(ny) * DX, indexing="xy")
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    centre = np.array([(nx - 1) * DX / 2, (ny - 1) * DX / 2])
+    keep = np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]) > 6 * DX
+    points = points[keep]
+    left, right = points[:, 0] < 2.5 * DX, points[:, 0] > (nx - 3.5) * DX
+    cloud = NodeCloud(points=points, volume=np.full(len(points), DX * DX * 1e-3), block=np.ones(len(points), np.int32),
+                      sets={"left": left, "right": right}, grid_spacing=DX, dimension=2)
+    write_node_file(os.path.join(directory, "nodes.vtu"), cloud)
+    ramp = [0.0, 5e-6]
+    return {
+        "dimension": 2, "analysis": "plane_stress", "thickness": 1e-3, "grid_spacing": DX, "horizon": 3.015 * DX,
+        "blocks": [{"id": 1, "name": "pmma", "model": "pmb", "density": 1190.0, "youngs_modulus": 3.2e9,
+                    "fracture_energy": 300.0}],
+        "node_sets": ["left", "right"], "no_fail_sets": ["left", "right"],
+        "boundary_conditions": [
+            {"set": "left", "kind": "velocity", "component": 0, "times": ramp, "values": [0.0, -15.0]},
+            {"set": "right", "kind": "velocity", "component": 0, "times": ramp, "values": [0.0, 15.0]}],
+        "end": 6e-5, "every_time": 6e-5, "measure": "damage",
+    }
+
+
+def write_case(directory: str, problem: dict, name: str, time: dict, adaptive: dict | None) -> str:
+    run_dir = os.path.join(directory, name)
+    os.makedirs(run_dir, exist_ok=True)
+    case = {key: problem[key] for key in ("dimension", "analysis", "thickness", "grid_spacing", "horizon", "blocks",
+                                          "node_sets", "boundary_conditions")}
+    case.update({"format_version": 1, "case": name, "nodes_file": "../nodes.vtu", "output_dir": ".",
+                 "no_fail_sets": problem.get("no_fail_sets", []), "initial_conditions": [], "damping": 0.0,
+                 "time": dict(time, end=problem["end"], max_steps=10_000_000),
+                 "output": {"every_time": problem["every_time"], "every_steps": None,
+                            "history_every": 1_000_000}})
+    if adaptive:
+        case["adaptive"] = adaptive
+    path = os.path.join(run_dir, "case.json")
+    with open(path, "w", encoding="utf-8") as stream:
+        json.dump(case, stream, indent=1)
+    return path
+
+
+def run(solver: str, case_path: str, threads: int) -> dict:
+    result = subprocess.run([solver, case_path, "--threads", str(threads), "--quiet"], capture_output=True, text=True)
+    log = open(os.path.join(os.path.dirname(case_path), "run.log"), encoding="utf-8").read()
+    done = re.search(r"(\d+) steps to t = \S+ s in ([0-9.]+) s wall.*?(\d+) force evaluations", log)
+    if result.returncode != 0 or not done:
+        return {"status": f"failed ({result.returncode})", "steps": 0, "wall": float("nan"), "evaluations": 0}
+    return {"status": "ok", "steps": int(done.group(1)), "wall": float(done.group(2)),
+            "evaluations": int(done.group(3))}
+
+
+def fields(run_dir: str, measure: str) -> list[np.ndarray]:
+    frames = read_series(os.path.join(run_dir, "frames.pvd"))
+    out = []
+    for _time, path in frames:
+        frame = read_frame(os.path.join(run_dir, path))
+        out.append(frame.displacement if measure == "displacement" else frame.damage)
+    return out if measure == "displacement" else out[-1:]
+
+
+def error(run_dir: str, reference: list[np.ndarray], measure: str) -> float:
+    """Relative L2 over the saved times (displacement) or of the final field (damage)."""
+    got = fields(run_dir, measure)
+    if len(got) != len(reference):
+        return float("nan")
+    num = sum(float(np.sum((a - b) ** 2)) for a, b in zip(got, reference))
+    den = sum(float(np.sum(b ** 2)) for b in reference)
+    return (num / den) ** 0.5
+
+
+def schemes(quick: bool):
+    """(scheme, parameter, time section, adaptive section) of every run."""
+    factors = [1.0, 0.8, 0.5, 0.25] if quick else [1.0, 0.9, 0.8, 0.5, 0.25, 0.125]
+    for f in factors:
+        yield "verlet-eq2.5", f, {"integrator": "verlet", "dt": "stable", "safety_factor": f}, None
+    for f in [0.95] if quick else [0.95, 0.5]:
+        yield "verlet-exact", f, {"integrator": "verlet", "dt": "exact", "safety_factor": f}, None
+    tols = [1e-2, 1e-4] if quick else [1e-2, 1e-3, 1e-4, 1e-5]
+    for phi in (1.0, 0.5):
+        for tol in tols:
+            yield (f"adaptive-phi{phi:g}", tol, {"integrator": "adaptive", "dt": "stable", "safety_factor": 0.8},
+                   {"tol": tol, "kd": 20, "p": 3.0, "phi": phi, "dt_initial": None, "dt_min": None, "dt_max": None})
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"))
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
+    parser.add_argument("--quick", action="store_true", help="fewer runs (a smoke test of the benchmark)")
+    args = parser.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    rows = []
+    for problem_name, make in (("wave", strip_problem), ("fracture", hole_problem)):
+        directory = os.path.join(args.out, problem_name)
+        os.makedirs(directory, exist_ok=True)
+        problem = make(directory)
+        # Reference: Verlet at 1/16 of 0.8 × eq. 2.5 (validation.md §4).
+        ref_case = write_case(directory, problem, "reference",
+                              {"integrator": "verlet", "dt": "stable", "safety_factor": 0.05}, None)
+        ref = run(args.solver, ref_case, args.threads)
+        reference = fields(os.path.dirname(ref_case), problem["measure"])
+        print(f"{problem_name}: reference {ref['steps']} steps, {ref['wall']:.2f} s", flush=True)
+        for scheme, parameter, time, adaptive in schemes(args.quick):
+            name = f"{scheme}-{parameter:g}"
+            case_path = write_case(directory, problem, name, time, adaptive)
+            r = run(args.solver, case_path, args.threads)
+            e = error(os.path.dirname(case_path), reference, problem["measure"]) if r["status"] == "ok" else float("nan")
+            rows.append({"problem": problem_name, "scheme": scheme, "parameter": parameter, "wall_time": r["wall"],
+                         "force_evaluations": r["evaluations"], "steps": r["steps"], "error": e,
+                         "status": r["status"]})
+            print(f"  {name:24s} {r['status']:6s} steps {r['steps']:7d}  evals {r['evaluations']:8d}  "
+                  f"wall {r['wall']:8.3f} s  error {e:.3g}", flush=True)
+    with open(os.path.join(args.out, "accuracy.csv"), "w", newline="", encoding="utf-8") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    plot(rows, os.path.join(args.out, "accuracy.png"), args.threads)
+    print(f"wrote {args.out}/accuracy.csv and accuracy.png ({platform.node()}, {os.cpu_count()} cores, "
+          f"{args.threads} threads)")
+    return 0
+
+
+def plot(rows: list[dict], path: str, threads: int):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    problems = sorted({r["problem"] for r in rows}, reverse=True)
+    fig, axes = plt.subplots(len(problems), 2, figsize=(11, 4.2 * len(problems)), squeeze=False)
+    for row_axes, problem in zip(axes, problems):
+        for ax, xkey, xlabel in zip(row_axes, ("wall_time", "force_evaluations"),
+                                    (f"solver wall time [s] ({threads} threads)", "force evaluations")):
+            for scheme in sorted({r["scheme"] for r in rows}):
+                pts = sorted((r[xkey], r["error"], r["parameter"]) for r in rows
+                             if r["problem"] == problem and r["scheme"] == scheme and r["status"] == "ok"
+                             and r["error"] > 0)
+                if pts:
+                    ax.loglog([p[0] for p in pts], [p[1] for p in pts], marker="o", label=scheme)
+                    for p in pts:
+                        ax.annotate(f"{p[2]:g}", (p[0], p[1]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel("relative L2 error of " + ("displacement" if problem == "wave" else "final damage"))
+            ax.set_title(f"{problem}: error against {xlabel.split(' [')[0]}")
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,83 @@
+"""reaction_force.png: the reaction force of each node set listed in `output.reactions` (history.csv
+columns reaction_<set>_fx, _fy, _fz of pipeline/formats.md §4) against the displacement that the
+set's boundary condition prescribes: the force–displacement curve of a tensile test."""
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+
+from .casefile import CaseSettings
+from .plotting import new_figure, save_figure
+
+COLUMN = re.compile(r"^reaction_([A-Za-z_][A-Za-z0-9_]*)_f([xyz])$")
+
+
+def reaction_sets(history: dict) -> list[str]:
+    """Node sets that have all three reaction columns, in column order."""
+    found: dict[str, set] = {}
+    for column in history:
+        match = COLUMN.match(column)
+        if match:
+            found.setdefault(match.group(1), set()).add(match.group(2))
+    return [name for name, axes in found.items() if axes == {"x", "y", "z"}]
+
+
+def _table_value(times, values, t):
+    """The piecewise-linear table of formats.md §3, held constant outside, at times t."""
+    return np.interp(t, times, values) if len(times) > 1 else np.full_like(t, values[0])
+
+
+def _table_integral(times, values, t):
+    """∫_0^t of the piecewise-linear table (exact: cumulative trapezoids on a fine merge of the
+    breakpoints and the requested times)."""
+    grid = np.union1d(np.concatenate(([0.0], np.asarray(times, float))), t)
+    grid = grid[grid >= 0.0]
+    v = _table_value(times, values, grid)
+    cumulative = np.concatenate(([0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(grid))))
+    return np.interp(t, grid, cumulative)
+
+
+def prescribed_displacement(case_json: dict, set_name: str, t: np.ndarray) -> dict[int, np.ndarray]:
+    """Component → displacement of `set_name` at times t, from its displacement or velocity
+    conditions in case.json (a velocity is integrated from t = 0; an initial displacement of the
+    set is not included)."""
+    out = {}
+    for bc in case_json.get("boundary_conditions", []):
+        if bc.get("set") != set_name or bc.get("kind") not in ("displacement", "velocity"):
+            continue
+        times, values = bc["times"], bc["values"]
+        out[int(bc["component"])] = (_table_value(times, values, t) if bc["kind"] == "displacement"
+                                     else _table_integral(times, values, t))
+    return out
+
+
+def plot_reactions(history: dict, case: CaseSettings, case_json_path: str, path: str):
+    """One panel per set: each non-zero reaction component against the set's prescribed
+    displacement in the component that moves most (against time if nothing moves)."""
+    with open(case_json_path, encoding="utf-8") as stream:
+        case_json = json.load(stream)
+    names = reaction_sets(history)
+    t = history["time"]
+    fig, axes = new_figure(len(names), 1, size=(7.0, 3.6 * len(names) + 0.8))
+    for row, name in enumerate(names):
+        ax = axes[row, 0]
+        moves = prescribed_displacement(case_json, name, t)
+        moving = {c: u for c, u in moves.items() if np.any(u != 0.0)}
+        if moving:
+            comp = max(moving, key=lambda c: np.abs(moving[c]).max())
+            x, xlabel = moving[comp] * 1e3, f"prescribed displacement u{'xyz'[comp]} of '{name}' [mm]"
+        else:
+            x, xlabel = t, "time t [s]"
+        for axis in "xyz":
+            values = history[f"reaction_{name}_f{axis}"]
+            if np.any(values != 0.0):
+                ax.plot(x, values, label=f"F{axis}")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("reaction force [N]")
+        ax.set_title(f"{case.heading}: reaction on '{name}'")
+        ax.legend(fontsize="small")
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    save_figure(fig, path)

@@ -1,0 +1,125 @@
+"""`make bench`: the speed benchmark of issue 6 (a benchmark, not a timed test).
+
+Runs pd_speed (solver/bench/speed.cpp) for each brick size and thread count, one process per run
+so that peak memory is per run, writes out/bench/speed.csv and prints, for 1 and 2 threads:
+directed bond updates per second, time per step against N (with its growth exponent, which must
+be ≈ 1), bytes of bond storage per directed bond and peak memory, and set-up time per node.
+Then the cost of output at each case's own interval: pdsolve on out/<case>/case.json as the case
+sets it, against the same run writing only its first and last frame (skipped for cases not built).
+
+    /usr/bin/python3 solver/bench/speed.py [--build build/solver] [--sides 40 46 100] [--quick]
+
+Wall-clock numbers depend on what else the machine runs; the load average is printed with them.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+STEPS = {40: 40, 46: 30, 100: 10}  # ~0.1–1 s of loop per run at the target rate
+
+
+def run_speed(exe, side, threads, steps, workdir):
+    out = subprocess.run([exe, "--side", str(side), "--steps", str(steps), "--threads", str(threads),
+                          "--dir", workdir], check=True, capture_output=True, text=True).stdout
+    return out.strip().splitlines()[-1]
+
+
+def loop_seconds(log_text):
+    m = re.search(r"done: (\d+) steps .* in ([0-9.]+) s wall", log_text)
+    return (int(m.group(1)), float(m.group(2))) if m else (None, None)
+
+
+def output_cost(pdsolve, case_dir):
+    """CPU seconds (user + system, so file writing counts) of pdsolve with the case's own output, and
+    with frames only at the start and the end; one thread, because on a shared machine the CPU time
+    of a single-threaded run is far steadier than the wall time of a two-threaded one."""
+    with open(os.path.join(case_dir, "case.json")) as f:
+        case = json.load(f)
+    results = {}
+    with tempfile.TemporaryDirectory(prefix="pd-bench-") as tmp:
+        for label in ("case output", "first+last frame"):
+            c = json.loads(json.dumps(case))
+            c["nodes_file"] = os.path.abspath(os.path.join(case_dir, case["nodes_file"]))
+            c["output_dir"] = os.path.join(tmp, label.replace(" ", "_").replace("+", "_"))
+            if label != "case output":
+                c["output"]["every_time"] = c["time"]["end"]
+                c["output"]["every_steps"] = None
+                c["output"]["history_every"] = 10 ** 12
+            path = os.path.join(tmp, "case.json")
+            with open(path, "w") as f:
+                json.dump(c, f)
+            before = os.times()
+            subprocess.run([pdsolve, path, "--threads", "1", "--quiet"], check=True, capture_output=True)
+            after = os.times()
+            cpu = (after.children_user - before.children_user) + (after.children_system - before.children_system)
+            with open(os.path.join(c["output_dir"], "run.log")) as f:
+                steps, _ = loop_seconds(f.read())
+            results[label] = (steps, cpu)
+    return results
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--build", default="build/solver")
+    ap.add_argument("--sides", type=int, nargs="+", default=[40, 46, 100])
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--out", default="out/bench/speed.csv")
+    ap.add_argument("--quick", action="store_true", help="a quarter of the steps")
+    args = ap.parse_args()
+    exe = os.path.join(args.build, "pd_speed")
+    os.makedirs(os.path.dirname(args.out), exist_ok=True)
+    workdir = os.path.join(os.path.dirname(args.out), "tmp")
+
+    header = subprocess.run([exe, "--header"], check=True, capture_output=True, text=True).stdout.strip()
+    rows = []
+    print(f"load average before: {os.getloadavg()[0]:.2f} (wall-clock numbers are only as quiet as the machine)")
+    for side in args.sides:
+        for threads in args.threads:
+            steps = max(2, STEPS.get(side, 10) // (4 if args.quick else 1))
+            line = run_speed(exe, side, threads, steps, workdir)
+            rows.append(dict(zip(header.split(","), line.split(","))))
+            r = rows[-1]
+            print(f"  N = {int(r['nodes']):>8}  threads {threads}: {float(r['bond_updates_per_s']):.3e} directed bond "
+                  f"updates/s, {1e3 * float(r['step_s']):8.2f} ms/step, set-up {float(r['setup_us_per_node']):.2f} µs/node, "
+                  f"peak {float(r['peak_rss_mb']):.0f} MB", flush=True)
+    with open(args.out, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=header.split(",") + ["load_average"])
+        w.writeheader()
+        load = f"{os.getloadavg()[0]:.2f}"
+        for r in rows:
+            w.writerow({**r, "load_average": load})
+    print(f"wrote {args.out}")
+
+    for threads in args.threads:
+        rs = sorted((r for r in rows if int(r["threads"]) == threads), key=lambda r: int(r["nodes"]))
+        if len(rs) >= 2:
+            n0, n1 = int(rs[0]["nodes"]), int(rs[-1]["nodes"])
+            t0, t1 = float(rs[0]["step_s"]), float(rs[-1]["step_s"])
+            print(f"threads {threads}: time per step ∝ N^{math.log(t1 / t0) / math.log(n1 / n0):.3f} "
+                  f"from N = {n0} to {n1} (1 = linear)")
+    r = rows[-1]
+    print(f"bond storage: {float(r['bond_bytes_per_directed_bond']):.3f} bytes per directed bond "
+          f"(4 neighbour + 1 flag + offsets); a 10^7-node brick: ≈ "
+          f"{float(r['peak_rss_mb']) / int(r['nodes']) * 1e7 / 1024:.1f} GB at this peak memory per node")
+
+    pdsolve = os.path.join(args.build, "pdsolve")
+    for case in ("membrane", "impact"):
+        case_dir = os.path.join("out", case)
+        if not os.path.exists(os.path.join(case_dir, "case.json")):
+            print(f"output cost: out/{case} not built (make case={case}), skipped")
+            continue
+        res = output_cost(pdsolve, case_dir)
+        (s_with, t_with), (s_without, t_without) = res["case output"], res["first+last frame"]
+        print(f"output cost, {case} ({s_with} steps, 1 thread): {t_with:.2f} CPU s with the case's output, "
+              f"{t_without:.2f} without: {100 * (t_with - t_without) / t_with:+.1f}% of run time")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

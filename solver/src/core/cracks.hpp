@@ -1,0 +1,23 @@
+// Pre-cracks (notches): bonds whose reference segment crosses a crack segment start broken, the
+// usual way to put a sharp notch into a peridynamic body (Bobaru & Zhang 2015, the crack-branching
+// set-up of validation.md C7; PDMATLAB2D CrackBranching.m cuts the bonds the same way).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/bonds.hpp"
+#include "core/case.hpp"
+#include "core/nodes.hpp"
+
+namespace pd {
+
+// True if the segments p–q and a–b cross in the xy plane (in 3D: the bond crosses the plane through
+// a–b parallel to z). Touching (an end exactly on the other segment's line) does not count, so a
+// crack laid between two lattice rows cuts exactly the bonds that straddle it.
+bool segments_cross(const double p[2], const double q[2], const double a[2], const double b[2]);
+
+// Marks every bond crossing one of the cracks as broken (both stored copies); returns how many
+// bonds that is, each counted once.
+std::int64_t cut_crossing_bonds(const std::vector<CrackSegment>& cracks, const Vec3Array& x, BondList& bonds);
+
+}  // namespace pd

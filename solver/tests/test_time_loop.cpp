@@ -1,0 +1,127 @@
+// The time loop through pdsolve: frames land exactly on k·every_time for both integrators, an
+// unstable Verlet run is stopped with a message naming the step and the cause and writes no
+// non-finite frame, dt "exact" runs, and a bad adaptive value is an input error.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "io/node_file.hpp"
+#include "io/vtu.hpp"
+#include "lattice.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("pd_test_time_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+int run_solver(const fs::path& dir) {
+  const std::string command = std::string(PDSOLVE_PATH) + " " + (dir / "case.json").string() + " --threads 1 --quiet > " +
+                              (dir / "log.txt").string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A free 2D plate, 14 × 10 nodes, set vibrating by an initial velocity of one edge row.
+void write_case(const fs::path& dir, const std::string& time, const std::string& extra = "",
+                const std::string& every = "3e-7") {
+  pd::Nodes nodes = pdtest::cubic_lattice(14, 10, 1, 1e-3, 2, 1e-3);
+  pd::NodeSet edge{"edge", std::vector<std::uint8_t>(nodes.size(), 0)};
+  for (std::size_t i = 0; i < nodes.size(); ++i) edge.member[i] = nodes.x[0][i] < 0.5e-3;
+  nodes.sets = {edge};
+  pd::write_node_file(dir / "nodes.vtu", nodes);
+  std::ofstream(dir / "case.json") << R"({
+    "format_version": 1, "case": "vibe", "nodes_file": "nodes.vtu", "output_dir": "out",
+    "dimension": 2, "analysis": "plane_stress", "thickness": 0.001, "grid_spacing": 0.001, "horizon": 0.003015,
+    "blocks": [{"id": 1, "name": "plate", "model": "pmb", "density": 2440.0, "youngs_modulus": 7.2e10,
+                "fracture_energy": null}],
+    "node_sets": ["edge"],
+    "initial_conditions": [{"set": "edge", "kind": "velocity", "component": 0, "value": 1.0}],
+    "time": )" + time + extra + R"(,
+    "output": {"every_time": )" + every + R"(, "every_steps": null, "history_every": 1}
+  })";
+}
+
+std::vector<double> frame_times(const fs::path& out) {
+  const std::string pvd = slurp(out / "frames.pvd");
+  const std::regex dataset("<DataSet timestep=\"([^\"]+)\"");
+  std::vector<double> times;
+  for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), dataset); it != std::sregex_iterator(); ++it)
+    times.push_back(std::stod((*it)[1]));
+  return times;
+}
+
+}  // namespace
+
+TEST(TimeLoop, FramesLandExactlyOnOutputTimesForBothIntegrators) {
+  for (const std::string integrator : {"verlet", "adaptive"}) {
+    const fs::path dir = temp_dir("land_" + integrator);
+    // 3e-7 s is not a multiple of the stable step (≈ 1.1e-7 × 0.8), so every frame needs a short step.
+    write_case(dir, R"({"end": 3e-6, "integrator": ")" + integrator + R"(", "dt": "stable", "safety_factor": 0.8})",
+               integrator == "adaptive" ? R"(, "adaptive": {"tol": 1e-3, "kd": 20, "p": 3.0, "phi": 0.5})" : "");
+    ASSERT_EQ(run_solver(dir), 0) << slurp(dir / "log.txt");
+    const std::vector<double> times = frame_times(dir / "out");
+    ASSERT_EQ(times.size(), 11u) << integrator;
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      const pd::VtuGrid g = pd::read_vtu(dir / "out" / "frames" / ("frame_" + std::string(6 - std::to_string(k).size(), '0') + std::to_string(k) + ".vtu"));
+      const double t = pd::values_of<double>(*g.find(g.field_data, "TIME"))[0];
+      // exactly k·every_time as the loop computes it (the .pvd text rounds to its own digits)
+      EXPECT_EQ(t, static_cast<double>(k) * 3e-7) << integrator << " frame " << k;
+    }
+    const std::string log = slurp(dir / "out" / "run.log");
+    EXPECT_NE(log.find("force evaluations"), std::string::npos) << log;
+  }
+}
+
+TEST(TimeLoop, VerletAboveTheExactLimitIsStoppedWithoutNonFiniteFrames) {
+  const fs::path dir = temp_dir("blowup");
+  write_case(dir, R"({"end": 2e-5, "integrator": "verlet", "dt": "exact", "safety_factor": 1.5})", "", "1e-6");
+  ASSERT_EQ(run_solver(dir), 3) << slurp(dir / "log.txt");
+  const std::string message = slurp(dir / "log.txt");
+  EXPECT_TRUE(std::regex_search(message, std::regex("step [0-9]+"))) << message;
+  EXPECT_NE(message.find("above the stability limit"), std::string::npos) << message;
+  EXPECT_NE(message.find("1.5 × the exact stability limit"), std::string::npos) << message;
+  // Every frame written is finite.
+  for (const auto& entry : fs::directory_iterator(dir / "out" / "frames")) {
+    const pd::VtuGrid g = pd::read_vtu(entry.path());
+    for (const char* name : {"displacement", "velocity"})
+      for (double x : pd::values_of<double>(*g.find(g.point_data, name))) ASSERT_TRUE(std::isfinite(x)) << entry.path();
+  }
+  EXPECT_EQ(slurp(dir / "out" / "history.csv").find("nan"), std::string::npos);
+  EXPECT_EQ(slurp(dir / "out" / "history.csv").find("inf"), std::string::npos);
+}
+
+TEST(TimeLoop, ExactTimeStepRunsStablyAtSafetyFactor095) {
+  const fs::path dir = temp_dir("exact");
+  write_case(dir, R"({"end": 1e-5, "integrator": "verlet", "dt": "exact", "safety_factor": 0.95})", "", "1e-6");
+  ASSERT_EQ(run_solver(dir), 0) << slurp(dir / "log.txt");
+  const std::string log = slurp(dir / "out" / "run.log");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("exact limit [0-9.e-]+ s = ([0-9.]+) × eq. 2.5"))) << log;
+  EXPECT_GT(std::stod(m[1]), 1.4);  // a 2D plate, m = 3: well above eq. 2.5 (periodic lattice: 1.67)
+  EXPECT_LT(std::stod(m[1]), 1.9);
+}
+
+TEST(TimeLoop, BadAdaptiveValueIsAnInputError) {
+  const fs::path dir = temp_dir("bad");
+  write_case(dir, R"({"end": 1e-6, "integrator": "adaptive"})", R"(, "adaptive": {"tol": 1e-3, "phi": 0.2})");
+  EXPECT_EQ(run_solver(dir), 1);
+  EXPECT_NE(slurp(dir / "log.txt").find("adaptive.phi: must be between 0.5 and 1, got 0.2"), std::string::npos)
+      << slurp(dir / "log.txt");
+  EXPECT_FALSE(fs::exists(dir / "out" / "frames.pvd"));
+}

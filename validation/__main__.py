@@ -1,0 +1,58 @@
+"""`make validate`: run the full cases (through make, so only stale stages rerun), check each one
+and write out/validate/report.md (case, quantity, expected, got, pass) and one PNG per case.
+
+    /usr/bin/python3 -m validation [CASE ...]     (default: every case with checks)
+Exit status 1 if any check fails.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+
+from . import branching, plate_with_hole, traction
+from .figures import FIGURES
+from .runner import ROOT
+
+CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks}
+
+
+def main(argv: list[str]) -> int:
+    cases = argv or list(CHECKS)
+    report_dir = os.path.join(ROOT, "out", "validate")
+    os.makedirs(report_dir, exist_ok=True)
+    lines = ["# Validation report", "",
+             "Written by `make validate` (validation/__main__.py) from the full runs in out/<case>/.", "",
+             "| case | quantity | expected | got | pass |", "|---|---|---|---|---|"]
+    notes, failed = [], 0
+    for case in cases:
+        start = time.monotonic()
+        # $PDSOLVE (a solver built elsewhere) is handed to make as SOLVER, as runner.py does.
+        solver = [f"SOLVER={os.environ['PDSOLVE']}"] if os.environ.get("PDSOLVE") else []
+        make = subprocess.run(["make", "--no-print-directory", f"case={case}", *solver], cwd=ROOT)
+        if make.returncode != 0:
+            lines.append(f"| {case} | the run | `make case={case}` succeeds | exit {make.returncode} | **NO** |")
+            failed += 1
+            continue
+        out = os.path.join(ROOT, "out", case)
+        for row in CHECKS[case](out):
+            lines.append(row.row())
+            failed += not row.passed
+            if row.note:
+                notes.append(f"- {case}, {row.quantity}: {row.note}")
+        FIGURES[case](out, os.path.join(report_dir, f"{case}.png"))
+        with open(os.path.join(out, "run.log"), encoding="utf-8") as stream:
+            done = [l for l in stream if l.startswith(("done", "stopped"))]
+        notes.append(f"- {case}: {done[-1].strip() if done else 'no solver summary'} "
+                     f"(make and checks: {time.monotonic() - start:.0f} s)")
+    lines += ["", "## Notes", ""] + notes + [""]
+    with open(os.path.join(report_dir, "report.md"), "w", encoding="utf-8") as stream:
+        stream.write("\n".join(lines))
+    print("\n".join(lines))
+    print(f"validation: {failed} failed check(s); report in out/validate/report.md")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
