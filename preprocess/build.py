@@ -4,6 +4,7 @@ from __future__ import annotations
 from .cloud import NodeCloud
 from .discretize import discretize
 from .errors import PreprocessError
+from .ordering import space_filling_order
 from .readers import read_mesh
 
 
@@ -17,13 +18,15 @@ def build_node_cloud(mesh_path: str, *, dimension: int, thickness: float | None,
     the top dimension, except that when the mesh has exactly one top-dimension group or none and
     one block name is given, every node belongs to that block. set_layers: name → layer [m] for
     lower-dimension groups. Every named physical group becomes a node set. See
-    preprocess.discretize for the full rules on blocks and sets.
+    preprocess.discretize for the full rules on blocks and sets. The nodes are numbered along a
+    space-filling curve (preprocess.ordering) for the solver's memory locality.
     Raises PreprocessError, whose message starts with the mesh path.
     """
     mesh = read_mesh(mesh_path)
     try:
-        return discretize(mesh, dimension=dimension, thickness=thickness, method=method, dx=dx,
-                          block_names=list(block_names), set_layers=dict(set_layers or {}))
+        cloud = discretize(mesh, dimension=dimension, thickness=thickness, method=method, dx=dx,
+                           block_names=list(block_names), set_layers=dict(set_layers or {}))
     except MemoryError as err:
         raise PreprocessError(f"{mesh_path}: out of memory while discretizing "
                               f"({method}, dx = {dx}); use a larger dx") from err
+    return space_filling_order(cloud)

@@ -3,7 +3,12 @@
 // free faces, the top layers given an initial velocity, advanced by the velocity-Verlet integrator
 // pdsolve uses (bond breaking on). Prints one CSV row (header with --header).
 //
-//   pd_speed --side N [--steps S] [--threads T] [--dir D]
+//   pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE]
+//
+// --nodes FILE reads the brick from a node file instead of writing the x-fastest lattice (the
+// brick must be the side³ lattice of spacing 1 mm at the origin, in any node order): speed.py uses
+// it to measure what the node numbering costs (x-fastest, shuffled, Morton as the pre-processor
+// writes it: preprocess/ordering.py).
 //
 // set-up = reading the node file (written to D first, not timed) + build_model (bonds, material);
 // loop = S integrator steps, timed; directed bond updates/s = directed bonds × S / loop time, each
@@ -42,7 +47,7 @@ const char* const kHeader =
     "broken_bonds";
 
 int usage() {
-  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] | --header\n");
+  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] | --header\n");
   return 2;
 }
 
@@ -50,7 +55,7 @@ int usage() {
 
 int main(int argc, char** argv) {
   int side = 0, steps = 20, threads = 0;
-  std::filesystem::path dir = "out/bench/tmp";
+  std::filesystem::path dir = "out/bench/tmp", nodes;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--header") {
@@ -62,6 +67,7 @@ int main(int argc, char** argv) {
     else if (a == "--steps") steps = std::atoi(argv[++k]);
     else if (a == "--threads") threads = std::atoi(argv[++k]);
     else if (a == "--dir") dir = argv[++k];
+    else if (a == "--nodes") nodes = argv[++k];
     else return usage();
   }
   if (side < 4 || steps < 1) return usage();
@@ -71,14 +77,17 @@ int main(int argc, char** argv) {
   // Silica-glass-like brick, dx = 1 mm: the material only sets the time step and the stretch scale.
   const double dx = 1e-3, horizon = 3.0002 * dx;
   const pd::Case c = pdtest::lattice_case(3, "3d", dx, horizon, 72e9, 2440.0, /*fracture_energy=*/4.0);
-  std::filesystem::create_directories(dir);
-  const std::filesystem::path node_file = dir / ("brick-" + std::to_string(side) + ".vtu");
-  pd::write_node_file(node_file, pdtest::cubic_lattice(side, side, side, dx, 3));
+  std::filesystem::path node_file = nodes;
+  if (nodes.empty()) {
+    std::filesystem::create_directories(dir);
+    node_file = dir / ("brick-" + std::to_string(side) + ".vtu");
+    pd::write_node_file(node_file, pdtest::cubic_lattice(side, side, side, dx, 3));
+  }
 
   const auto setup_start = Clock::now();
   pd::Model model = pd::build_model(c, pd::read_node_file(node_file));
   const double setup = since(setup_start);
-  std::filesystem::remove(node_file);
+  if (nodes.empty()) std::filesystem::remove(node_file);
   const std::size_t n = model.nodes.size();
 
   // The top three layers move down at 0.1 m/s: the brick rings with stretches of order v/c ≈ 2e-5,

@@ -4,7 +4,7 @@ Runs pd_speed (solver/bench/speed.cpp) for each brick size and thread count, one
 so that peak memory is per run, writes out/bench/speed.csv and prints, for 1 and 2 threads:
 directed bond updates per second, time per step against N (with its growth exponent, which must
 be ≈ 1), bytes of bond storage per directed bond and peak memory, and set-up time per node.
-Then the cost of output at each case's own interval: pdsolve on out/<case>/case.json as the case
+Then what the node numbering costs (x-fastest, shuffled, Morton-sorted), and the cost of output at each case's own interval: pdsolve on out/<case>/case.json as the case
 sets it, against the same run writing only its first and last frame (skipped for cases not built).
 
     /usr/bin/python3 solver/bench/speed.py [--build build/solver] [--sides 40 46 100] [--quick]
@@ -24,10 +24,43 @@ import tempfile
 STEPS = {40: 40, 46: 30, 100: 10}  # ~0.1–1 s of loop per run at the target rate
 
 
-def run_speed(exe, side, threads, steps, workdir):
+def run_speed(exe, side, threads, steps, workdir, nodes=None):
+    extra = ["--nodes", nodes] if nodes else []
     out = subprocess.run([exe, "--side", str(side), "--steps", str(steps), "--threads", str(threads),
-                          "--dir", workdir], check=True, capture_output=True, text=True).stdout
+                          "--dir", workdir] + extra, check=True, capture_output=True, text=True).stdout
     return out.strip().splitlines()[-1]
+
+
+def node_order_study(exe, header, side, steps, workdir):
+    """Bond updates per CPU second (1 thread) of the side³ brick numbered x-fastest (as the lattice
+    discretization makes it), shuffled (as an unsorted cloud could be), and Morton-sorted after
+    shuffling (what the pre-processor writes: preprocess/ordering.py)."""
+    import numpy as np
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    sys.path.insert(0, root)
+    from preprocess.cloud import NodeCloud
+    from preprocess.node_file import write_node_file
+    from preprocess.ordering import morton_order, reorder
+
+    dx = 1e-3
+    k, j, i = np.meshgrid(np.arange(side), np.arange(side), np.arange(side), indexing="ij")
+    points = np.column_stack([i.ravel(), j.ravel(), k.ravel()]).astype(float) * dx  # x fastest
+    lattice = NodeCloud(points=points, volume=np.full(len(points), dx ** 3), block=np.ones(len(points), np.int32),
+                        sets={}, grid_spacing=dx, dimension=3)
+    shuffled = reorder(lattice, np.random.default_rng(1).permutation(len(points)))
+    clouds = {"x-fastest": lattice, "shuffled": shuffled,
+              "morton": reorder(shuffled, morton_order(shuffled.points, dx))}
+    os.makedirs(workdir, exist_ok=True)
+    rates = {}
+    for label, cloud in clouds.items():
+        path = os.path.join(workdir, f"order-{label}.vtu")
+        write_node_file(path, cloud)
+        row = dict(zip(header.split(","), run_speed(exe, side, 1, steps, workdir, nodes=path).split(",")))
+        os.remove(path)
+        rates[label] = float(row["bond_updates_per_cpu_s"])
+        print(f"  node order {label:>9}, N = {side ** 3}, 1 thread: {rates[label]:.3e} directed bond updates "
+              f"per CPU s", flush=True)
+    return rates
 
 
 def loop_seconds(log_text):
@@ -71,6 +104,8 @@ def main():
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--out", default="out/bench/speed.csv")
     ap.add_argument("--quick", action="store_true", help="a quarter of the steps")
+    ap.add_argument("--order-side", type=int, default=40,
+                    help="brick side of the node-order study (0: skip it)")
     args = ap.parse_args()
     exe = os.path.join(args.build, "pd_speed")
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
@@ -107,6 +142,10 @@ def main():
     print(f"bond storage: {float(r['bond_bytes_per_directed_bond']):.3f} bytes per directed bond "
           f"(4 neighbour + 1 flag + offsets); a 10^7-node brick: ≈ "
           f"{float(r['peak_rss_mb']) / int(r['nodes']) * 1e7 / 1024:.1f} GB at this peak memory per node")
+
+    if args.order_side:
+        node_order_study(exe, header, args.order_side,
+                         max(2, STEPS.get(args.order_side, 10) // (4 if args.quick else 1)), workdir)
 
     pdsolve = os.path.join(args.build, "pdsolve")
     for case in ("membrane", "impact"):
