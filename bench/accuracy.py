@@ -1,12 +1,21 @@
 """Run time against error (make bench-accuracy): Verlet at several safety factors of eq. 2.5 and at
-the exact limit, and the adaptive step of thesis §2.2 over a sweep of TOL for φ = 1 and φ = ½, on an
-elastic wave in a strip and on a plate with a hole pulled to fracture; each against a Verlet run at
-1/16 of the stable step (validation.md §4). A benchmark, not a test: it asserts nothing.
+the exact limit, and the adaptive step of thesis §2.2 over a sweep of TOL for φ = 1 and φ = ½ (at the
+default Δt_max = eq. 2.5, and for φ = ½ also with Δt_max = 4 × eq. 2.5, so that the controller alone
+sets the step), on an elastic wave in a strip and on a plate with a hole pulled to fracture; each
+against a Verlet run at 1/16 of the default step, 0.05 × eq. 2.5 (validation.md §4). A benchmark,
+not a test: it asserts nothing. docs/accuracy.md reads the numbers.
+
+Errors: the wave, the relative L2 norm of the displacement over the 11 saved frames,
+sqrt(Σ_frames Σ_nodes |u − u_ref|² / Σ_frames Σ_nodes |u_ref|²); the fracture, the relative L2 norm
+of the difference of the final damage fields. Cost: the solver's own time-loop wall time (run.log's
+`done:` line, frame output included, set-up excluded), the minimum over --repeat runs of any run
+shorter than 2 s (validation.md §4: the minimum of repeated runs), and the force evaluations
+(rejected adaptive attempts included), which do not depend on the machine.
 
 Writes out/bench/accuracy.csv (a row per run) and out/bench/accuracy.png (log-log error against
 wall time and against force evaluations).
 
-    /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 2] [--quick]
+    /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 1] [--repeat 3] [--quick]
 """
 from __future__ import annotations
 
@@ -32,9 +41,10 @@ DX = 1.0e-3
 
 
 def strip_problem(directory: str) -> dict:
-    """An elastic wave: a 120 × 6 strip, the left grip moved by a smooth velocity pulse (a Hann
-    pulse as an 11-point table), the wave runs along the strip; 11 frames over 20 µs."""
-    nx, ny = 120, 6
+    """An elastic wave: a 120 × 24 strip (2880 nodes), the left grip moved by a smooth velocity pulse
+    (a Hann pulse of 2 m/s peak over 8 µs as an 11-point table), the wave runs along the strip;
+    11 frames over 20 µs."""
+    nx, ny = 120, 24
     x, y = np.meshgrid(np.arange(nx) * DX, np.arange(ny) * DX, indexing="xy")
     points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
     grip = points[:, 0] < 2.5 * DX
@@ -55,8 +65,11 @@ def strip_problem(directory: str) -> dict:
 
 
 def hole_problem(directory: str) -> dict:
-    """Fracture: an 80 × 40 plate with a hole of radius 6 dx, both ends pulled apart fast enough that
-    cracks start at the hole within the run; the error is measured on the final damage field."""
+    """Fracture: an 80 × 40 plate with a hole of radius 6 dx (PMMA, s0 = 6.6·10⁻³), both ends pulled
+    apart at 4 m/s after a 5 µs ramp. Each end sends in a tensile wave of strain v/c = 2.4·10⁻³; where
+    the two meet (4.9·10⁻³, still below s0) the hole concentrates it about threefold, and two cracks run
+    from the hole's edge across the plate, perpendicular to the load, within the 60 µs run. The error
+    is measured on the final damage field."""
     nx, ny = 80, 40
     x, y = np.meshgrid(np.arange(nx) * DX, np.arange(ny) * DX, indexing="xy")
     points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
@@ -74,8 +87,8 @@ def hole_problem(directory: str) -> dict:
                     "fracture_energy": 300.0}],
         "node_sets": ["left", "right"], "no_fail_sets": ["left", "right"],
         "boundary_conditions": [
-            {"set": "left", "kind": "velocity", "component": 0, "times": ramp, "values": [0.0, -15.0]},
-            {"set": "right", "kind": "velocity", "component": 0, "times": ramp, "values": [0.0, 15.0]}],
+            {"set": "left", "kind": "velocity", "component": 0, "times": ramp, "values": [0.0, -4.0]},
+            {"set": "right", "kind": "velocity", "component": 0, "times": ramp, "values": [0.0, 4.0]}],
         "end": 6e-5, "every_time": 6e-5, "measure": "damage",
     }
 
@@ -98,14 +111,43 @@ def write_case(directory: str, problem: dict, name: str, time: dict, adaptive: d
     return path
 
 
-def run(solver: str, case_path: str, threads: int) -> dict:
+def run_once(solver: str, case_path: str, threads: int) -> dict:
     result = subprocess.run([solver, case_path, "--threads", str(threads), "--quiet"], capture_output=True, text=True)
-    log = open(os.path.join(os.path.dirname(case_path), "run.log"), encoding="utf-8").read()
+    try:
+        with open(os.path.join(os.path.dirname(case_path), "run.log"), encoding="utf-8") as stream:
+            log = stream.read()
+    except OSError:
+        log = ""
     done = re.search(r"(\d+) steps to t = \S+ s in ([0-9.]+) s wall.*?(\d+) force evaluations", log)
+    broken = re.search(r"(\d+) broken bonds", log)
     if result.returncode != 0 or not done:
-        return {"status": f"failed ({result.returncode})", "steps": 0, "wall": float("nan"), "evaluations": 0}
+        last = (result.stderr.strip().splitlines() or ["no message"])[-1]
+        return {"status": f"failed ({result.returncode}: {last[:80]})", "steps": 0, "wall": float("nan"),
+                "evaluations": 0, "broken_bonds": -1, "log": log}
     return {"status": "ok", "steps": int(done.group(1)), "wall": float(done.group(2)),
-            "evaluations": int(done.group(3))}
+            "evaluations": int(done.group(3)), "broken_bonds": int(broken.group(1)) if broken else -1, "log": log}
+
+
+def run(solver: str, case_path: str, threads: int, repeat: int = 1) -> dict:
+    """Run the case; rerun a run shorter than 2 s up to `repeat` times in all and keep the smallest
+    wall time (the runs are deterministic: the same steps and force evaluations every time)."""
+    best = run_once(solver, case_path, threads)
+    for _ in range(repeat - 1):
+        if best["status"] != "ok" or best["wall"] > 2.0:
+            break
+        again = run_once(solver, case_path, threads)
+        if again["status"] != "ok" or (again["steps"], again["evaluations"]) != (best["steps"], best["evaluations"]):
+            raise RuntimeError(f"{case_path}: a rerun differs ({again['status']}, {again['steps']} steps)")
+        best["wall"] = min(best["wall"], again["wall"])
+    return best
+
+
+def stable_dt(log: str) -> float:
+    """eq. 2.5 (without safety factor) as the solver computed it, from run.log's dt line."""
+    found = re.search(r"\(stable (\S+) s", log)
+    if not found:
+        raise RuntimeError("run.log has no 'stable' time step")
+    return float(found.group(1))
 
 
 def fields(run_dir: str, measure: str) -> list[np.ndarray]:
@@ -127,56 +169,88 @@ def error(run_dir: str, reference: list[np.ndarray], measure: str) -> float:
     return (num / den) ** 0.5
 
 
-def schemes(quick: bool):
+def schemes(quick: bool, dt_stable: float):
     """(scheme, parameter, time section, adaptive section) of every run."""
-    factors = [1.0, 0.8, 0.5, 0.25] if quick else [1.0, 0.9, 0.8, 0.5, 0.25, 0.125]
+    factors = [1.0, 0.8, 0.5, 0.25] if quick else [1.0, 0.9, 0.8, 0.5, 0.25, 0.125, 0.025]
+    # 0.025: half the reference step, which shows how far the reference itself is from converged.
     for f in factors:
         yield "verlet-eq2.5", f, {"integrator": "verlet", "dt": "stable", "safety_factor": f}, None
-    for f in [0.95] if quick else [0.95, 0.5]:
+    for f in [1.0, 0.95] if quick else [1.0, 0.95, 0.8, 0.5]:
         yield "verlet-exact", f, {"integrator": "verlet", "dt": "exact", "safety_factor": f}, None
     tols = [1e-2, 1e-4] if quick else [1e-2, 1e-3, 1e-4, 1e-5]
-    for phi in (1.0, 0.5):
+    # Every adaptive setting at its default (K_d 20, p 3, first step 0.8 × eq. 2.5, Δt_max = eq. 2.5)
+    # but TOL and φ; the "dtmax4" runs lift Δt_max to 4 × eq. 2.5.
+    for label, phi, dt_max in (("adaptive-phi1", 1.0, None), ("adaptive-phi0.5", 0.5, None),
+                               ("adaptive-phi0.5-dtmax4", 0.5, 4.0 * dt_stable)):
         for tol in tols:
-            yield (f"adaptive-phi{phi:g}", tol, {"integrator": "adaptive", "dt": "stable", "safety_factor": 0.8},
-                   {"tol": tol, "kd": 20, "p": 3.0, "phi": phi, "dt_initial": None, "dt_min": None, "dt_max": None})
+            yield (label, tol, {"integrator": "adaptive", "dt": "stable", "safety_factor": 0.8},
+                   {"tol": tol, "kd": 20, "p": 3.0, "phi": phi, "dt_initial": None, "dt_min": None,
+                    "dt_max": dt_max})
+
+
+def machine() -> str:
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as stream:
+            found = re.search(r"model name\s*:\s*(.+)", stream.read())
+            model = found.group(1).strip() if found else model
+    except OSError:
+        pass
+    return f"{model}, {os.cpu_count()} logical CPUs"
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"))
-    parser.add_argument("--threads", type=int, default=2)
-    parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
-    parser.add_argument("--quick", action="store_true", help="fewer runs (a smoke test of the benchmark)")
+    parser = argparse.ArgumentParser(description="Error against run time and force evaluations: velocity Verlet and "
+                                     "the adaptive step on a wave and a fracture problem (docs/accuracy.md).")
+    parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"), help="pdsolve to run")
+    parser.add_argument("--threads", type=int, default=1,
+                        help="OpenMP threads of every run (default 1: the clouds have 2880 and 3088 nodes)")
+    parser.add_argument("--repeat", type=int, default=3, help="runs of a case shorter than 2 s; the fastest counts")
+    parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"), help="where the csv, png and runs go")
+    parser.add_argument("--quick", action="store_true", help="fewer runs, no repeats (a smoke test of the benchmark)")
     args = parser.parse_args(argv)
+    if not os.path.isfile(args.solver):
+        parser.error(f"{args.solver} is missing: build it with `make solver`")
+    repeat = 1 if args.quick else max(1, args.repeat)
     os.makedirs(args.out, exist_ok=True)
+    load = os.getloadavg()[0]
+    print(f"{machine()}; {args.threads} thread(s); load average {load:.2f} at the start", flush=True)
     rows = []
     for problem_name, make in (("wave", strip_problem), ("fracture", hole_problem)):
         directory = os.path.join(args.out, problem_name)
         os.makedirs(directory, exist_ok=True)
         problem = make(directory)
-        # Reference: Verlet at 1/16 of 0.8 × eq. 2.5 (validation.md §4).
+        # Reference: Verlet at 1/16 of the default step, 0.8/16 = 0.05 × eq. 2.5 (validation.md §4).
         ref_case = write_case(directory, problem, "reference",
                               {"integrator": "verlet", "dt": "stable", "safety_factor": 0.05}, None)
         ref = run(args.solver, ref_case, args.threads)
+        if ref["status"] != "ok":
+            raise SystemExit(f"{problem_name}: the reference run failed: {ref['status']}")
         reference = fields(os.path.dirname(ref_case), problem["measure"])
-        print(f"{problem_name}: reference {ref['steps']} steps, {ref['wall']:.2f} s", flush=True)
-        for scheme, parameter, time, adaptive in schemes(args.quick):
+        dt_stable = stable_dt(ref["log"])
+        print(f"{problem_name}: eq. 2.5 = {dt_stable:.4g} s; reference {ref['steps']} steps, {ref['wall']:.2f} s",
+              flush=True)
+        rows.append({"problem": problem_name, "scheme": "reference", "parameter": 0.05, "wall_time": ref["wall"],
+                     "force_evaluations": ref["evaluations"], "steps": ref["steps"], "mean_dt": problem["end"] / ref["steps"],
+                     "error": 0.0, "broken_bonds": ref["broken_bonds"], "status": "ok"})
+        for scheme, parameter, time, adaptive in schemes(args.quick, dt_stable):
             name = f"{scheme}-{parameter:g}"
             case_path = write_case(directory, problem, name, time, adaptive)
-            r = run(args.solver, case_path, args.threads)
+            r = run(args.solver, case_path, args.threads, repeat)
             e = error(os.path.dirname(case_path), reference, problem["measure"]) if r["status"] == "ok" else float("nan")
             rows.append({"problem": problem_name, "scheme": scheme, "parameter": parameter, "wall_time": r["wall"],
-                         "force_evaluations": r["evaluations"], "steps": r["steps"], "error": e,
-                         "status": r["status"]})
-            print(f"  {name:24s} {r['status']:6s} steps {r['steps']:7d}  evals {r['evaluations']:8d}  "
-                  f"wall {r['wall']:8.3f} s  error {e:.3g}", flush=True)
+                         "force_evaluations": r["evaluations"], "steps": r["steps"],
+                         "mean_dt": problem["end"] / r["steps"] if r["steps"] else float("nan"), "error": e,
+                         "broken_bonds": r["broken_bonds"], "status": r["status"]})
+            print(f"  {name:32s} {r['status'][:6]:6s} steps {r['steps']:6d}  evals {r['evaluations']:6d}  "
+                  f"wall {r['wall']:7.3f} s  error {e:.3g}", flush=True)
     with open(os.path.join(args.out, "accuracy.csv"), "w", newline="", encoding="utf-8") as stream:
         writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
     plot(rows, os.path.join(args.out, "accuracy.png"), args.threads)
-    print(f"wrote {args.out}/accuracy.csv and accuracy.png ({platform.node()}, {os.cpu_count()} cores, "
-          f"{args.threads} threads)")
+    print(f"wrote {args.out}/accuracy.csv and accuracy.png ({machine()}, {args.threads} thread(s), "
+          f"load average {load:.2f} at the start, {os.getloadavg()[0]:.2f} at the end)")
     return 0
 
 
@@ -188,11 +262,13 @@ def plot(rows: list[dict], path: str, threads: int):
     fig, axes = plt.subplots(len(problems), 2, figsize=(11, 4.2 * len(problems)), squeeze=False)
     for row_axes, problem in zip(axes, problems):
         for ax, xkey, xlabel in zip(row_axes, ("wall_time", "force_evaluations"),
-                                    (f"solver wall time [s] ({threads} threads)", "force evaluations")):
+                                    (f"solver wall time [s] ({threads} thread{'s' if threads > 1 else ''})", "force evaluations")):
             for scheme in sorted({r["scheme"] for r in rows}):
-                pts = sorted((r[xkey], r["error"], r["parameter"]) for r in rows
+                # joined in the order of the parameter (safety factor or TOL)
+                pts = sorted(((r[xkey], r["error"], r["parameter"]) for r in rows
                              if r["problem"] == problem and r["scheme"] == scheme and r["status"] == "ok"
-                             and r["error"] > 0)
+                             and r["scheme"] != "reference" and np.isfinite(r["error"]) and r["error"] > 0),
+                             key=lambda p: p[2])
                 if pts:
                     ax.loglog([p[0] for p in pts], [p[1] for p in pts], marker="o", label=scheme)
                     for p in pts:

@@ -193,3 +193,11 @@ def test_dt_exact_is_a_known_rule(tmp_path):
     assert case["time"]["dt"] == "exact"
     message = error_of(tmp_path, MINIMAL.replace("  end: 1.0e-3", "  end: 1.0e-3\n  dt: exakt"))
     assert "time.dt: 'exakt' is not one of 'stable', 'exact'" in message
+
+
+@pytest.mark.parametrize("tol, kd", [("0.0", "0"), ("-1.0e-3", "-2")])
+def test_adaptive_tol_not_positive_and_kd_below_one_are_rejected(tmp_path, tol, kd):
+    # issue 3: TOL is a relative error (> 0) and K_d a count of iterations (≥ 1).
+    message = error_of(tmp_path, MINIMAL + f"adaptive:\n  tol: {tol}\n  kd: {kd}\n")
+    assert f"plate.yaml:12: adaptive.tol: must be greater than 0, got {float(tol):g}" in message
+    assert f"plate.yaml:13: adaptive.kd: must be at least 1, got {int(kd)}" in message
