@@ -63,10 +63,17 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
                                  "times": times, "values": values})
     initial = []
     for ic in case["initial_conditions"]:
-        for kind in ("velocity", "displacement"):
-            for comp, (_times, values) in (ic[kind] or {}).items():
-                initial.append({"set": ic["set"], "kind": kind, "component": AXIS[comp],
-                                "value": values[0]})
+        for comp, (_times, values) in (ic["velocity"] or {}).items():
+            initial.append({"set": ic["set"], "kind": "velocity", "component": AXIS[comp], "value": values[0]})
+        # displacement + strain·x per component (strain: a uniform pre-strain, formats.md §3)
+        shift = {comp: values[0] for comp, (_t, values) in (ic["displacement"] or {}).items()}
+        strain = {comp: values[0] for comp, (_t, values) in (ic["strain"] or {}).items()}
+        for comp in sorted(set(shift) | set(strain), key=AXIS.get):
+            entry = {"set": ic["set"], "kind": "displacement", "component": AXIS[comp],
+                     "value": shift.get(comp, 0.0)}
+            if comp in strain:
+                entry["gradient"] = strain[comp]
+            initial.append(entry)
     contact = dict(case["contact"])
     if contact["skin"] is None:
         contact["skin"] = 0.5 * grid_spacing  # half the node spacing: few rebuilds, few extra pairs

@@ -66,6 +66,9 @@ INITIAL_CONDITION = {
     "velocity": Key("components", "initial velocity per component x, y, z", unit="m/s", table=False),
     "displacement": Key("components", "initial displacement per component x, y, z", unit="m",
                         table=False),
+    "strain": Key("components", "uniform initial strain per component x, y, z: adds the affine "
+                  "displacement u_x = strain_x·x (y, z alike) to displacement (a pre-strain; hold it "
+                  "with a velocity 0 boundary condition)", table=False),
 }
 
 INDENTER = {
@@ -192,6 +195,13 @@ CASE = {
         reactions=Key("names", "node sets whose reaction force (the force the prescribed displacement or "
                       "velocity applies to the set) goes to history.csv as reaction_<set>_fx, _fy, _fz",
                       default=[], unit="N"),
+        restart_every_time=Key("number", "write the checkpoint out/<case>/checkpoint.bin after the first step "
+                               "at or past every multiple of this much simulated time (it never shortens a "
+                               "step); SIGINT/SIGTERM always write one; `pdsolve case.json --restart "
+                               "checkpoint.bin` continues bitwise (pipeline/formats.md §5)",
+                               default=None, unit="s", above=0.0),
+        restart_every_steps=Key("integer", "write the checkpoint every this many steps (may be combined "
+                                "with restart_every_time)", default=None, minimum=1),
     ),
     "figures": section(
         "what postprocess draws",

@@ -254,8 +254,8 @@ def _check_context(case: dict, checker: _Checker):
         if dim == 2:
             pass  # z is allowed in 2D: a membrane moves out of its plane
     for i, ic in enumerate(case["initial_conditions"]):
-        if not ic["velocity"] and not ic["displacement"]:
-            checker.error(("initial_conditions", i), "give velocity or displacement")
+        if not ic["velocity"] and not ic["displacement"] and not ic["strain"]:
+            checker.error(("initial_conditions", i), "give velocity, displacement or strain")
     names = set()
     for i, ind in enumerate(case["indenters"]):
         _check_indenter(ind, i, dim, names, checker)

@@ -14,12 +14,16 @@
 namespace {
 
 const char* const kUsage =
-    "usage: pdsolve CASE.json [--threads N] [--end-time T] [--max-steps N] [--quiet] [--help] [--version]\n"
+    "usage: pdsolve CASE.json [--restart CHECKPOINT] [--threads N] [--end-time T] [--max-steps N] [--quiet]\n"
+    "               [--help] [--version]\n"
     "\n"
     "Bond-based PMB peridynamics solver. Reads the resolved case CASE.json and its node file\n"
     "(pipeline/formats.md), writes frames/*.vtu, frames.pvd, history.csv and run.log to the\n"
     "case's output_dir.\n"
     "\n"
+    "  --restart CHECKPOINT\n"
+    "                  continue the run of CASE.json from CHECKPOINT (its output_dir/checkpoint.bin),\n"
+    "                  bitwise as if it had never stopped; refused for another case or node file\n"
     "  --threads N     OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --end-time T    simulated end time [s], overrides time.end\n"
     "  --max-steps N   stop after N steps at most\n"
@@ -27,8 +31,13 @@ const char* const kUsage =
     "  --help          this text\n"
     "  --version       the solver version and how it was built (compiler, flags, OpenMP, sanitizers)\n"
     "\n"
+    "SIGINT (Ctrl-C) or SIGTERM: the run finishes its step, writes output_dir/checkpoint.bin and\n"
+    "stops (a second signal kills it at once); so does output.restart_every_time / _steps, without\n"
+    "stopping.\n"
+    "\n"
     "Exit codes: 0 done; 1 bad input (reported before any output file is written); 2 bad command\n"
-    "line; 3 the run failed (e.g. the state became non-finite; the last valid frame is kept).\n";
+    "line; 3 the run failed (e.g. the state became non-finite; the last valid frame is kept);\n"
+    "130 / 143 interrupted by SIGINT / SIGTERM after writing the checkpoint.\n";
 
 #ifdef _OPENMP
 // The specification version of an _OPENMP date (OpenMP's own table).
@@ -109,6 +118,8 @@ int main(int argc, char** argv) {
       options.end_time = parse_number(arg, value());
     } else if (arg == "--max-steps") {
       options.max_steps = parse_integer(arg, value());
+    } else if (arg == "--restart") {
+      options.restart = value();
     } else if (arg == "--quiet") {
       options.quiet = true;
     } else if (!arg.empty() && arg[0] == '-') {

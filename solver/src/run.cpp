@@ -4,6 +4,8 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <csignal>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +22,7 @@
 #include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
 #include "io/case_reader.hpp"
+#include "io/checkpoint.hpp"
 #include "io/node_file.hpp"
 #include "io/output.hpp"
 
@@ -65,6 +68,59 @@ std::int64_t first_non_finite(const State& s) {
   return first == n ? -1 : first;
 }
 
+// "node 12 at (0.001, 0.002, 0) m": where something happened, for messages.
+std::string node_text(const Model& m, std::int64_t node) {
+  const auto i = static_cast<std::size_t>(node);
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "node %lld at (%.6g, %.6g, %.6g) m", static_cast<long long>(node),
+                m.nodes.x[0][i], m.nodes.x[1][i], m.nodes.x[2][i]);
+  return buffer;
+}
+
+// The node with the largest finite speed (lowest index on ties): where an instability that grows
+// geometrically has grown longest, i.e. most likely where it started.
+std::int64_t fastest_node(const State& s) {
+  std::int64_t best = 0;
+  double best_speed = -1.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double speed = s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i];
+    if (std::isfinite(speed) && speed > best_speed) best_speed = speed, best = static_cast<std::int64_t>(i);
+  }
+  return best;
+}
+
+// SIGINT / SIGTERM: the handler only records the signal; the time loop checks it after each step,
+// writes a checkpoint and stops. SA_RESETHAND: a second signal kills at once.
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void record_signal(int signal) { g_signal = signal; }
+
+class SignalGuard {
+ public:
+  SignalGuard() {
+    g_signal = 0;
+    struct sigaction action {};
+    action.sa_handler = record_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND | SA_RESTART;
+    sigaction(SIGINT, &action, &old_int_);
+    sigaction(SIGTERM, &action, &old_term_);
+    // A signal the caller ignores (SIGINT of a background job of a script, nohup) stays ignored.
+    if (old_int_.sa_handler == SIG_IGN) sigaction(SIGINT, &old_int_, nullptr);
+    if (old_term_.sa_handler == SIG_IGN) sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  ~SignalGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  SignalGuard(const SignalGuard&) = delete;
+  SignalGuard& operator=(const SignalGuard&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+const char* signal_name(int signal) { return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : "a signal"; }
+
 std::string duration_text(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
   char buffer[32];
@@ -78,6 +134,7 @@ std::string duration_text(double seconds) {
 }  // namespace
 
 int run(const RunOptions& opt) {
+  const SignalGuard signals;  // from the start: a signal while reading is seen after the first step
   // ---- read and build: every input error is thrown here, before any output exists
   Case c = read_case(opt.case_file);
   if (opt.end_time) c.time.end = *opt.end_time;
@@ -92,6 +149,15 @@ int run(const RunOptions& opt) {
   Model model = build_model(c, std::move(nodes));
   const double build_seconds = seconds_since(build_start);
   const std::size_t n = model.nodes.size();
+  // A material whose constants come out unusable (overflow of c for extreme E, δ or thickness).
+  for (std::size_t b = 0; b < model.material.block.size(); ++b) {
+    const auto& k = model.material.block[b];
+    if (!std::isfinite(k.micromodulus) || !(k.micromodulus > 0.0) || !(k.critical_stretch > 0.0))
+      throw Error(c.file.string() + ": blocks[" + std::to_string(b) + "] '" + c.blocks[b].name +
+                  "': the material gives micromodulus c = " + format("%.6g", k.micromodulus) +
+                  " and critical stretch s0 = " + format("%.6g", k.critical_stretch) +
+                  " (need finite c > 0 and s0 > 0): check density, youngs_modulus, fracture_energy, horizon and thickness");
+  }
 
   const double dt_stable = stable_time_step(model);
   double dt = 0.0, dt_exact = 0.0;  // dt_exact: computed when time.dt is "exact" or a run fails
@@ -123,10 +189,51 @@ int run(const RunOptions& opt) {
   integrator->configure(c);
 
   State state(n);
-  apply_initial_conditions(c, model.nodes, state.u, state.v);
   double t = 0.0;
-  integrator->initialize(state, t);
+  const bool restarting = !opt.restart.empty();
+  Checkpoint ck;
+  const std::uint64_t case_hash = file_hash(opt.case_file), nodes_hash = file_hash(c.nodes_file);
+  if (restarting) {
+    ck = read_checkpoint(opt.restart);
+    const std::string where = opt.restart.string() + ": ";
+    if (ck.case_hash != case_hash)
+      throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
+                  " changed since it was written); restart with the case.json it was written for");
+    if (ck.nodes_hash != nodes_hash)
+      throw Error(where + "the checkpoint belongs to another node file (or " + c.nodes_file.string() +
+                  " changed since it was written)");
+    if (ck.nodes != n || ck.directed_bonds != model.bonds.directed() || ck.broken_flags.size() != model.bonds.directed() ||
+        ck.integrator != integrator->name() ||
+        (model.contact.pairs && ck.contact_rebuilds > 0 && ck.contact_u_build[0].size() != n))
+      throw Error(where + "the checkpoint does not fit this model (" + std::to_string(ck.nodes) + " nodes, " +
+                  std::to_string(ck.directed_bonds / 2) + " bonds, integrator " + ck.integrator + "; here " +
+                  std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator->name() + ")");
+    if (ck.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
+    // initialize() sizes the integrator's scratch; then everything it set is replaced by the
+    // checkpoint, so the run continues bitwise as if it had never stopped.
+    t = ck.time;
+    integrator->initialize(state, t);
+    state = ck.state;
+    model.bonds.broken = ck.broken_flags;
+    if (model.contact.pairs)
+      model.contact_list.restore(model.nodes.x, ck.contact_u_build, model.block_index, model.contact,
+                                 ck.contact_rebuilds, ck.contact_seconds);
+    try {
+      integrator->load_state(ck.integrator_state);
+    } catch (const std::exception& e) {
+      throw Error(where + e.what());
+    }
+    dt = ck.dt;
+  } else {
+    apply_initial_conditions(c, model.nodes, state.u, state.v);
+    integrator->initialize(state, t);
+  }
   if (first_non_finite(state) >= 0) throw Error(c.file.string() + ": the initial state is not finite");
+  // Nodes without a bond move freely: only loads and contact act on them (preprocess warns too,
+  // but the solver may be run alone).
+  std::int64_t isolated = 0, first_isolated = -1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (model.bonds.offsets[i + 1] == model.bonds.offsets[i] && isolated++ == 0) first_isolated = static_cast<std::int64_t>(i);
 
   // ---- output starts here
   // The scene's own history columns (formats.md §4): only when it has contact or indenters.
@@ -141,10 +248,17 @@ int run(const RunOptions& opt) {
   if (breakable) extra_columns.push_back("broken_bond_energy");
   for (const auto& set : c.output.reactions)
     for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("reaction_" + set + "_" + axis);
-  OutputWriter out(c.output_dir, extra_columns);
-  RunLog log(c.output_dir / "run.log", opt.quiet);
+  OutputResume resume{ck.frame_times, ck.history_bytes};
+  OutputWriter out(c.output_dir, extra_columns, restarting ? &resume : nullptr);
+  const std::filesystem::path checkpoint_file = (c.output_dir / "checkpoint.bin").lexically_normal();
+  // A checkpoint of an earlier run would not match the frames this run writes.
+  if (!restarting) std::filesystem::remove(checkpoint_file);
+  RunLog log(c.output_dir / "run.log", opt.quiet, restarting);
   log.line("pdsolve " PD_VERSION ": case " + (c.name.empty() ? opt.case_file.string() : c.name) + " (" +
            opt.case_file.string() + ")");
+  if (restarting)
+    log.line("restart from " + opt.restart.string() + ": step " + std::to_string(ck.step) + ", t = " +
+             format("%.6g", ck.time) + " s, " + std::to_string(ck.frame_times.size()) + " frames kept (frames after it, history.csv rows after it: dropped)");
   log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(model.bonds.directed() / 2) + " (" +
            format("%.1f", static_cast<double>(model.bonds.directed()) / static_cast<double>(n)) +
            " per node), built in " + format("%.3f", build_seconds) + " s");
@@ -162,6 +276,10 @@ int run(const RunOptions& opt) {
                                         : "fixed; stable " + format("%.6g", dt_stable) + " s") +
            (c.time.integrator == "adaptive" ? ", the initial step" : "") +
            "), integrator " + integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
+  if (isolated > 0)
+    log.line("warning: " + std::to_string(isolated) + " of " + std::to_string(n) +
+             " nodes have no bond within the horizon (isolated: only loads and contact act on them); the first is " +
+             node_text(model, first_isolated));
   if (c.time.dt_rule == "fixed" && dt > dt_stable)
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
   for (const auto& text : work_summary(model, c)) log.line(text);
@@ -174,6 +292,7 @@ int run(const RunOptions& opt) {
            (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
 
   const auto loop_start = Clock::now();
+  const double wall_before = restarting ? ck.wall_time : 0.0;  // time loop of the run(s) before a restart
   std::int64_t step = 0, broken = broken_bond_count(model), last_frame_step = -1;
   double broken_energy = 0.0;  // Σ energy of bonds at the moment they broke [J]
   auto history_row = [&](double dt_taken) {
@@ -188,7 +307,7 @@ int run(const RunOptions& opt) {
     r.external_work = state.external_work;
     r.damping_work = state.damping_work;
     r.broken_bonds = broken;
-    r.wall_time = seconds_since(loop_start);
+    r.wall_time = wall_before + seconds_since(loop_start);
     if (model.contact.pairs || !model.indenters.empty()) r.extra.push_back(state.contact_energy);
     if (model.contact.pairs) r.extra.push_back(static_cast<double>(model.contact_list.rebuilds()));
     for (std::size_t k = 0; k < model.indenters.size(); ++k)
@@ -206,7 +325,8 @@ int run(const RunOptions& opt) {
     last_frame_step = step;
     if (c.output.every_time) next_frame_index = static_cast<std::int64_t>(std::floor(t / *c.output.every_time * (1.0 + 1e-12))) + 1;
   };
-  frame(0.0);
+  std::int64_t next_restart_index = 1;  // restart_every_time: checkpoint k at t ≥ k·restart_every_time
+  if (!restarting) frame(0.0);
 
   const bool progress = !opt.quiet && isatty(fileno(stderr));
   auto last_progress = Clock::now();
@@ -220,6 +340,53 @@ int run(const RunOptions& opt) {
   constexpr int kGrowthSteps = 20;
   double energy_before = -1.0, energy_streak_start = 0.0;
   int growth_streak = 0;
+  if (restarting) {
+    step = ck.step;
+    dt_taken = ck.dt_taken;
+    last_frame_step = ck.last_frame_step;
+    next_frame_index = ck.next_frame_index;
+    next_restart_index = ck.next_restart_index;
+    broken = ck.broken;
+    force_evaluations = ck.force_evaluations;
+    broken_energy = ck.broken_energy;
+    energy_before = ck.energy_before;
+    energy_streak_start = ck.energy_streak_start;
+    growth_streak = static_cast<int>(ck.growth_streak);
+  }
+  // Everything the loop carries from step to step, to checkpoint.bin (written atomically).
+  auto write_restart = [&]() {
+    out.flush_history();
+    Checkpoint k;
+    k.case_hash = case_hash;
+    k.nodes_hash = nodes_hash;
+    k.nodes = n;
+    k.directed_bonds = model.bonds.directed();
+    k.integrator = integrator->name();
+    k.step = step;
+    k.time = t;
+    k.dt = dt;
+    k.dt_taken = dt_taken;
+    k.last_frame_step = last_frame_step;
+    k.next_frame_index = next_frame_index;
+    k.next_restart_index = next_restart_index;
+    k.broken = broken;
+    k.force_evaluations = force_evaluations;
+    k.broken_energy = broken_energy;
+    k.wall_time = wall_before + seconds_since(loop_start);
+    k.energy_before = energy_before;
+    k.energy_streak_start = energy_streak_start;
+    k.growth_streak = growth_streak;
+    k.integrator_state = integrator->save_state();
+    k.state = state;
+    k.broken_flags = model.bonds.broken;
+    k.contact_rebuilds = model.contact_list.rebuilds();
+    k.contact_seconds = model.contact_list.seconds();
+    k.contact_u_build = model.contact_list.u_build();
+    k.frame_times = out.frame_times();
+    k.history_bytes = out.history_bytes();
+    write_checkpoint(checkpoint_file, k);
+  };
+  int interrupted = 0;
   // Why a run blew up, from the true stability limit (computed now if not yet known).
   auto likely_cause = [&](double h) {
     if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
@@ -257,9 +424,10 @@ int run(const RunOptions& opt) {
     force_evaluations += integrator->last_step().force_evaluations;
     if (integrator->last_step().next_dt > 0.0) dt = integrator->last_step().next_dt;
     if (const std::int64_t bad = first_non_finite(state); bad >= 0) {
-      log.error("pdsolve: error: non-finite displacement or velocity at node " + std::to_string(bad) + " after step " +
-                std::to_string(step) + " (t = " + format("%.6g", t) + " s); " + likely_cause(h) +
-                "; stopped without writing this state");
+      log.error("pdsolve: error: non-finite displacement or velocity at " + node_text(model, bad) + " after step " +
+                std::to_string(step) + " (t = " + format("%.6g", t) + " s; the largest finite speed is at " +
+                node_text(model, fastest_node(state)) + "); " + likely_cause(h) +
+                "; stopped without writing this state, the last frame written is the last valid one");
       status = kRunFailed;
       state_valid = false;
       break;
@@ -275,7 +443,9 @@ int run(const RunOptions& opt) {
       log.error("pdsolve: error: the energy grew from " + format("%.3g", energy_streak_start) + " J to " +
                 format("%.3g", energy) + " J in the " + std::to_string(kGrowthSteps) + " steps up to and after step " +
                 std::to_string(step) + " (t = " + format("%.6g", t) + " s), at least ×" + format("%g", kGrowthPerStep) +
-                " every step: the run is unstable; " + likely_cause(h) + "; stopped without writing this state");
+                " every step: the run is unstable, most likely starting at " + node_text(model, fastest_node(state)) +
+                " (the largest speed); " + likely_cause(h) +
+                "; stopped without writing this state, the last frame written is the last valid one");
       status = kRunFailed;
       state_valid = false;
       break;
@@ -284,6 +454,19 @@ int run(const RunOptions& opt) {
                                                 : t >= static_cast<double>(next_frame_index) * *c.output.every_time - 1e-9 * h;
     if (frame_due) frame(h);
     else if (step % c.output.history_every == 0) history_row(h);
+    // Checkpoints never shorten a step, so a run that writes them takes bitwise the same steps.
+    bool restart_due = c.output.restart_every_steps && step % *c.output.restart_every_steps == 0;
+    if (c.output.restart_every_time && t >= static_cast<double>(next_restart_index) * *c.output.restart_every_time) {
+      restart_due = true;
+      next_restart_index = static_cast<std::int64_t>(std::floor(t / *c.output.restart_every_time)) + 1;
+    }
+    if (opt.after_step) opt.after_step(step);
+    if (g_signal != 0) {
+      interrupted = g_signal;
+      write_restart();
+      break;
+    }
+    if (restart_due) write_restart();
     if (progress && seconds_since(last_progress) > 0.5) {
       last_progress = Clock::now();
       const double elapsed = seconds_since(loop_start);
@@ -295,12 +478,13 @@ int run(const RunOptions& opt) {
     }
   }
   if (progress) std::fprintf(stderr, "\r%70s\r", "");
-  if (state_valid && last_frame_step != step) frame(dt_taken);
+  // An interrupted run writes no last frame: the restart goes on with the frames of an uninterrupted run.
+  if (state_valid && !interrupted && last_frame_step != step) frame(dt_taken);
   out.finish();
 
   const double wall = seconds_since(loop_start);
   const double updates = static_cast<double>(model.bonds.directed()) * static_cast<double>(step);
-  log.line(std::string(status == kOk ? "done" : "stopped") + ": " + std::to_string(step) + " steps to t = " +
+  log.line(std::string(interrupted ? "interrupted" : status == kOk ? "done" : "stopped") + ": " + std::to_string(step) + " steps to t = " +
            format("%.6g", t) + " s in " + format("%.3f", wall) + " s wall (" +
            format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
            std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds, " +
@@ -309,6 +493,12 @@ int run(const RunOptions& opt) {
     log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
              std::to_string(step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
              std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
+  if (interrupted) {
+    log.error("pdsolve: interrupted by " + std::string(signal_name(interrupted)) + " after step " + std::to_string(step) +
+              " (t = " + format("%.6g", t) + " s); checkpoint written to " + checkpoint_file.string() +
+              "; continue with: pdsolve " + opt.case_file.string() + " --restart " + checkpoint_file.string());
+    return kInterruptedBase + interrupted;
+  }
   if (status == kOk && step >= max_steps && t < end * (1.0 - 1e-12))
     log.line("note: stopped at max_steps " + std::to_string(max_steps) + " before the end time");
   return status;

@@ -2,6 +2,7 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 namespace pd {
@@ -12,13 +13,19 @@ struct RunOptions {
   std::optional<double> end_time;         // overrides time.end
   std::optional<std::int64_t> max_steps;  // caps time.max_steps
   bool quiet = false;                     // nothing on stdout, no progress line
+  std::filesystem::path restart;          // a checkpoint.bin to continue from (empty: start at t = 0)
+  // Called after every completed step with the step number (tests raise a signal from it).
+  std::function<void(std::int64_t step)> after_step;
 };
 
-// Exit codes of pdsolve.
+// Exit codes of pdsolve. Interrupted by SIGINT or SIGTERM after writing a checkpoint: 128 + the
+// signal number (130, 143), as a shell reports a process killed by it.
 enum ExitCode : int { kOk = 0, kInputError = 1, kUsageError = 2, kRunFailed = 3 };
+constexpr int kInterruptedBase = 128;
 
 // Throws pd::Error for bad input, always before any output file is written; returns kRunFailed
-// (after writing what is valid) if the state becomes non-finite.
+// (after writing what is valid) if the state becomes non-finite, 128 + signal after SIGINT/SIGTERM
+// (a checkpoint is written first; run.cpp installs the handlers for the duration of the call).
 int run(const RunOptions& options);
 
 }  // namespace pd

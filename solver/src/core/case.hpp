@@ -23,6 +23,7 @@ struct InitialCondition {
   std::string kind;  // velocity | displacement
   int component = 0;
   double value = 0.0;
+  double gradient = 0.0;  // displacement only: u = value + gradient·x[component] (a uniform pre-strain)
 };
 
 struct TimeSettings {
@@ -48,6 +49,10 @@ struct OutputSettings {
   std::optional<std::int64_t> every_steps;
   std::int64_t history_every = 1;
   std::vector<std::string> reactions;      // node sets whose reaction force goes to history.csv
+  // A checkpoint (io/checkpoint.hpp) after the first step at or past every k·restart_every_time of
+  // simulated time and/or every restart_every_steps steps; neither: only on SIGINT/SIGTERM.
+  std::optional<double> restart_every_time;  // s
+  std::optional<std::int64_t> restart_every_steps;
 };
 
 // A pre-crack: bonds crossing the segment from–to (in the xy plane; in 3D the plane through it

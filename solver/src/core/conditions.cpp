@@ -84,8 +84,10 @@ void apply_initial_conditions(const Case& c, const Nodes& nodes, Vec3Array& u, V
   for (const auto& ic : c.initial_conditions) {
     const NodeSet& set = require_set(nodes, ic.set);
     auto& target = ic.kind == "velocity" ? v : u;
+    const auto d = static_cast<std::size_t>(ic.component);
+    // value + gradient·x: an affine displacement, e.g. the uniform pre-strain of cases/drum.
     for (std::size_t i = 0; i < nodes.size(); ++i)
-      if (set.member[i]) target[static_cast<std::size_t>(ic.component)][i] = ic.value;
+      if (set.member[i]) target[d][i] = ic.value + ic.gradient * nodes.x[d][i];
   }
 }
 

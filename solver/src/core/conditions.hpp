@@ -46,7 +46,7 @@ struct Conditions {
 // component (e.g. the corner shared by two clamped edges); body forces add up.
 Conditions make_conditions(const Case& c, const Nodes& nodes);
 
-// Initial velocity and displacement (constant per set); the rest of the body starts at rest.
+// Initial velocity and displacement (value + gradient·x per set); the rest of the body starts at rest.
 void apply_initial_conditions(const Case& c, const Nodes& nodes, Vec3Array& u, Vec3Array& v);
 
 }  // namespace pd

@@ -93,4 +93,12 @@ bool VerletList::update(const Vec3Array& x, const Vec3Array& u, const std::vecto
   return true;
 }
 
+void VerletList::restore(const Vec3Array& x, const Vec3Array& u_build, const std::vector<std::int32_t>& block,
+                         const ContactParameters& p, std::int64_t rebuilds, double seconds) {
+  pairs_ = rebuilds > 0 ? search(x, u_build, block, p) : ContactPairs{};
+  u_build_ = u_build;
+  rebuilds_ = rebuilds;
+  seconds_ = seconds;
+}
+
 }  // namespace pd

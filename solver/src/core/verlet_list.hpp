@@ -46,6 +46,12 @@ class VerletList {
   static ContactPairs search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
                              const ContactParameters& p);
 
+  // The list as it was after `rebuilds` builds, the last at displacement u_build (a checkpoint,
+  // io/checkpoint.hpp): search() at u_build gives bitwise the pairs that build found.
+  void restore(const Vec3Array& x, const Vec3Array& u_build, const std::vector<std::int32_t>& block,
+               const ContactParameters& p, std::int64_t rebuilds, double seconds);
+  const Vec3Array& u_build() const { return u_build_; }
+
   const ContactPairs& pairs() const { return pairs_; }
   std::int64_t rebuilds() const { return rebuilds_; }  // builds including the first
   double seconds() const { return seconds_; }          // wall time spent searching [s]

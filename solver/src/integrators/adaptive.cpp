@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "forces/pmb.hpp"
@@ -47,6 +48,19 @@ void AdaptiveStep::initialize(State& state, double t) {
   motion_.assign(n, 0.0);
   report_ = StepReport{};
   proposal_ = 0.0;
+}
+
+std::vector<char> AdaptiveStep::save_state() const {
+  std::vector<char> bytes = Integrator::save_state();
+  const std::size_t at = bytes.size();
+  bytes.resize(at + sizeof proposal_);
+  std::memcpy(bytes.data() + at, &proposal_, sizeof proposal_);
+  return bytes;
+}
+
+void AdaptiveStep::load_state(const std::vector<char>& bytes) {
+  load_report(bytes, sizeof proposal_);
+  std::memcpy(&proposal_, bytes.data() + kReportBytes, sizeof proposal_);
 }
 
 void AdaptiveStep::update(const State& s, const Vec3Array& f_imp, double t, double t1, double dt) {

@@ -54,6 +54,10 @@ class AdaptiveStep : public Integrator {
   // dt out: the step taken. last_step().next_dt is the controller's proposal for the next step.
   void step(State& state, double& t, double& dt) override;
 
+  // The base state plus proposal_ (what a shortened step is measured against).
+  std::vector<char> save_state() const override;
+  void load_state(const std::vector<char>& bytes) override;
+
   const AdaptiveSettings& settings() const { return settings_; }
   double dt_min() const { return dt_min_; }
   double dt_max() const { return dt_max_; }

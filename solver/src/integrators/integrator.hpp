@@ -3,9 +3,11 @@
 // (the adaptive Zohdi scheme, integrators/adaptive.hpp) may have changed. Plus the force evaluation and
 // energy bookkeeping every integrator shares.
 #pragma once
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/case.hpp"
 #include "core/model.hpp"
@@ -39,8 +41,35 @@ class Integrator {
   virtual void initialize(State& state, double t) = 0;
   virtual void step(State& state, double& t, double& dt) = 0;
   const StepReport& last_step() const { return report_; }
+  // The integrator's own state between steps (a checkpoint, io/checkpoint.hpp), as bytes: the last
+  // report (history.csv reads it) plus what a subclass carries from step to step (the adaptive
+  // proposal). load_state() after initialize() continues bitwise as if never stopped.
+  virtual std::vector<char> save_state() const {
+    std::vector<char> bytes;
+    auto put = [&bytes](const auto& value) {
+      const auto* p = reinterpret_cast<const char*>(&value);
+      bytes.insert(bytes.end(), p, p + sizeof value);
+    };
+    put(report_.iterations), put(report_.rejected), put(report_.broken_now), put(report_.broken_energy_now);
+    put(report_.force_evaluations), put(report_.next_dt);
+    return bytes;
+  }
+  // Throws std::runtime_error if the bytes are not what save_state() of this integrator writes.
+  virtual void load_state(const std::vector<char>& bytes) { load_report(bytes, 0); }
 
  protected:
+  static constexpr std::size_t kReportBytes = 3 * sizeof(int) + sizeof(std::int64_t) + 2 * sizeof(double);
+  // Reads what Integrator::save_state wrote; `extra` more bytes follow it (a subclass's own).
+  void load_report(const std::vector<char>& bytes, std::size_t extra) {
+    if (bytes.size() != kReportBytes + extra) throw std::runtime_error("integrator state of the wrong size");
+    std::size_t at = 0;
+    auto get = [&](auto& value) {
+      std::memcpy(&value, bytes.data() + at, sizeof value);
+      at += sizeof value;
+    };
+    get(report_.iterations), get(report_.rejected), get(report_.broken_now), get(report_.broken_energy_now);
+    get(report_.force_evaluations), get(report_.next_dt);
+  }
   StepReport report_;
 };
 

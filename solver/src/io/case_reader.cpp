@@ -173,7 +173,7 @@ BoundaryCondition read_boundary(const Checker& ck, const json& j, std::size_t k)
 InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "initial_conditions[" + std::to_string(k) + "]";
   ck.object(j, where);
-  ck.known_keys(j, where, {"set", "kind", "component", "value"});
+  ck.known_keys(j, where, {"set", "kind", "component", "value", "gradient"});
   InitialCondition ic;
   ic.set = ck.string(ck.required(j, "set", where + ".set"), where + ".set");
   ic.kind = ck.string(ck.required(j, "kind", where + ".kind"), where + ".kind");
@@ -181,6 +181,11 @@ InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
     ck.fail(where + ".kind", "unknown kind '" + ic.kind + "'; known: velocity, displacement");
   ic.component = static_cast<int>(ck.integer(ck.required(j, "component", where + ".component"), where + ".component", 0, 2));
   ic.value = ck.number(ck.required(j, "value", where + ".value"), where + ".value");
+  if (const json* g = ck.optional(j, "gradient"); g && !g->is_null()) {
+    ic.gradient = ck.number(*g, where + ".gradient");
+    if (ic.gradient != 0.0 && ic.kind != "displacement")
+      ck.fail(where + ".gradient", "is only allowed for kind displacement (a uniform pre-strain)");
+  }
   return ic;
 }
 
@@ -389,13 +394,19 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 
   const json& output = ck.object(ck.required(root, "output", "output"), "output");
-  ck.known_keys(output, "output", {"every_time", "every_steps", "history_every", "reactions"});
+  ck.known_keys(output, "output",
+                {"every_time", "every_steps", "history_every", "reactions", "restart_every_time", "restart_every_steps"});
   if (const json* j = ck.optional(output, "every_time"); j && !j->is_null())
     c.output.every_time = ck.positive(*j, "output.every_time");
   if (const json* j = ck.optional(output, "every_steps"); j && !j->is_null())
     c.output.every_steps = ck.integer(*j, "output.every_steps", 1, std::numeric_limits<std::int64_t>::max());
   if (c.output.every_time.has_value() == c.output.every_steps.has_value())
     ck.fail("output", "exactly one of every_time and every_steps must be set (not null)");
+  if (const json* j = ck.optional(output, "restart_every_time"); j && !j->is_null())
+    c.output.restart_every_time = ck.positive(*j, "output.restart_every_time");
+  if (const json* j = ck.optional(output, "restart_every_steps"); j && !j->is_null())
+    c.output.restart_every_steps =
+        ck.integer(*j, "output.restart_every_steps", 1, std::numeric_limits<std::int64_t>::max());
   if (const json* j = ck.optional(output, "history_every"))
     c.output.history_every = ck.integer(*j, "output.history_every", 1, std::numeric_limits<std::int64_t>::max());
   if (const json* j = ck.optional(output, "reactions")) {

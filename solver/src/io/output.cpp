@@ -1,8 +1,16 @@
 // Writers of frames, the .pvd collection, history.csv and run.log.
 #include "io/output.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 
@@ -53,21 +61,83 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
   write_vtu(path, g);
 }
 
-OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns)
+namespace {
+
+double clock_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string frame_file(std::size_t k) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frames/frame_%06zu.vtu", k);
+  return name;
+}
+
+}  // namespace
+
+OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns,
+                           const OutputResume* resume)
     : dir_(std::move(output_dir)) {
   std::error_code ec;
   std::filesystem::create_directories(dir_ / "frames", ec);
   if (ec) throw Error((dir_ / "frames").string() + ": cannot create the directory: " + ec.message());
-  // Frames of an earlier, longer run would otherwise sit next to the new ones.
-  static const std::regex frame_name("frame_[0-9]{6}\\.vtu(\\.part)?");
-  for (const auto& entry : std::filesystem::directory_iterator(dir_ / "frames"))
-    if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), frame_name))
+  std::string header = kHistoryHeader;
+  for (const auto& name : extra_columns) header += ',' + name;
+  header += '\n';
+  const std::filesystem::path history = dir_ / "history.csv";
+  if (resume) {
+    // Every check first, so a refused restart changes no file.
+    history_fd_ = ::open(history.c_str(), O_RDWR | O_CLOEXEC);
+    if (history_fd_ < 0) throw Error(history.string() + ": cannot open for the restart: " + std::strerror(errno));
+    const off_t size = ::lseek(history_fd_, 0, SEEK_END);
+    std::string head(header.size(), '\0');
+    const bool short_file = size < 0 || static_cast<std::uint64_t>(size) < resume->history_bytes;
+    const bool same_header =
+        ::pread(history_fd_, head.data(), head.size(), 0) == static_cast<ssize_t>(head.size()) && head == header;
+    if (short_file || !same_header) {
+      ::close(history_fd_);
+      history_fd_ = -1;
+      finished_ = true;
+      if (short_file)
+        throw Error(history.string() + ": " + std::to_string(size) + " bytes, shorter than the " +
+                    std::to_string(resume->history_bytes) + " the checkpoint wrote; cannot restart");
+      throw Error(history.string() + ": its header is not the one this case writes; cannot restart");
+    }
+    for (std::size_t k = 0; k < resume->frame_times.size(); ++k) {
+      if (!std::filesystem::is_regular_file(dir_ / frame_file(k))) {
+        ::close(history_fd_);
+        history_fd_ = -1;
+        finished_ = true;
+        throw Error((dir_ / frame_file(k)).string() + ": missing, but the checkpoint counts " +
+                    std::to_string(resume->frame_times.size()) + " frames written; cannot restart");
+      }
+      frames_.emplace_back(resume->frame_times[k], frame_file(k));
+    }
+  }
+  // Frames of an earlier, longer run (or written after the checkpoint) would otherwise sit next to
+  // the new ones.
+  static const std::regex frame_name("frame_([0-9]{6})\\.vtu(\\.part)?");
+  std::smatch match;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_ / "frames")) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && std::regex_match(name, match, frame_name) &&
+        (match[2].matched || std::stoul(match[1].str()) >= frames_.size()))
       std::filesystem::remove(entry.path());
-  history_.open(dir_ / "history.csv.part", std::ios::trunc);
-  if (!history_) throw Error((dir_ / "history.csv.part").string() + ": cannot open for writing");
-  history_ << kHistoryHeader;
-  for (const auto& name : extra_columns) history_ << ',' << name;
-  history_ << '\n';
+  }
+  if (resume) {
+    // Rows after the checkpoint (from a run killed later) are cut off: the restart writes them again.
+    if (::ftruncate(history_fd_, static_cast<off_t>(resume->history_bytes)) != 0 ||
+        ::lseek(history_fd_, 0, SEEK_END) < 0)
+      throw Error(history.string() + ": cannot cut back to the checkpoint: " + std::strerror(errno));
+    history_bytes_ = resume->history_bytes;
+    write_pvd();
+  } else {
+    history_fd_ = ::open(history.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (history_fd_ < 0) throw Error(history.string() + ": cannot open for writing: " + std::strerror(errno));
+    history_buffer_ = header;
+    flush_history();
+  }
+  last_flush_ = clock_seconds();
 }
 
 OutputWriter::~OutputWriter() {
@@ -77,11 +147,7 @@ OutputWriter::~OutputWriter() {
   }
 }
 
-void OutputWriter::frame(const Model& model, const State& state, double time, std::int64_t step) {
-  char name[64];
-  std::snprintf(name, sizeof name, "frames/frame_%06d.vtu", frames_written());
-  write_frame(dir_ / name, model, state, time, step);
-  frames_.emplace_back(time, name);
+void OutputWriter::write_pvd() const {
   std::ostringstream pvd;
   pvd.precision(17);
   pvd << "<?xml version=\"1.0\"?>\n"
@@ -91,35 +157,68 @@ void OutputWriter::frame(const Model& model, const State& state, double time, st
     pvd << "    <DataSet timestep=\"" << t << "\" group=\"\" part=\"0\" file=\"" << file << "\"/>\n";
   pvd << "  </Collection>\n</VTKFile>\n";
   write_file_atomically(dir_ / "frames.pvd", pvd.str());
-  history_.flush();
+}
+
+void OutputWriter::frame(const Model& model, const State& state, double time, std::int64_t step) {
+  const std::string name = frame_file(frames_.size());
+  write_frame(dir_ / name, model, state, time, step);
+  frames_.emplace_back(time, name);
+  write_pvd();
+  flush_history();
+}
+
+std::vector<double> OutputWriter::frame_times() const {
+  std::vector<double> times;
+  for (const auto& frame : frames_) times.push_back(frame.first);
+  return times;
 }
 
 void OutputWriter::history(const HistoryRow& r) {
   char line[512];
-  std::snprintf(line, sizeof line, "%lld,%.17g,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%lld,%.6f\n",
+  std::snprintf(line, sizeof line, "%lld,%.17g,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%lld,%.6f",
                 static_cast<long long>(r.step), r.time, r.dt, r.iterations, r.rejected, r.kinetic_energy,
                 r.strain_energy, r.external_work, r.damping_work, static_cast<long long>(r.broken_bonds),
                 r.wall_time);
-  std::string text = line;
-  if (!r.extra.empty()) {
-    text.pop_back();  // the newline
-    for (double value : r.extra) {
-      std::snprintf(line, sizeof line, ",%.17g", value);
-      text += line;
-    }
-    text += '\n';
+  history_buffer_ += line;
+  for (double value : r.extra) {
+    std::snprintf(line, sizeof line, ",%.17g", value);
+    history_buffer_ += line;
   }
-  history_ << text;
+  history_buffer_ += '\n';
+  if (history_buffer_.size() >= (64u << 10) || clock_seconds() - last_flush_ > 1.0) flush_history();
+}
+
+void OutputWriter::flush_history() {
+  const std::string file = (dir_ / "history.csv").string();
+  if (history_fd_ < 0) {
+    if (!history_buffer_.empty()) throw Error(file + ": written after it was closed");
+    return;
+  }
+  std::size_t done = 0;
+  while (done < history_buffer_.size()) {
+    const ssize_t w = ::write(history_fd_, history_buffer_.data() + done, history_buffer_.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) throw Error(file + ": write failed (disk full?): " + std::strerror(errno));
+    done += static_cast<std::size_t>(w);
+  }
+  history_bytes_ += history_buffer_.size();
+  history_buffer_.clear();
+  last_flush_ = clock_seconds();
 }
 
 void OutputWriter::finish() {
   if (finished_) return;
   finished_ = true;
-  history_.close();
-  if (!history_) throw Error((dir_ / "history.csv.part").string() + ": write failed (disk full?)");
-  std::error_code ec;
-  std::filesystem::rename(dir_ / "history.csv.part", dir_ / "history.csv", ec);
-  if (ec) throw Error((dir_ / "history.csv").string() + ": cannot rename into place: " + ec.message());
+  flush_history();
+  if (history_fd_ >= 0 && ::close(history_fd_) != 0)
+    throw Error((dir_ / "history.csv").string() + ": write failed (disk full?): " + std::strerror(errno));
+  history_fd_ = -1;
+}
+
+RunLog::RunLog(std::filesystem::path path, bool quiet, bool append) : path_(std::move(path)), quiet_(quiet) {
+  if (!append) return;
+  std::ifstream in(path_, std::ios::binary);
+  text_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 void RunLog::line(const std::string& text) {

@@ -1,5 +1,6 @@
 // Solver output (pipeline/formats.md §4): frames/frame_NNNNNN.vtu, frames.pvd, history.csv, run.log.
-// Every file is written under a temporary name and renamed into place.
+// Frames, frames.pvd and run.log are written under a temporary name and renamed into place;
+// history.csv grows in place by whole lines (see OutputWriter).
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -31,24 +32,47 @@ extern const char* const kHistoryHeader;
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
                  std::int64_t step);
 
+// Where a restarted run picks up its output (io/checkpoint.hpp): the frames written so far and
+// the length of history.csv at the checkpoint.
+struct OutputResume {
+  std::vector<double> frame_times;  // frame k is frames/frame_k.vtu at time frame_times[k]
+  std::uint64_t history_bytes = 0;
+};
+
+// history.csv is written in place, only ever extended by whole lines: rows are buffered and
+// written with one write(2) per flush (at every frame, every second of wall time, when 64 KiB
+// are buffered and at the end), so a killed run leaves complete rows up to its last flush.
 class OutputWriter {
  public:
   // Creates output_dir/frames and removes frame files left by an earlier run there. extra_columns
   // name the HistoryRow::extra values (contact and indenter columns, present only when the scene
-  // has contact or indenters).
-  explicit OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns = {});
+  // has contact or indenters). With `resume`: keeps the frames it lists (throws pd::Error if one
+  // is missing), removes later ones, and cuts history.csv back to history_bytes (throws if it is
+  // shorter or its header differs).
+  explicit OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns = {},
+                        const OutputResume* resume = nullptr);
   ~OutputWriter();
+  OutputWriter(const OutputWriter&) = delete;
+  OutputWriter& operator=(const OutputWriter&) = delete;
 
   void frame(const Model& model, const State& state, double time, std::int64_t step);  // + frames.pvd
   void history(const HistoryRow& row);
-  // Flushes history.csv.part and renames it to history.csv; called at the end (also after a failure).
+  // Writes the buffered rows to history.csv (whole lines, one write); throws pd::Error on failure.
+  void flush_history();
+  // Flushes and closes history.csv; called at the end (also after a failure or an interruption).
   void finish();
   int frames_written() const { return static_cast<int>(frames_.size()); }
+  std::vector<double> frame_times() const;
+  std::uint64_t history_bytes() const { return history_bytes_; }  // on disk, after flush_history()
 
  private:
+  void write_pvd() const;
   std::filesystem::path dir_;
   std::vector<std::pair<double, std::string>> frames_;  // (time, relative file)
-  std::ofstream history_;
+  int history_fd_ = -1;
+  std::string history_buffer_;
+  std::uint64_t history_bytes_ = 0;
+  double last_flush_ = 0.0;  // steady-clock seconds
   bool finished_ = false;
 };
 
@@ -56,7 +80,8 @@ class OutputWriter {
 // atomically after every message so run.log is complete even if the run is killed.
 class RunLog {
  public:
-  RunLog(std::filesystem::path path, bool quiet) : path_(std::move(path)), quiet_(quiet) {}
+  // append: keep what run.log holds already (a restarted run adds to it).
+  RunLog(std::filesystem::path path, bool quiet, bool append = false);
   void line(const std::string& text);
   void error(const std::string& text);  // stderr always, and run.log
 

@@ -1,0 +1,179 @@
+// Writer and reader of checkpoint.bin (io/checkpoint.hpp, pipeline/formats.md §5).
+#include "io/checkpoint.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <type_traits>
+
+#include "core/error.hpp"
+#include "io/vtu.hpp"
+
+namespace pd {
+
+namespace {
+
+constexpr char kMagic[8] = {'P', 'D', 'C', 'K', 'P', 'T', '\r', '\n'};
+constexpr std::uint32_t kByteOrderMark = 0x01020304;
+
+std::uint64_t fnv1a(const char* data, std::size_t size) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (std::size_t k = 0; k < size; ++k) {
+    h ^= static_cast<unsigned char>(data[k]);
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+class Writer {
+ public:
+  template <class T>
+  void scalar(const T& value) {
+    static_assert(std::is_arithmetic_v<T>);
+    const auto* p = reinterpret_cast<const char*>(&value);
+    bytes_.append(p, sizeof value);
+  }
+  template <class T>
+  void array(const std::vector<T>& values) {
+    static_assert(std::is_arithmetic_v<T>);
+    scalar(static_cast<std::uint64_t>(values.size()));
+    if (!values.empty()) bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  }
+  void vec3(const Vec3Array& a) {
+    for (const auto& c : a) array(c);
+  }
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+class Reader {
+ public:
+  Reader(const std::string& bytes, std::size_t begin, std::size_t end, std::string file)
+      : bytes_(bytes), at_(begin), end_(end), file_(std::move(file)) {}
+  template <class T>
+  void scalar(T& value) {
+    static_assert(std::is_arithmetic_v<T>);
+    need(sizeof value);
+    std::memcpy(&value, bytes_.data() + at_, sizeof value);
+    at_ += sizeof value;
+  }
+  template <class T>
+  void array(std::vector<T>& values) {
+    std::uint64_t count = 0;
+    scalar(count);
+    if (count > (end_ - at_) / sizeof(T)) fail("an array runs past the end of the payload");
+    values.resize(static_cast<std::size_t>(count));
+    if (!values.empty()) std::memcpy(values.data(), bytes_.data() + at_, values.size() * sizeof(T));
+    at_ += values.size() * sizeof(T);
+  }
+  void vec3(Vec3Array& a) {
+    for (auto& c : a) array(c);
+  }
+  void done() const {
+    if (at_ != end_) fail("the payload has " + std::to_string(end_ - at_) + " bytes more than expected");
+  }
+  [[noreturn]] void fail(const std::string& what) const { throw Error(file_ + ": not a valid checkpoint: " + what); }
+
+ private:
+  void need(std::size_t size) const {
+    if (end_ - at_ < size) fail("the payload ends early");
+  }
+  const std::string& bytes_;
+  std::size_t at_, end_;
+  std::string file_;
+};
+
+// One field list for both directions, so writer and reader cannot drift apart.
+template <class IO>
+void fields(IO& io, Checkpoint& c) {
+  io.scalar(c.case_hash), io.scalar(c.nodes_hash), io.scalar(c.nodes), io.scalar(c.directed_bonds);
+  std::vector<char> name(c.integrator.begin(), c.integrator.end());
+  io.array(name);
+  c.integrator.assign(name.begin(), name.end());
+  io.scalar(c.step), io.scalar(c.time), io.scalar(c.dt), io.scalar(c.dt_taken);
+  io.scalar(c.last_frame_step), io.scalar(c.next_frame_index), io.scalar(c.next_restart_index);
+  io.scalar(c.broken), io.scalar(c.force_evaluations), io.scalar(c.broken_energy), io.scalar(c.wall_time);
+  io.scalar(c.energy_before), io.scalar(c.energy_streak_start), io.scalar(c.growth_streak);
+  io.array(c.integrator_state);
+  State& s = c.state;
+  io.vec3(s.u), io.vec3(s.v), io.vec3(s.f), io.array(s.w);
+  io.scalar(s.contact_energy);
+  std::vector<double> indenter;
+  for (const auto& force : s.indenter_force) indenter.insert(indenter.end(), force.begin(), force.end());
+  io.array(indenter);
+  s.indenter_force.resize(indenter.size() / 3);
+  for (std::size_t k = 0; k < s.indenter_force.size(); ++k)
+    for (std::size_t d = 0; d < 3; ++d) s.indenter_force[k][d] = indenter[3 * k + d];
+  io.scalar(s.external_power), io.scalar(s.damping_power), io.scalar(s.external_work), io.scalar(s.damping_work);
+  io.array(c.broken_flags);
+  io.scalar(c.contact_rebuilds), io.scalar(c.contact_seconds), io.vec3(c.contact_u_build);
+  io.array(c.frame_times), io.scalar(c.history_bytes);
+}
+
+}  // namespace
+
+std::uint64_t file_hash(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open for reading");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return fnv1a(bytes.data(), bytes.size());
+}
+
+void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint) {
+  Writer payload;
+  fields(payload, const_cast<Checkpoint&>(checkpoint));  // the writer only reads (see fields)
+  Writer file;
+  std::string text(kMagic, sizeof kMagic);
+  file.scalar(kCheckpointVersion);
+  file.scalar(kByteOrderMark);
+  file.scalar(static_cast<std::uint64_t>(payload.bytes().size()));
+  text += file.bytes();
+  text += payload.bytes();
+  Writer sum;
+  sum.scalar(fnv1a(payload.bytes().data(), payload.bytes().size()));
+  text += sum.bytes();
+  write_file_atomically(path, text);
+}
+
+Checkpoint read_checkpoint(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open the checkpoint for reading");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string file = path.string();
+  constexpr std::size_t kHead = sizeof kMagic + 4 + 4 + 8;
+  if (bytes.size() < kHead || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw Error(file + ": not a pdsolve checkpoint (no PDCKPT header)");
+  Reader head(bytes, sizeof kMagic, kHead, file);
+  std::uint32_t version = 0, mark = 0;
+  std::uint64_t size = 0;
+  head.scalar(version), head.scalar(mark), head.scalar(size);
+  if (mark != kByteOrderMark) throw Error(file + ": checkpoint written on a machine of the other byte order");
+  if (version != kCheckpointVersion)
+    throw Error(file + ": checkpoint format version " + std::to_string(version) + ", this pdsolve reads version " +
+                std::to_string(kCheckpointVersion));
+  if (size > bytes.size() - kHead || bytes.size() - kHead - size != 8)
+    throw Error(file + ": checkpoint truncated or padded: " + std::to_string(bytes.size()) + " bytes, the header says " +
+                std::to_string(kHead + size + 8));
+  std::uint64_t stored = 0;
+  std::memcpy(&stored, bytes.data() + kHead + size, sizeof stored);
+  if (stored != fnv1a(bytes.data() + kHead, static_cast<std::size_t>(size)))
+    throw Error(file + ": checkpoint checksum mismatch (the file is damaged)");
+  Checkpoint c;
+  Reader payload(bytes, kHead, kHead + static_cast<std::size_t>(size), file);
+  fields(payload, c);
+  payload.done();
+  const std::size_t n = c.state.u[0].size();
+  for (const auto* a : {&c.state.u, &c.state.v, &c.state.f})
+    for (const auto& comp : *a)
+      if (comp.size() != n) payload.fail("arrays of different lengths");
+  if (c.state.w.size() != n || c.nodes != n) payload.fail("arrays of different lengths");
+  for (const auto& comp : c.contact_u_build)
+    if (comp.size() != c.contact_u_build[0].size() || (!comp.empty() && comp.size() != n))
+      payload.fail("arrays of different lengths");
+  if (c.integrator.empty()) payload.fail("no integrator name");
+  return c;
+}
+
+}  // namespace pd

@@ -1,0 +1,66 @@
+// The checkpoint file out/<case>/checkpoint.bin: everything the time loop needs to continue a run
+// bitwise as if it had never stopped (pipeline/formats.md §5).
+//
+// Layout (little-endian): 8 bytes magic "PDCKPT\r\n", uint32 format version (kCheckpointVersion),
+// uint32 byte-order mark 0x01020304, uint64 payload size, the payload, then uint64 FNV-1a-64 of
+// the payload. The payload is a fixed sequence of scalars and arrays (an array: uint64 count,
+// then the raw elements), in the order of the fields of Checkpoint below.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/nodes.hpp"
+#include "core/state.hpp"
+
+namespace pd {
+
+constexpr std::uint32_t kCheckpointVersion = 1;
+
+struct Checkpoint {
+  // What it belongs to: a restart refuses a checkpoint of another case or node file.
+  std::uint64_t case_hash = 0;   // FNV-1a-64 of the case.json bytes
+  std::uint64_t nodes_hash = 0;  // FNV-1a-64 of the node-file bytes
+  std::uint64_t nodes = 0, directed_bonds = 0;
+  std::string integrator;
+
+  // The time loop (run.cpp).
+  std::int64_t step = 0;
+  double time = 0.0;
+  double dt = 0.0;        // the step the loop will try next (Verlet's dt, or the adaptive proposal)
+  double dt_taken = 0.0;  // the last step taken
+  std::int64_t last_frame_step = -1, next_frame_index = 1, next_restart_index = 1;
+  std::int64_t broken = 0, force_evaluations = 0;
+  double broken_energy = 0.0;
+  double wall_time = 0.0;  // seconds of time loop before this checkpoint (history.csv's wall_time goes on)
+  double energy_before = -1.0, energy_streak_start = 0.0;  // the blow-up watch
+  std::int64_t growth_streak = 0;
+  std::vector<char> integrator_state;  // Integrator::save_state()
+
+  State state;
+  std::vector<std::uint8_t> broken_flags;  // BondList::broken
+
+  // The contact Verlet list: rebuilt at restart from the displacement of its last build.
+  std::int64_t contact_rebuilds = 0;
+  double contact_seconds = 0.0;
+  Vec3Array contact_u_build;
+
+  // Output: the frames written so far (their times; file k is frames/frame_k.vtu) and the length
+  // of history.csv at the checkpoint (rows after it, from a run killed later, are cut off).
+  std::vector<double> frame_times;
+  std::uint64_t history_bytes = 0;
+};
+
+// FNV-1a-64 of a file's bytes; throws pd::Error if it cannot be read.
+std::uint64_t file_hash(const std::filesystem::path& path);
+
+// Writes under a temporary name and renames into place: a checkpoint is whole or absent.
+void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
+
+// Throws pd::Error naming the file if it is not a checkpoint of this version, is truncated, or its
+// checksum does not match.
+Checkpoint read_checkpoint(const std::filesystem::path& path);
+
+}  // namespace pd

@@ -1,0 +1,179 @@
+"""End to end: pdsolve stopped by SIGTERM mid-run writes a checkpoint and only whole files, and
+`pdsolve --restart` continues to bitwise the result of an uninterrupted run.
+
+A coarse, short copy of cases/membrane goes through mesh and preprocess as the Makefile calls them;
+pdsolve runs once uninterrupted, once with SIGTERM after a few frames, then restarts.
+"""
+import csv
+import os
+import shutil
+import signal
+import subprocess
+import time
+
+import meshio
+import numpy as np
+import pytest
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+PY = "/usr/bin/python3"
+FRAMES = 50  # frames of the whole run: enough that SIGTERM lands mid-run
+
+
+@pytest.fixture(scope="module")
+def prepared(tmp_path_factory):
+    if not os.path.exists(SOLVER):
+        pytest.fail(f"{SOLVER} is missing: build it with `make solver` (make test does)")
+    work = tmp_path_factory.mktemp("restart")
+    case_dir = work / "cases" / "membrane"
+    case_dir.mkdir(parents=True)
+    shutil.copy(os.path.join(ROOT, "cases", "membrane", "membrane.geo"), case_dir)
+    with open(os.path.join(ROOT, "cases", "membrane", "membrane.yaml"), encoding="utf-8") as stream:
+        case = yaml.safe_load(stream)
+    case["discretization"]["dx"] = 0.002
+    case["node_sets"]["clamped"]["layer"] = 0.006
+    case["time"]["end"] = 1.0e-2
+    case["output"] = {"every_time": 1.0e-2 / FRAMES, "restart_every_steps": 500}
+    case["figures"]["times"] = [0.0]
+    yaml_path = case_dir / "membrane.yaml"
+    yaml_path.write_text(yaml.safe_dump(case))
+    out = work / "prepared"
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    for args in (
+        (PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(case_dir / "membrane.geo"), str(out / "mesh.msh")),
+        (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
+    ):
+        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+    return work, out
+
+
+def copy_case(prepared, name):
+    work, out = prepared
+    target = work / name
+    target.mkdir()
+    for f in ("case.json", "nodes.vtu"):
+        shutil.copy(out / f, target / f)
+    return target
+
+
+@pytest.fixture(scope="module")
+def runs(prepared):
+    whole = copy_case(prepared, "whole")
+    result = subprocess.run([SOLVER, str(whole / "case.json"), "--quiet", "--threads", "1"],
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+
+    cut = copy_case(prepared, "cut")
+    proc = subprocess.Popen([SOLVER, str(cut / "case.json"), "--quiet", "--threads", "1"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and proc.poll() is None:
+        if (cut / "frames" / "frame_000004.vtu").exists():
+            break
+        time.sleep(0.01)
+    assert proc.poll() is None, "the run ended before it could be interrupted"
+    proc.send_signal(signal.SIGTERM)
+    stdout, stderr = proc.communicate(timeout=300)
+    interrupted = {"code": proc.returncode, "stderr": stderr,
+                   "frames": sorted(os.listdir(cut / "frames")),
+                   "files": sorted(os.listdir(cut)),
+                   "history": (cut / "history.csv").read_text()}
+
+    restart = subprocess.run([SOLVER, str(cut / "case.json"), "--quiet", "--threads", "1",
+                              "--restart", str(cut / "checkpoint.bin")],
+                             capture_output=True, text=True, timeout=600)
+    assert restart.returncode == 0, restart.stderr
+    return whole, cut, interrupted
+
+
+@pytest.fixture(scope="module")
+def killed(prepared):
+    """SIGKILL (no chance to checkpoint) after some frames; restart from the last periodic checkpoint."""
+    cut = copy_case(prepared, "killed")
+    proc = subprocess.Popen([SOLVER, str(cut / "case.json"), "--quiet", "--threads", "1"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and proc.poll() is None:
+        if (cut / "frames" / "frame_000010.vtu").exists():
+            break
+        time.sleep(0.01)
+    assert proc.poll() is None, "the run ended before it could be killed"
+    proc.kill()
+    proc.wait(timeout=60)
+    history = (cut / "history.csv").read_text()
+    files = sorted(os.listdir(cut))
+    restart = subprocess.run([SOLVER, str(cut / "case.json"), "--quiet", "--threads", "1",
+                              "--restart", str(cut / "checkpoint.bin")],
+                             capture_output=True, text=True, timeout=600)
+    assert restart.returncode == 0, restart.stderr
+    return cut, history, files
+
+
+def test_sigkill_then_restart_from_the_periodic_checkpoint(runs, killed):
+    whole = runs[0]
+    cut, history, files = killed
+    assert "checkpoint.bin" in files
+    width = len(history.splitlines()[0].split(","))
+    assert all(len(line.split(",")) == width for line in history.splitlines()[:-1])
+    for name in sorted(os.listdir(whole / "frames"))[-1:]:
+        a, b = meshio.read(whole / "frames" / name), meshio.read(cut / "frames" / name)
+        for key in ("displacement", "velocity", "damage"):
+            assert np.array_equal(a.point_data[key], b.point_data[key]), f"{name}: {key} differs"
+    rows = read_history(cut / "history.csv")
+    assert [int(r["step"]) for r in rows] == list(range(len(rows)))
+    assert len(rows) == len(read_history(whole / "history.csv"))
+
+
+def read_history(path):
+    with open(path, newline="") as stream:
+        return list(csv.DictReader(stream))
+
+
+def test_sigterm_writes_a_checkpoint_and_exits_143(runs):
+    whole, cut, interrupted = runs
+    assert interrupted["code"] == 128 + signal.SIGTERM, interrupted["stderr"]
+    assert "interrupted by SIGTERM" in interrupted["stderr"]
+    assert "--restart" in interrupted["stderr"]
+    assert "checkpoint.bin" in interrupted["files"]
+    assert 5 <= len(interrupted["frames"]) < FRAMES + 1
+
+
+def test_no_truncated_files_after_sigterm(runs):
+    whole, cut, interrupted = runs
+    assert not [f for f in interrupted["files"] + interrupted["frames"] if f.endswith(".part")]
+    history = interrupted["history"]
+    assert history.endswith("\n"), "history.csv ends in a partial line"
+    width = len(history.splitlines()[0].split(","))
+    assert all(len(line.split(",")) == width for line in history.splitlines())
+
+
+def test_restart_reproduces_the_uninterrupted_run_exactly(runs):
+    whole, cut, _ = runs
+    names = sorted(os.listdir(whole / "frames"))
+    assert names == sorted(os.listdir(cut / "frames"))
+    assert len(names) == FRAMES + 1
+    for name in (names[-1], names[len(names) // 2]):
+        a, b = meshio.read(whole / "frames" / name), meshio.read(cut / "frames" / name)
+        for key in ("displacement", "velocity", "damage"):
+            assert np.array_equal(a.point_data[key], b.point_data[key]), f"{name}: {key} differs"
+    assert (whole / "frames.pvd").read_text() == (cut / "frames.pvd").read_text()
+
+
+def test_history_has_every_step_once_and_the_same_rows(runs):
+    whole, cut, _ = runs
+    a, b = read_history(whole / "history.csv"), read_history(cut / "history.csv")
+    steps = [int(r["step"]) for r in b]
+    assert steps == list(range(len(steps))), "history.csv has duplicated or missing steps"
+    assert len(a) == len(b)
+    for ra, rb in zip(a, b):
+        ra.pop("wall_time"), rb.pop("wall_time")
+        assert ra == rb
+
+
+def test_run_log_tells_the_story(runs):
+    _, cut, _ = runs
+    log = (cut / "run.log").read_text()
+    assert "interrupted: " in log and "restart from" in log and "done: " in log
