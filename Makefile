@@ -3,10 +3,11 @@
 #   make figures case=X       redraw figures and Gmsh views from existing results
 #   make case=X config=Y      run cases/X/Y.yaml (a variant of case X) into out/X-Y/
 #   make test                 build everything and run every test (then test-asan)
-#   make validate             full plate_with_hole, traction, branching runs + checks → out/validate/report.md
+#   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
 #   make fuzz                 libFuzzer on the solver's readers, FUZZ_SECONDS (60) each (clang)
 #   make bench                speed of the bond kernel on 3D bricks → out/bench/speed.csv (docs/performance.md)
+#   make bench-accuracy       error against run time, Verlet vs adaptive → out/bench/accuracy.csv (docs/accuracy.md)
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
@@ -29,7 +30,7 @@ PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
 POST_SOURCES   := $(wildcard postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
 
-.PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench validate
+.PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench bench-accuracy validate
 .DELETE_ON_ERROR:
 
 all: run
@@ -60,10 +61,22 @@ $(OUT)/mesh.msh: $(CASEDIR)/$(case).geo $(OUT)/mesh-parameters.json | $(DEPS)
 $(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
 	$(PY) -m pipeline.run preprocess $< $(MESH) $(OUT)
 
-$(OUT)/history.csv $(OUT)/frames.pvd &: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
-	$(SOLVER) $(OUT)/case.json
+# A stamp, not history.csv, marks a finished solve: an interrupted run keeps its files (Ctrl-C and
+# SIGTERM write checkpoint.bin, pipeline/formats.md §5) and the next `make` resumes it, bitwise as if
+# it had never stopped, as long as the checkpoint is newer than the case, the nodes and the solver.
+CHECKPOINT := $(OUT)/checkpoint.bin
+$(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
+	@if [ -f $(CHECKPOINT) ] && [ $(CHECKPOINT) -nt $(OUT)/case.json ] && [ $(CHECKPOINT) -nt $(OUT)/nodes.vtu ] \
+	    && [ $(CHECKPOINT) -nt $(SOLVER) ]; then \
+	  echo "$(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
+	  $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT); \
+	else \
+	  echo "$(SOLVER) $(OUT)/case.json"; \
+	  $(SOLVER) $(OUT)/case.json; \
+	fi
+	@touch $@
 
-$(OUT)/figures/.done: $(OUT)/history.csv $(OUT)/frames.pvd $(POST_SOURCES)
+$(OUT)/figures/.done: $(OUT)/.solved $(POST_SOURCES)
 	$(PY) -m postprocess $(OUT)
 	@touch $@
 
@@ -116,9 +129,16 @@ BENCH_SIDES ?= 40 46 100
 bench: $(SOLVER)
 	$(PY) solver/bench/speed.py --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
 
+# Error against run time and force evaluations (issue 3): Verlet at several safety factors and at the
+# exact limit, the adaptive step over a sweep of TOL, on a wave and on a fracture problem, against a
+# Verlet run at 1/16 of the step; ACCURACY_ARGS=--quick for a smoke run (docs/accuracy.md).
+ACCURACY_ARGS ?=
+bench-accuracy: $(SOLVER) | $(DEPS)
+	$(PY) -m bench.accuracy --solver $(SOLVER) --out out/bench $(ACCURACY_ARGS)
+
 # The full cases with quantitative checks (validation/): out/validate/report.md and a PNG per case.
 validate: $(SOLVER) | $(DEPS)
-	$(PY) -m validation
+	PDSOLVE=$(SOLVER) $(PY) -m validation
 
 clean-case:
 	rm -rf $(OUT)

@@ -182,7 +182,8 @@ CASE = {
                        above=0.0),
         dt_min=Key("number", "smallest step; not converging there stops the run (default: 1e-6 × "
                    "eq. 2.5)", default=None, unit="s", above=0.0),
-        dt_max=Key("number", "largest step (default: eq. 2.5 without safety factor)", default=None,
+        dt_max=Key("number", "largest step (default: the smaller of eq. 2.5 and 0.9 × Δt_exact/(2φ), "
+                   "where the fixed-point iteration still contracts)", default=None,
                    unit="s", above=0.0),
     ),
     "output": section(
