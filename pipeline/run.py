@@ -11,6 +11,7 @@ name and renamed, so an interrupted stage leaves nothing half-written.
 from __future__ import annotations
 
 import argparse
+import difflib
 import json
 import os
 import sys
@@ -62,22 +63,42 @@ def cmd_mesh(args):
     mesh_geo(args.geo, args.out, case["dimension"], case["geometry"]["parameters"])
 
 
+def missing_block_error(case: dict, mesh: str, err) -> CaseError:
+    """A material whose name is no top-dimension physical group of the mesh, reported at its line
+    of the case file (the mesh is what it was looked up in)."""
+    lines = case["_lines"]
+    messages = []
+    for name, reason in err.missing_blocks.items():
+        line = lines.get(("materials", name), lines.get(("materials",), 1))
+        close = difflib.get_close_matches(name, err.top_groups, n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        messages.append(f"{case['_path']}:{line}: materials.{name}: {reason} in {mesh}{hint}; a material "
+                        f"names the physical group holding its nodes, and the mesh's "
+                        f"{case['dimension']}D groups are: {', '.join(err.top_groups) or 'none'}")
+    return CaseError("\n".join(messages))
+
+
 def cmd_preprocess(args):
-    from preprocess import build_node_cloud
+    from preprocess import PreprocessError, build_node_cloud
     from preprocess.node_file import write_node_file
 
     case = load_case(args.case)
     disc = case["discretization"]
-    cloud = build_node_cloud(
-        args.mesh,
-        dimension=case["dimension"],
-        thickness=case["thickness"],
-        method=disc["method"],
-        dx=disc["dx"],
-        block_names=list(case["materials"]),
-        set_layers={name: opts["layer"] for name, opts in case["node_sets"].items()
-                    if opts["layer"] is not None},
-    )
+    try:
+        cloud = build_node_cloud(
+            args.mesh,
+            dimension=case["dimension"],
+            thickness=case["thickness"],
+            method=disc["method"],
+            dx=disc["dx"],
+            block_names=list(case["materials"]),
+            set_layers={name: opts["layer"] for name, opts in case["node_sets"].items()
+                        if opts["layer"] is not None},
+        )
+    except PreprocessError as err:
+        if not getattr(err, "missing_blocks", None):
+            raise
+        raise missing_block_error(case, args.mesh, err) from err
     resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
                        nodes_file="nodes.vtu")
     # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.

@@ -138,8 +138,12 @@ def _element_blocks(mesh: Mesh, top, dimension, block_names) -> dict[str, np.nda
                 lines.append(f"block '{n}' is a {mesh.groups[n].dim}D physical group, not a {dimension}D one")
             else:
                 lines.append(f"block '{n}' is not a physical group of the mesh")
-        raise PreprocessError(f"{path}: {'; '.join(lines)}; the {dimension}D groups are: "
+        err = PreprocessError(f"{path}: {'; '.join(lines)}; the {dimension}D groups are: "
                               f"{', '.join(g.name for g in top_groups) or 'none'}")
+        # What the driver needs to point at the case file's materials.<name> line instead.
+        err.missing_blocks = dict(zip(missing, lines))
+        err.top_groups = [g.name for g in top_groups]
+        raise err
     for bid, name in enumerate(block_names, start=1):
         for t, idx in mesh.groups[name].cells.items():
             if t not in elem_block:

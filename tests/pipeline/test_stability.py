@@ -203,3 +203,20 @@ def test_every_lattice_node_has_bonds_in_the_membrane_case():
                       block=np.ones(n * n, np.int32), sets={}, grid_spacing=dx, dimension=2)
     resolved = resolve(case, node_sets=["clamped", "centre", "membrane"], grid_spacing=dx, nodes_file="n.vtu")
     assert check_discretized_case(case, resolved, cloud) == []
+
+
+def test_a_material_that_is_no_physical_group_is_reported_at_its_case_line(tmp_path):
+    """Two materials need two 2D physical groups; the square mesh has only 'plate', so 'grip' is
+    reported at its own line of the case file, naming the mesh, before anything is written."""
+    mesh = tmp_path / "square.unv"
+    mesh.write_text(SQUARE_UNV)
+    case = tmp_path / "square.yaml"
+    case.write_text(CASE.replace("time:\n", "  gripp:\n    density: 7800\n    youngs_modulus: 2.0e11\ntime:\n"))
+    out = tmp_path / "out"
+    result = subprocess.run(["/usr/bin/python3", "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
+                            cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.startswith(f"error: {case}:9: materials.gripp: block 'gripp' is not a physical group of "
+                                    f"the mesh in {mesh}; a material names the physical group holding its nodes, "
+                                    f"and the mesh's 2D groups are: plate"), result.stderr
+    assert not out.exists() or not any(out.iterdir())
