@@ -64,15 +64,17 @@ $(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
 # A stamp, not history.csv, marks a finished solve: an interrupted run keeps its files (Ctrl-C and
 # SIGTERM write checkpoint.bin, pipeline/formats.md §5) and the next `make` resumes it, bitwise as if
 # it had never stopped, as long as the checkpoint is newer than the case, the nodes and the solver.
+# exec: the solver replaces the shell, so a SIGTERM that make passes to its child reaches the solver
+# (which then writes its checkpoint) instead of killing a shell and orphaning the solver.
 CHECKPOINT := $(OUT)/checkpoint.bin
 $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
 	@if [ -f $(CHECKPOINT) ] && [ $(CHECKPOINT) -nt $(OUT)/case.json ] && [ $(CHECKPOINT) -nt $(OUT)/nodes.vtu ] \
 	    && [ $(CHECKPOINT) -nt $(SOLVER) ]; then \
 	  echo "$(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
-	  $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT); \
+	  exec $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT); \
 	else \
 	  echo "$(SOLVER) $(OUT)/case.json"; \
-	  $(SOLVER) $(OUT)/case.json; \
+	  exec $(SOLVER) $(OUT)/case.json; \
 	fi
 	@touch $@
 
@@ -136,7 +138,8 @@ ACCURACY_ARGS ?=
 bench-accuracy: $(SOLVER) | $(DEPS)
 	$(PY) -m bench.accuracy --solver $(SOLVER) --out out/bench $(ACCURACY_ARGS)
 
-# The full cases with quantitative checks (validation/): out/validate/report.md and a PNG per case.
+# The full cases and validation/models/ runs with quantitative checks (validation/README.md):
+# out/validate/report.md, a PNG per check and convergence.png.
 validate: $(SOLVER) | $(DEPS)
 	PDSOLVE=$(SOLVER) $(PY) -m validation
 

@@ -26,7 +26,7 @@ const char* const kUsage =
     "                  bitwise as if it had never stopped; refused for another case or node file\n"
     "  --threads N     OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --end-time T    simulated end time [s], overrides time.end\n"
-    "  --max-steps N   stop after N steps at most\n"
+    "  --max-steps N   stop after step N at most (counted from the start of the run, also on a restart)\n"
     "  --quiet         print nothing on stdout and no progress line (run.log is still written)\n"
     "  --help          this text\n"
     "  --version       the solver version and how it was built (compiler, flags, OpenMP, sanitizers)\n"

@@ -7,6 +7,7 @@
 #include <csignal>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -90,9 +91,17 @@ std::int64_t fastest_node(const State& s) {
 }
 
 // SIGINT / SIGTERM: the handler only records the signal; the time loop checks it after each step,
-// writes a checkpoint and stops. SA_RESETHAND: a second signal kills at once.
-volatile std::sig_atomic_t g_signal = 0;
-extern "C" void record_signal(int signal) { g_signal = signal; }
+// writes a checkpoint and stops. The handler then restores the default action of both signals it
+// handles, so a second SIGINT or SIGTERM kills at once. std::atomic, not volatile sig_atomic_t:
+// the signal may arrive on an OpenMP worker thread while the main thread reads the flag.
+std::atomic<int> g_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free, "a signal handler may only touch lock-free atomics");
+std::atomic<bool> g_handles_int{false}, g_handles_term{false};
+extern "C" void record_signal(int signal) {
+  g_signal.store(signal);
+  if (g_handles_int.load()) std::signal(SIGINT, SIG_DFL);  // signal() is async-signal-safe (POSIX)
+  if (g_handles_term.load()) std::signal(SIGTERM, SIG_DFL);
+}
 
 class SignalGuard {
  public:
@@ -107,8 +116,12 @@ class SignalGuard {
     // A signal the caller ignores (SIGINT of a background job of a script, nohup) stays ignored.
     if (old_int_.sa_handler == SIG_IGN) sigaction(SIGINT, &old_int_, nullptr);
     if (old_term_.sa_handler == SIG_IGN) sigaction(SIGTERM, &old_term_, nullptr);
+    g_handles_int = old_int_.sa_handler != SIG_IGN;
+    g_handles_term = old_term_.sa_handler != SIG_IGN;
   }
   ~SignalGuard() {
+    g_handles_int = false;
+    g_handles_term = false;
     sigaction(SIGINT, &old_int_, nullptr);
     sigaction(SIGTERM, &old_term_, nullptr);
   }
@@ -193,42 +206,53 @@ int run(const RunOptions& opt) {
   const bool restarting = !opt.restart.empty();
   Checkpoint ck;
   const std::uint64_t case_hash = file_hash(opt.case_file), nodes_hash = file_hash(c.nodes_file);
+  // Every refusal of a checkpoint says how to start over instead (the Makefile resumes whenever
+  // checkpoint.bin is newer than the case, so a refused one would otherwise block every `make`).
+  const auto start_over = [&](const std::exception& e) {
+    return Error(std::string(e.what()) + "; to start the run over instead, delete " + opt.restart.string());
+  };
   if (restarting) {
-    ck = read_checkpoint(opt.restart);
-    const std::string where = opt.restart.string() + ": ";
-    if (ck.case_hash != case_hash)
-      throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
-                  " changed since it was written); restart with the case.json it was written for");
-    if (ck.nodes_hash != nodes_hash)
-      throw Error(where + "the checkpoint belongs to another node file (or " + c.nodes_file.string() +
-                  " changed since it was written)");
-    if (ck.nodes != n || ck.directed_bonds != model.bonds.directed() || ck.broken_flags.size() != model.bonds.directed() ||
-        ck.integrator != integrator->name() ||
-        (model.contact.pairs && ck.contact_rebuilds > 0 && ck.contact_u_build[0].size() != n))
-      throw Error(where + "the checkpoint does not fit this model (" + std::to_string(ck.nodes) + " nodes, " +
-                  std::to_string(ck.directed_bonds / 2) + " bonds, integrator " + ck.integrator + "; here " +
-                  std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator->name() + ")");
-    if (ck.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
-    // initialize() sizes the integrator's scratch; then everything it set is replaced by the
-    // checkpoint, so the run continues bitwise as if it had never stopped.
-    t = ck.time;
-    integrator->initialize(state, t);
-    state = ck.state;
-    model.bonds.broken = ck.broken_flags;
-    if (model.contact.pairs)
-      model.contact_list.restore(model.nodes.x, ck.contact_u_build, model.block_index, model.contact,
-                                 ck.contact_rebuilds, ck.contact_seconds);
     try {
-      integrator->load_state(ck.integrator_state);
-    } catch (const std::exception& e) {
-      throw Error(where + e.what());
+      ck = read_checkpoint(opt.restart);
+      const std::string where = opt.restart.string() + ": ";
+      if (ck.case_hash != case_hash)
+        throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
+                    " changed since it was written); restart with the case.json it was written for");
+      if (ck.nodes_hash != nodes_hash)
+        throw Error(where + "the checkpoint belongs to another node file (or " + c.nodes_file.string() +
+                    " changed since it was written)");
+      if (ck.nodes != n || ck.directed_bonds != model.bonds.directed() || ck.broken_flags.size() != model.bonds.directed() ||
+          ck.integrator != integrator->name() ||
+          (model.contact.pairs && ck.contact_rebuilds > 0 && ck.contact_u_build[0].size() != n))
+        throw Error(where + "the checkpoint does not fit this model (" + std::to_string(ck.nodes) + " nodes, " +
+                    std::to_string(ck.directed_bonds / 2) + " bonds, integrator " + ck.integrator + "; here " +
+                    std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator->name() + ")");
+      if (ck.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
+      // initialize() sizes the integrator's scratch; then everything it set is replaced by the
+      // checkpoint, so the run continues bitwise as if it had never stopped.
+      t = ck.time;
+      integrator->initialize(state, t);
+      state = std::move(ck.state);  // moved: a restarted run holds one copy of the state
+      model.bonds.broken = std::move(ck.broken_flags);
+      if (model.contact.pairs)
+        model.contact_list.restore(model.nodes.x, ck.contact_u_build, model.block_index, model.contact,
+                                   ck.contact_rebuilds, ck.contact_seconds);
+      try {
+        integrator->load_state(ck.integrator_state);
+      } catch (const std::exception& e) {
+        throw Error(where + e.what());
+      }
+    } catch (const Error& e) {
+      throw start_over(e);
     }
     dt = ck.dt;
   } else {
     apply_initial_conditions(c, model.nodes, state.u, state.v);
     integrator->initialize(state, t);
   }
-  if (first_non_finite(state) >= 0) throw Error(c.file.string() + ": the initial state is not finite");
+  if (first_non_finite(state) >= 0)
+    throw Error((restarting ? opt.restart.string() + ": the checkpoint's state" : c.file.string() + ": the initial state") +
+                " is not finite");
   // Nodes without a bond move freely: only loads and contact act on them (preprocess warns too,
   // but the solver may be run alone).
   std::int64_t isolated = 0, first_isolated = -1;
@@ -249,7 +273,15 @@ int run(const RunOptions& opt) {
   for (const auto& set : c.output.reactions)
     for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("reaction_" + set + "_" + axis);
   OutputResume resume{ck.frame_times, ck.history_bytes};
-  OutputWriter out(c.output_dir, extra_columns, restarting ? &resume : nullptr);
+  const auto open_output = [&]() {
+    try {
+      return OutputWriter(c.output_dir, extra_columns, restarting ? &resume : nullptr);
+    } catch (const Error& e) {  // on a restart: history.csv shorter than recorded, a frame missing
+      if (!restarting) throw;
+      throw start_over(e);
+    }
+  };
+  OutputWriter out = open_output();
   const std::filesystem::path checkpoint_file = (c.output_dir / "checkpoint.bin").lexically_normal();
   // A checkpoint of an earlier run would not match the frames this run writes.
   if (!restarting) std::filesystem::remove(checkpoint_file);
@@ -291,217 +323,225 @@ int run(const RunOptions& opt) {
   log.line("end time " + format("%.6g", end) + " s, steps expected " + std::to_string(steps_expected) +
            (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
 
-  const auto loop_start = Clock::now();
-  const double wall_before = restarting ? ck.wall_time : 0.0;  // time loop of the run(s) before a restart
-  std::int64_t step = 0, broken = broken_bond_count(model), last_frame_step = -1;
-  double broken_energy = 0.0;  // Σ energy of bonds at the moment they broke [J]
-  auto history_row = [&](double dt_taken) {
-    HistoryRow r;
-    r.step = step;
-    r.time = t;
-    r.dt = dt_taken;
-    r.iterations = step == 0 ? 0 : integrator->last_step().iterations;
-    r.rejected = step == 0 ? 0 : integrator->last_step().rejected;
-    r.kinetic_energy = kinetic_energy(model, state);
-    r.strain_energy = stored_strain_energy(model, state);
-    r.external_work = state.external_work;
-    r.damping_work = state.damping_work;
-    r.broken_bonds = broken;
-    r.wall_time = wall_before + seconds_since(loop_start);
-    if (model.contact.pairs || !model.indenters.empty()) r.extra.push_back(state.contact_energy);
-    if (model.contact.pairs) r.extra.push_back(static_cast<double>(model.contact_list.rebuilds()));
-    for (std::size_t k = 0; k < model.indenters.size(); ++k)
-      for (std::size_t d = 0; d < 3; ++d)  // the reaction on the indenter: minus its force on the body
-        r.extra.push_back(k < state.indenter_force.size() ? -state.indenter_force[k][d] : 0.0);
-    if (breakable) r.extra.push_back(broken_energy);
-    for (const auto& set : c.output.reactions)
-      for (double component : reaction_force(model, state, set, t)) r.extra.push_back(component);
-    out.history(r);
-  };
-  std::int64_t next_frame_index = 1;  // every_time: frame k at t ≥ k·every_time
-  auto frame = [&](double dt_taken) {
-    out.frame(model, state, t, step);
-    history_row(dt_taken);
-    last_frame_step = step;
-    if (c.output.every_time) next_frame_index = static_cast<std::int64_t>(std::floor(t / *c.output.every_time * (1.0 + 1e-12))) + 1;
-  };
-  std::int64_t next_restart_index = 1;  // restart_every_time: checkpoint k at t ≥ k·restart_every_time
-  if (!restarting) frame(0.0);
+  // From here on output files exist: an error (a full disk, a failed rename) is a failed run, not
+  // bad input (exit 3, --help), and it goes to run.log too; the frames written so far stay valid.
+  try {
+    const auto loop_start = Clock::now();
+    const double wall_before = restarting ? ck.wall_time : 0.0;  // time loop of the run(s) before a restart
+    std::int64_t step = 0, broken = broken_bond_count(model), last_frame_step = -1;
+    double broken_energy = 0.0;  // Σ energy of bonds at the moment they broke [J]
+    auto history_row = [&](double dt_taken) {
+      HistoryRow r;
+      r.step = step;
+      r.time = t;
+      r.dt = dt_taken;
+      r.iterations = step == 0 ? 0 : integrator->last_step().iterations;
+      r.rejected = step == 0 ? 0 : integrator->last_step().rejected;
+      r.kinetic_energy = kinetic_energy(model, state);
+      r.strain_energy = stored_strain_energy(model, state);
+      r.external_work = state.external_work;
+      r.damping_work = state.damping_work;
+      r.broken_bonds = broken;
+      r.wall_time = wall_before + seconds_since(loop_start);
+      if (model.contact.pairs || !model.indenters.empty()) r.extra.push_back(state.contact_energy);
+      if (model.contact.pairs) r.extra.push_back(static_cast<double>(model.contact_list.rebuilds()));
+      for (std::size_t k = 0; k < model.indenters.size(); ++k)
+        for (std::size_t d = 0; d < 3; ++d)  // the reaction on the indenter: minus its force on the body
+          r.extra.push_back(k < state.indenter_force.size() ? -state.indenter_force[k][d] : 0.0);
+      if (breakable) r.extra.push_back(broken_energy);
+      for (const auto& set : c.output.reactions)
+        for (double component : reaction_force(model, state, set, t)) r.extra.push_back(component);
+      out.history(r);
+    };
+    std::int64_t next_frame_index = 1;  // every_time: frame k at t ≥ k·every_time
+    auto frame = [&](double dt_taken) {
+      out.frame(model, state, t, step);
+      history_row(dt_taken);
+      last_frame_step = step;
+      if (c.output.every_time) next_frame_index = static_cast<std::int64_t>(std::floor(t / *c.output.every_time * (1.0 + 1e-12))) + 1;
+    };
+    std::int64_t next_restart_index = 1;  // restart_every_time: checkpoint k at t ≥ k·restart_every_time
+    if (!restarting) frame(0.0);
 
-  const bool progress = !opt.quiet && isatty(fileno(stderr));
-  auto last_progress = Clock::now();
-  int status = kOk;
-  bool state_valid = true;  // false after a blow-up: that state is never written
-  double dt_taken = 0.0;
-  std::int64_t force_evaluations = 0;
-  // Blow-up watch: an explicit step above its limit makes the energy grow geometrically (×47 per
-  // step at 1.5× the limit); physical loading does not keep up ×1.5 per step for 20 steps.
-  constexpr double kGrowthPerStep = 1.5;
-  constexpr int kGrowthSteps = 20;
-  double energy_before = -1.0, energy_streak_start = 0.0;
-  int growth_streak = 0;
-  if (restarting) {
-    step = ck.step;
-    dt_taken = ck.dt_taken;
-    last_frame_step = ck.last_frame_step;
-    next_frame_index = ck.next_frame_index;
-    next_restart_index = ck.next_restart_index;
-    broken = ck.broken;
-    force_evaluations = ck.force_evaluations;
-    broken_energy = ck.broken_energy;
-    energy_before = ck.energy_before;
-    energy_streak_start = ck.energy_streak_start;
-    growth_streak = static_cast<int>(ck.growth_streak);
-  }
-  // Everything the loop carries from step to step, to checkpoint.bin (written atomically).
-  auto write_restart = [&]() {
-    out.flush_history();
-    Checkpoint k;
-    k.case_hash = case_hash;
-    k.nodes_hash = nodes_hash;
-    k.nodes = n;
-    k.directed_bonds = model.bonds.directed();
-    k.integrator = integrator->name();
-    k.step = step;
-    k.time = t;
-    k.dt = dt;
-    k.dt_taken = dt_taken;
-    k.last_frame_step = last_frame_step;
-    k.next_frame_index = next_frame_index;
-    k.next_restart_index = next_restart_index;
-    k.broken = broken;
-    k.force_evaluations = force_evaluations;
-    k.broken_energy = broken_energy;
-    k.wall_time = wall_before + seconds_since(loop_start);
-    k.energy_before = energy_before;
-    k.energy_streak_start = energy_streak_start;
-    k.growth_streak = growth_streak;
-    k.integrator_state = integrator->save_state();
-    k.state = state;
-    k.broken_flags = model.bonds.broken;
-    k.contact_rebuilds = model.contact_list.rebuilds();
-    k.contact_seconds = model.contact_list.seconds();
-    k.contact_u_build = model.contact_list.u_build();
-    k.frame_times = out.frame_times();
-    k.history_bytes = out.history_bytes();
-    write_checkpoint(checkpoint_file, k);
-  };
-  int interrupted = 0;
-  // Why a run blew up, from the true stability limit (computed now if not yet known).
-  auto likely_cause = [&](double h) {
-    if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
-    const double ratio = h / dt_exact;
-    std::string text = "dt = " + format("%.6g", h) + " s is " + format("%.3g", ratio) + " × the exact stability limit " +
-                       format("%.6g", dt_exact) + " s (eq. 2.5: " + format("%.6g", dt_stable) + " s): ";
-    if (ratio > 1.0 && c.time.integrator == "verlet")
-      return text + "the time step is above the stability limit; use time.dt: stable or exact with safety_factor < 1";
-    return text + "the step is within the linear limit, so look for contact stiffness, large deformation or a load "
-                  "that makes the state jump";
-  };
-  while (step < max_steps && t < end * (1.0 - 1e-12)) {
-    // Land exactly on the end time and on every output time (t = k·every_time): the step that would
-    // cross one is shortened (or stretched by at most kLastStepSlack); dt itself is kept for the
-    // steps after it.
-    double target = end;
-    if (c.output.every_time) target = std::min(end, static_cast<double>(next_frame_index) * *c.output.every_time);
-    double h = dt;
-    const bool landing = target - t <= dt * (1.0 + kLastStepSlack);
-    if (landing) h = target - t;
-    const double requested = h;
-    try {
-      integrator->step(state, t, h);
-    } catch (const StepFailed& e) {
-      log.error("pdsolve: error: step " + std::to_string(step + 1) + ": " + e.what() +
-                "; stopped, the last accepted state is kept");
-      status = kRunFailed;
-      break;
+    const bool progress = !opt.quiet && isatty(fileno(stderr));
+    auto last_progress = Clock::now();
+    int status = kOk;
+    bool state_valid = true;  // false after a blow-up: that state is never written
+    double dt_taken = 0.0;
+    std::int64_t force_evaluations = 0;
+    // Blow-up watch: an explicit step above its limit makes the energy grow geometrically (×47 per
+    // step at 1.5× the limit); physical loading does not keep up ×1.5 per step for 20 steps.
+    constexpr double kGrowthPerStep = 1.5;
+    constexpr int kGrowthSteps = 20;
+    double energy_before = -1.0, energy_streak_start = 0.0;
+    int growth_streak = 0;
+    if (restarting) {
+      step = ck.step;
+      dt_taken = ck.dt_taken;
+      last_frame_step = ck.last_frame_step;
+      next_frame_index = ck.next_frame_index;
+      next_restart_index = ck.next_restart_index;
+      broken = ck.broken;
+      force_evaluations = ck.force_evaluations;
+      broken_energy = ck.broken_energy;
+      energy_before = ck.energy_before;
+      energy_streak_start = ck.energy_streak_start;
+      growth_streak = static_cast<int>(ck.growth_streak);
     }
-    if (landing && h == requested) t = target;  // exact, not t + (target − t) with its round-off
-    dt_taken = h;
-    ++step;
-    broken += integrator->last_step().broken_now;
-    broken_energy += integrator->last_step().broken_energy_now;
-    force_evaluations += integrator->last_step().force_evaluations;
-    if (integrator->last_step().next_dt > 0.0) dt = integrator->last_step().next_dt;
-    if (const std::int64_t bad = first_non_finite(state); bad >= 0) {
-      log.error("pdsolve: error: non-finite displacement or velocity at " + node_text(model, bad) + " after step " +
-                std::to_string(step) + " (t = " + format("%.6g", t) + " s; the largest finite speed is at " +
-                node_text(model, fastest_node(state)) + "); " + likely_cause(h) +
-                "; stopped without writing this state, the last frame written is the last valid one");
-      status = kRunFailed;
-      state_valid = false;
-      break;
+    // Everything the loop carries from step to step, to checkpoint.bin (written atomically).
+    auto write_restart = [&]() {
+      out.flush_history();
+      Checkpoint k;
+      k.case_hash = case_hash;
+      k.nodes_hash = nodes_hash;
+      k.nodes = n;
+      k.directed_bonds = model.bonds.directed();
+      k.integrator = integrator->name();
+      k.step = step;
+      k.time = t;
+      k.dt = dt;
+      k.dt_taken = dt_taken;
+      k.last_frame_step = last_frame_step;
+      k.next_frame_index = next_frame_index;
+      k.next_restart_index = next_restart_index;
+      k.broken = broken;
+      k.force_evaluations = force_evaluations;
+      k.broken_energy = broken_energy;
+      k.wall_time = wall_before + seconds_since(loop_start);
+      k.energy_before = energy_before;
+      k.energy_streak_start = energy_streak_start;
+      k.growth_streak = growth_streak;
+      k.integrator_state = integrator->save_state();
+      k.state = state;
+      k.broken_flags = model.bonds.broken;
+      k.contact_rebuilds = model.contact_list.rebuilds();
+      k.contact_seconds = model.contact_list.seconds();
+      k.contact_u_build = model.contact_list.u_build();
+      k.frame_times = out.frame_times();
+      k.history_bytes = out.history_bytes();
+      write_checkpoint(checkpoint_file, k);
+    };
+    int interrupted = 0;
+    // Why a run blew up, from the true stability limit (computed now if not yet known).
+    auto likely_cause = [&](double h) {
+      if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
+      const double ratio = h / dt_exact;
+      std::string text = "dt = " + format("%.6g", h) + " s is " + format("%.3g", ratio) + " × the exact stability limit " +
+                         format("%.6g", dt_exact) + " s (eq. 2.5: " + format("%.6g", dt_stable) + " s): ";
+      if (ratio > 1.0 && c.time.integrator == "verlet")
+        return text + "the time step is above the stability limit; use time.dt: stable or exact with safety_factor < 1";
+      return text + "the step is within the linear limit, so look for contact stiffness, large deformation or a load "
+                    "that makes the state jump";
+    };
+    while (step < max_steps && t < end * (1.0 - 1e-12)) {
+      // Land exactly on the end time and on every output time (t = k·every_time): the step that would
+      // cross one is shortened (or stretched by at most kLastStepSlack); dt itself is kept for the
+      // steps after it.
+      double target = end;
+      if (c.output.every_time) target = std::min(end, static_cast<double>(next_frame_index) * *c.output.every_time);
+      double h = dt;
+      const bool landing = target - t <= dt * (1.0 + kLastStepSlack);
+      if (landing) h = target - t;
+      const double requested = h;
+      try {
+        integrator->step(state, t, h);
+      } catch (const StepFailed& e) {
+        log.error("pdsolve: error: step " + std::to_string(step + 1) + ": " + e.what() +
+                  "; stopped, the last accepted state is kept");
+        status = kRunFailed;
+        break;
+      }
+      if (landing && h == requested) t = target;  // exact, not t + (target − t) with its round-off
+      dt_taken = h;
+      ++step;
+      broken += integrator->last_step().broken_now;
+      broken_energy += integrator->last_step().broken_energy_now;
+      force_evaluations += integrator->last_step().force_evaluations;
+      if (integrator->last_step().next_dt > 0.0) dt = integrator->last_step().next_dt;
+      if (const std::int64_t bad = first_non_finite(state); bad >= 0) {
+        log.error("pdsolve: error: non-finite displacement or velocity at " + node_text(model, bad) + " after step " +
+                  std::to_string(step) + " (t = " + format("%.6g", t) + " s; the largest finite speed is at " +
+                  node_text(model, fastest_node(state)) + "); " + likely_cause(h) +
+                  "; stopped without writing this state, the last frame written is the last valid one");
+        status = kRunFailed;
+        state_valid = false;
+        break;
+      }
+      const double energy = kinetic_energy(model, state) + stored_strain_energy(model, state) + state.contact_energy;
+      if (energy_before > 0.0 && energy > kGrowthPerStep * energy_before) {
+        if (growth_streak++ == 0) energy_streak_start = energy_before;
+      } else {
+        growth_streak = 0;
+      }
+      energy_before = energy;
+      if (growth_streak >= kGrowthSteps) {
+        log.error("pdsolve: error: the energy grew from " + format("%.3g", energy_streak_start) + " J to " +
+                  format("%.3g", energy) + " J in the " + std::to_string(kGrowthSteps) + " steps up to and after step " +
+                  std::to_string(step) + " (t = " + format("%.6g", t) + " s), at least ×" + format("%g", kGrowthPerStep) +
+                  " every step: the run is unstable, most likely starting at " + node_text(model, fastest_node(state)) +
+                  " (the largest speed); " + likely_cause(h) +
+                  "; stopped without writing this state, the last frame written is the last valid one");
+        status = kRunFailed;
+        state_valid = false;
+        break;
+      }
+      const bool frame_due = c.output.every_steps ? step % *c.output.every_steps == 0
+                                                  : t >= static_cast<double>(next_frame_index) * *c.output.every_time - 1e-9 * h;
+      if (frame_due) frame(h);
+      else if (step % c.output.history_every == 0) history_row(h);
+      // Checkpoints never shorten a step, so a run that writes them takes bitwise the same steps.
+      bool restart_due = c.output.restart_every_steps && step % *c.output.restart_every_steps == 0;
+      if (c.output.restart_every_time && t >= static_cast<double>(next_restart_index) * *c.output.restart_every_time) {
+        restart_due = true;
+        next_restart_index = static_cast<std::int64_t>(std::floor(t / *c.output.restart_every_time)) + 1;
+      }
+      if (opt.after_step) opt.after_step(step);
+      if (g_signal != 0) {
+        interrupted = g_signal;
+        write_restart();
+        break;
+      }
+      if (restart_due) write_restart();
+      if (progress && seconds_since(last_progress) > 0.5) {
+        last_progress = Clock::now();
+        const double elapsed = seconds_since(loop_start);
+        const double fraction = std::max(t / end, static_cast<double>(step) / static_cast<double>(max_steps));
+        std::fprintf(stderr, "\rstep %lld/%lld  t = %.4g s  %5.1f%%  ETA %s   ", static_cast<long long>(step),
+                     static_cast<long long>(steps_expected), t, 100.0 * fraction,
+                     duration_text(elapsed * (1.0 - fraction) / std::max(fraction, 1e-12)).c_str());
+        std::fflush(stderr);
+      }
     }
-    const double energy = kinetic_energy(model, state) + stored_strain_energy(model, state) + state.contact_energy;
-    if (energy_before > 0.0 && energy > kGrowthPerStep * energy_before) {
-      if (growth_streak++ == 0) energy_streak_start = energy_before;
-    } else {
-      growth_streak = 0;
-    }
-    energy_before = energy;
-    if (growth_streak >= kGrowthSteps) {
-      log.error("pdsolve: error: the energy grew from " + format("%.3g", energy_streak_start) + " J to " +
-                format("%.3g", energy) + " J in the " + std::to_string(kGrowthSteps) + " steps up to and after step " +
-                std::to_string(step) + " (t = " + format("%.6g", t) + " s), at least ×" + format("%g", kGrowthPerStep) +
-                " every step: the run is unstable, most likely starting at " + node_text(model, fastest_node(state)) +
-                " (the largest speed); " + likely_cause(h) +
-                "; stopped without writing this state, the last frame written is the last valid one");
-      status = kRunFailed;
-      state_valid = false;
-      break;
-    }
-    const bool frame_due = c.output.every_steps ? step % *c.output.every_steps == 0
-                                                : t >= static_cast<double>(next_frame_index) * *c.output.every_time - 1e-9 * h;
-    if (frame_due) frame(h);
-    else if (step % c.output.history_every == 0) history_row(h);
-    // Checkpoints never shorten a step, so a run that writes them takes bitwise the same steps.
-    bool restart_due = c.output.restart_every_steps && step % *c.output.restart_every_steps == 0;
-    if (c.output.restart_every_time && t >= static_cast<double>(next_restart_index) * *c.output.restart_every_time) {
-      restart_due = true;
-      next_restart_index = static_cast<std::int64_t>(std::floor(t / *c.output.restart_every_time)) + 1;
-    }
-    if (opt.after_step) opt.after_step(step);
-    if (g_signal != 0) {
-      interrupted = g_signal;
-      write_restart();
-      break;
-    }
-    if (restart_due) write_restart();
-    if (progress && seconds_since(last_progress) > 0.5) {
-      last_progress = Clock::now();
-      const double elapsed = seconds_since(loop_start);
-      const double fraction = std::max(t / end, static_cast<double>(step) / static_cast<double>(max_steps));
-      std::fprintf(stderr, "\rstep %lld/%lld  t = %.4g s  %5.1f%%  ETA %s   ", static_cast<long long>(step),
-                   static_cast<long long>(steps_expected), t, 100.0 * fraction,
-                   duration_text(elapsed * (1.0 - fraction) / std::max(fraction, 1e-12)).c_str());
-      std::fflush(stderr);
-    }
-  }
-  if (progress) std::fprintf(stderr, "\r%70s\r", "");
-  // An interrupted run writes no last frame: the restart goes on with the frames of an uninterrupted run.
-  if (state_valid && !interrupted && last_frame_step != step) frame(dt_taken);
-  out.finish();
+    if (progress) std::fprintf(stderr, "\r%70s\r", "");
+    // An interrupted run writes no last frame: the restart goes on with the frames of an uninterrupted run.
+    if (state_valid && !interrupted && last_frame_step != step) frame(dt_taken);
+    out.finish();
 
-  const double wall = seconds_since(loop_start);
-  const double updates = static_cast<double>(model.bonds.directed()) * static_cast<double>(step);
-  log.line(std::string(interrupted ? "interrupted" : status == kOk ? "done" : "stopped") + ": " + std::to_string(step) + " steps to t = " +
-           format("%.6g", t) + " s in " + format("%.3f", wall) + " s wall (" +
-           format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
-           std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds, " +
-           std::to_string(force_evaluations) + " force evaluations");
-  if (model.contact.pairs)
-    log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
-             std::to_string(step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
-             std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
-  if (interrupted) {
-    log.error("pdsolve: interrupted by " + std::string(signal_name(interrupted)) + " after step " + std::to_string(step) +
-              " (t = " + format("%.6g", t) + " s); checkpoint written to " + checkpoint_file.string() +
-              "; continue with: pdsolve " + opt.case_file.string() + " --restart " + checkpoint_file.string());
-    return kInterruptedBase + interrupted;
+    const double wall = seconds_since(loop_start);
+    const double updates = static_cast<double>(model.bonds.directed()) * static_cast<double>(step);
+    log.line(std::string(interrupted ? "interrupted" : status == kOk ? "done" : "stopped") + ": " + std::to_string(step) + " steps to t = " +
+             format("%.6g", t) + " s in " + format("%.3f", wall) + " s wall (" +
+             format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
+             std::to_string(out.frames_written()) + " frames, " + std::to_string(broken) + " broken bonds, " +
+             std::to_string(force_evaluations) + " force evaluations");
+    if (model.contact.pairs)
+      log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
+               std::to_string(step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
+               std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
+    if (interrupted) {
+      log.error("pdsolve: interrupted by " + std::string(signal_name(interrupted)) + " after step " + std::to_string(step) +
+                " (t = " + format("%.6g", t) + " s); checkpoint written to " + checkpoint_file.string() +
+                "; continue with: pdsolve " + opt.case_file.string() + " --restart " + checkpoint_file.string());
+      return kInterruptedBase + interrupted;
+    }
+    if (status == kOk && step >= max_steps && t < end * (1.0 - 1e-12))
+      log.line("note: stopped at max_steps " + std::to_string(max_steps) + " before the end time");
+    return status;
+  } catch (const Error& e) {
+    log.error(std::string("pdsolve: error during the run: ") + e.what() +
+              "; the frames and history rows written before it are complete");
+    return kRunFailed;
   }
-  if (status == kOk && step >= max_steps && t < end * (1.0 - 1e-12))
-    log.line("note: stopped at max_steps " + std::to_string(max_steps) + " before the end time");
-  return status;
 }
 
 }  // namespace pd

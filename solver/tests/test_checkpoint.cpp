@@ -392,11 +392,7 @@ TEST(Checkpoint, AdaptiveIntegratorStateCarriesItsProposal) {
   // proposes exactly what the original does; for some shortening, one without the state does not.
   int differs = 0;
   for (double fraction : {0.99, 0.95, 0.9, 0.8, 0.6, 0.4, 0.2}) {
-    pd::AdaptiveStep orig(m1);
-    orig.configure(c);
-    pd::State scratch(m1.nodes.size());
-    orig.initialize(scratch, t);
-    orig.load_state(saved);
+    pd::AdaptiveStep orig(a);  // a copy of the original integrator itself, never saved or loaded
     auto b = restored(m2, true), fresh = restored(m3, false);
     pd::State sa = s, sb = s, sc = s;
     double ta = t, tb = t, tc = t, ha = fraction * dt, hb = ha, hc = ha;

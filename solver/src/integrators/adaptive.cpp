@@ -7,6 +7,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/error.hpp"
 #include "core/stability.hpp"
 #include "forces/pmb.hpp"
 
@@ -39,6 +40,12 @@ void AdaptiveStep::configure(const Case& c) {
   }
   dt_max_ = settings_.dt_max.value_or(dt_max);
   dt_min_ = settings_.dt_min.value_or(std::min(1e-6 * scale, dt_max_));
+  // The reader checks dt_min ≤ dt_max when both are given; a default Δt_max can still fall below a
+  // given dt_min, and then the first rejected attempt would end the run.
+  if (dt_min_ > dt_max_)
+    throw Error(c.file.string() + ": adaptive.dt_min = " + number(dt_min_) + " s is above the default dt_max = " +
+                number(dt_max_) + " s (eq. 2.5 and the contraction limit of the fixed-point iteration); lower "
+                "adaptive.dt_min or give adaptive.dt_max");
 }
 
 void AdaptiveStep::initialize(State& state, double t) {
