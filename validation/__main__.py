@@ -11,15 +11,20 @@ import subprocess
 import sys
 import time
 
-from . import branching, plate_with_hole, traction
+from . import branching, convergence, drum, plate_with_hole, static, traction, wave
 from .figures import FIGURES
 from .runner import ROOT
 
-CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks}
+CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks,
+          "drum": drum.checks}
+# Checks that run their own small models (validation/models/) into out/validate/work/<name>/ and
+# draw their own PNG: validate(report_dir) -> rows.
+MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.validate, "static": static.validate}
 
 
 def main(argv: list[str]) -> int:
-    cases = argv or list(CHECKS)
+    cases = argv or list(CHECKS) + list(MODEL_CHECKS)
+    begin = time.monotonic()
     report_dir = os.path.join(ROOT, "out", "validate")
     os.makedirs(report_dir, exist_ok=True)
     lines = ["# Validation report", "",
@@ -28,8 +33,25 @@ def main(argv: list[str]) -> int:
     notes, failed = [], 0
     for case in cases:
         start = time.monotonic()
+        if case in MODEL_CHECKS:
+            try:
+                rows = MODEL_CHECKS[case](report_dir)
+            except Exception as error:  # a failed run is a failed check, the others still run
+                lines.append(f"| {case} | the runs | succeed | {type(error).__name__}: "
+                             f"{str(error).splitlines()[0][:200] if str(error) else ''} | **NO** |")
+                failed += 1
+                continue
+            for row in rows:
+                lines.append(row.row())
+                failed += not row.passed
+                if row.note:
+                    notes.append(f"- {case}, {row.quantity}: {row.note}")
+            notes.append(f"- {case}: runs and checks {time.monotonic() - start:.0f} s")
+            continue
         # $PDSOLVE (a solver built elsewhere) is handed to make as SOLVER, as runner.py does.
-        solver = [f"SOLVER={os.environ['PDSOLVE']}"] if os.environ.get("PDSOLVE") else []
+        # (-o: make must not try to rebuild a solver built elsewhere)
+        solver = ([f"SOLVER={os.environ['PDSOLVE']}", "-o", os.environ["PDSOLVE"]]
+                  if os.environ.get("PDSOLVE") else [])
         make = subprocess.run(["make", "--no-print-directory", f"case={case}", *solver], cwd=ROOT)
         if make.returncode != 0:
             lines.append(f"| {case} | the run | `make case={case}` succeeds | exit {make.returncode} | **NO** |")
@@ -46,6 +68,11 @@ def main(argv: list[str]) -> int:
             done = [l for l in stream if l.startswith(("done", "stopped"))]
         notes.append(f"- {case}: {done[-1].strip() if done else 'no solver summary'} "
                      f"(make and checks: {time.monotonic() - start:.0f} s)")
+    if {"wave", "static", "drum_convergence"} & set(cases):
+        convergence.figure(getattr(static.validate, "result", None), getattr(wave.validate, "result", None),
+                           os.path.join(report_dir, "convergence.png"),
+                           getattr(drum.validate_convergence, "result", None))
+    notes.append(f"- total `make validate` time: {time.monotonic() - begin:.0f} s")
     lines += ["", "## Notes", ""] + notes + [""]
     with open(os.path.join(report_dir, "report.md"), "w", encoding="utf-8") as stream:
         stream.write("\n".join(lines))

@@ -5,7 +5,7 @@ import numpy as np
 
 from postprocess.plotting import new_figure, save_figure
 
-from . import branching, plate_with_hole, traction
+from . import branching, drum, plate_with_hole, traction
 from .common import Run
 
 
@@ -66,4 +66,38 @@ def branching_figure(out_dir: str, path: str):
     save_figure(fig, path)
 
 
-FIGURES = {"plate_with_hole": plate_with_hole_figure, "traction": traction_figure, "branching": branching_figure}
+def drum_figure(out_dir: str, path: str):
+    """The modal coordinate q(t) with the fitted sinusoid and the membrane formula's period marked,
+    and the energy error against time."""
+    run = Run(out_dir)
+    t, q = drum.modal_coordinate(run)
+    f_theory = drum.theory_frequency(run)
+    f_zero, _ = drum.zero_crossing_frequency(t, q)
+    f_fit = drum.fitted_frequency(t, q, f_zero)
+    amplitude = np.max(np.abs(q))
+    tt = np.linspace(0.0, t[-1], 2000)
+    fig, axes = new_figure(2, 1, size=(7.0, 7.0))
+    ax = axes[0, 0]
+    ax.plot(t * 1e3, q * 1e6, "o", ms=3, label="peridynamics: modal coordinate of w")
+    ax.plot(tt * 1e3, amplitude * np.sin(2 * np.pi * f_theory * tt) * 1e6, "k--", lw=1,
+            label=f"membrane formula, f = {f_theory:.1f} Hz")
+    ax.plot(tt * 1e3, amplitude * np.sin(2 * np.pi * f_fit * tt) * 1e6, "C1-", lw=1,
+            label=f"fit, f = {f_fit:.1f} Hz ({f_fit / f_theory - 1:+.2%})")
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("fundamental-mode amplitude [µm]")
+    length, _ = drum.geometry(run)
+    ax.set_title(f"drum: ε0 = {drum.pre_strain(run):g}, L/dx = {length / run.dx:.0f}, no damping")
+    ax.legend(loc="lower left", fontsize=8)
+    ax.grid(alpha=0.3)
+    ax = axes[1, 0]
+    h = run.history
+    energy = h["kinetic_energy"] + h["strain_energy"] - h["external_work"] + h["damping_work"]
+    ax.plot(h["time"] * 1e3, (energy - energy[0]) / h["kinetic_energy"][0])
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("(KE + U − W_ext − E(0)) / KE(0)")
+    ax.grid(alpha=0.3)
+    save_figure(fig, path)
+
+
+FIGURES = {"plate_with_hole": plate_with_hole_figure, "traction": traction_figure, "branching": branching_figure,
+           "drum": drum_figure}

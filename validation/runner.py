@@ -34,13 +34,14 @@ def deep_update(base: dict, changes: dict) -> dict:
 
 
 def run_case(case: str, work: str, changes: dict | None = None, *, figures: bool = True,
-             timeout: float = 1800.0) -> tuple[str, float]:
+             timeout: float = 1800.0, source: str | None = None) -> tuple[str, float]:
     """Copy cases/<case>/<case>.geo and the .yaml with `changes` merged in to work/cases/<case>/,
-    run every stage into work/out/<case>/, and return (out_dir, solver wall seconds)."""
+    run every stage into work/out/<case>/, and return (out_dir, solver wall seconds).
+    source: another folder holding <case>.geo and <case>.yaml (validation/models/)."""
     solver = solver_path()
     if not os.path.exists(solver):
         raise FileNotFoundError(f"{solver} is missing: build it with `make solver` (make test does)")
-    source = os.path.join(ROOT, "cases", case)
+    source = source or os.path.join(ROOT, "cases", case)
     case_dir = os.path.join(work, "cases", case)
     os.makedirs(case_dir, exist_ok=True)
     shutil.copy(os.path.join(source, f"{case}.geo"), case_dir)
