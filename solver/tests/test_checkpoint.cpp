@@ -19,6 +19,7 @@
 #include "io/checkpoint.hpp"
 #include "io/node_file.hpp"
 #include "io/vtu.hpp"
+#include "files.hpp"
 #include "lattice.hpp"
 #include "run.hpp"
 
@@ -26,17 +27,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pd_test_ckpt_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+fs::path temp_dir(const std::string& name) { return pdtest::temp_dir("ckpt_" + name); }
+using pdtest::slurp;
 
 void replace(std::string& text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);

@@ -12,23 +12,15 @@
 
 #include "io/node_file.hpp"
 #include "io/vtu.hpp"
+#include "files.hpp"
 #include "lattice.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pd_test_time_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+fs::path temp_dir(const std::string& name) { return pdtest::temp_dir("time_" + name); }
+using pdtest::slurp;
 
 int run_solver(const fs::path& dir) {
   const std::string command = std::string(PDSOLVE_PATH) + " " + (dir / "case.json").string() + " --threads 1 --quiet > " +

@@ -14,19 +14,13 @@ import pytest
 import yaml
 from scipy.spatial import cKDTree
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SOLVER = os.path.join(ROOT, "build", "solver", "pdsolve")
-PY = "/usr/bin/python3"
+from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
 DX = 2.5e-4
 
 
 @pytest.fixture(scope="module")
 def impact_run(tmp_path_factory):
-    if not os.path.exists(SOLVER):
-        pytest.fail(f"{SOLVER} is missing: build it with `make solver` (make test does)")
-    work = tmp_path_factory.mktemp("impact")
-    case_dir = work / "cases" / "impact"
-    case_dir.mkdir(parents=True)
+    work, case_dir = new_case_folder(tmp_path_factory, "impact", "impact")
     shutil.copy(os.path.join(ROOT, "cases", "impact", "impact.geo"), case_dir)
     with open(os.path.join(ROOT, "cases", "impact", "impact.yaml"), encoding="utf-8") as stream:
         case = yaml.safe_load(stream)

@@ -13,18 +13,12 @@ import numpy as np
 import pytest
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SOLVER = os.path.join(ROOT, "build", "solver", "pdsolve")
-PY = "/usr/bin/python3"
+from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def membrane_run(tmp_path_factory):
-    if not os.path.exists(SOLVER):
-        pytest.fail(f"{SOLVER} is missing: build it with `make solver` (make test does)")
-    work = tmp_path_factory.mktemp("membrane")
-    case_dir = work / "cases" / "membrane"
-    case_dir.mkdir(parents=True)
+    work, case_dir = new_case_folder(tmp_path_factory, "membrane", "membrane")
     shutil.copy(os.path.join(ROOT, "cases", "membrane", "membrane.geo"), case_dir)
     with open(os.path.join(ROOT, "cases", "membrane", "membrane.yaml"), encoding="utf-8") as stream:
         case = yaml.safe_load(stream)

@@ -18,9 +18,7 @@ import meshio
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
-PY = "/usr/bin/python3"
+from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
 END = 6.0e-5
 
 GEO = """\
@@ -80,11 +78,7 @@ def read_history(path):
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    if not os.path.exists(SOLVER):
-        pytest.fail(f"{SOLVER} is missing: build it with `make solver` (make test does)")
-    work = tmp_path_factory.mktemp("unstructured")
-    case_dir = work / "cases" / "unstructured"
-    case_dir.mkdir(parents=True)
+    work, case_dir = new_case_folder(tmp_path_factory, "unstructured", "unstructured")
     geo = case_dir / "unstructured.geo"
     geo.write_text(GEO)
     env = dict(os.environ, PYTHONPATH=ROOT)

@@ -1,0 +1,21 @@
+"""What every end-to-end test needs: where the repository and the solver are, and a case folder
+laid out as the pipeline expects it (work/cases/<name>/), in pytest's temporary directory."""
+import os
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+# PDSOLVE points the tests at another build (a sanitizer build, a helper's own build folder).
+SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+PY = "/usr/bin/python3"
+
+
+def new_case_folder(tmp_path_factory, work_name: str, case_name: str):
+    """(work, work/cases/<case_name>): a fresh working folder with an empty case folder in it.
+    Fails at once with what to do when the solver has not been built."""
+    if not os.path.exists(SOLVER):
+        pytest.fail(f"{SOLVER} is missing: build it with `make solver` (make test does)")
+    work = tmp_path_factory.mktemp(work_name)
+    case_dir = work / "cases" / case_name
+    case_dir.mkdir(parents=True)
+    return work, case_dir
