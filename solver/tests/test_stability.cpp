@@ -13,16 +13,11 @@
 #include "forces/pmb.hpp"
 #include "integrators/integrator.hpp"
 #include "lattice.hpp"
+#include "one_thread.hpp"
 
 namespace {
 
-// Tiny problems and many steps: one thread, so that OpenMP barriers on a busy machine do not
-// dominate (results are bitwise the same for any thread count, tested elsewhere).
-struct OneThread {
-  int saved = omp_get_max_threads();
-  OneThread() { omp_set_num_threads(1); }
-  ~OneThread() { omp_set_num_threads(saved); }
-};
+using pdtest::OneThread;
 
 constexpr double kPi = 3.14159265358979323846;
 
