@@ -141,7 +141,7 @@ bench-accuracy: $(SOLVER) | $(DEPS)
 # The full cases and validation/models/ runs with quantitative checks (validation/README.md):
 # out/validate/report.md, a PNG per check and convergence.png.
 validate: $(SOLVER) | $(DEPS)
-	PDSOLVE=$(SOLVER) $(PY) -m validation
+	$(PY) -m validation
 
 clean-case:
 	rm -rf $(OUT)

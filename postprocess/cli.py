@@ -78,8 +78,11 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
     if do_figures:
         requested = case.times if case.times is not None else default_times(times)
         selected = select_frames(times, requested)
+        # A relative slack of 1e-9: the last frame's time is the sum of the steps, which may land
+        # an ulp below the end time the user wrote (4.3e-05 against 4.2999999999999995e-05).
+        slack = 1e-9 * max(abs(times[0]), abs(times[-1]), 1e-300)
         for t in requested:
-            if t < times[0] or t > times[-1]:
+            if t < times[0] - slack or t > times[-1] + slack:
                 print(f"postprocess: note: figures.times {t:g} s is outside the run "
                       f"[{times[0]:g}, {times[-1]:g}] s; drawing the nearest frame", file=sys.stderr)
 

@@ -49,7 +49,9 @@ def main(argv: list[str]) -> int:
             notes.append(f"- {case}: runs and checks {time.monotonic() - start:.0f} s")
             continue
         # $PDSOLVE (a solver built elsewhere) is handed to make as SOLVER, as runner.py does.
-        # (-o: make must not try to rebuild a solver built elsewhere)
+        # (-o: make must not try to rebuild a solver built elsewhere; it also means that a case
+        # already solved is not solved again when that solver changes: clean out/<case> first.
+        # `make validate` leaves PDSOLVE unset, so its cases follow build/solver like `make case=X`.)
         solver = ([f"SOLVER={os.environ['PDSOLVE']}", "-o", os.environ["PDSOLVE"]]
                   if os.environ.get("PDSOLVE") else [])
         make = subprocess.run(["make", "--no-print-directory", f"case={case}", *solver], cwd=ROOT)
