@@ -319,7 +319,10 @@ int run(const RunOptions& opt) {
     log.line("adaptive (thesis §2.2): TOL " + format("%g", adaptive->settings().tol) + ", Kd " +
              std::to_string(adaptive->settings().kd) + ", p " + format("%g", adaptive->settings().p) + ", phi " +
              format("%g", adaptive->settings().phi) + ", dt_min " + format("%.6g", adaptive->dt_min()) + " s, dt_max " +
-             format("%.6g", adaptive->dt_max()) + " s");
+             format("%.6g", adaptive->dt_max()) + " s" +
+             (adaptive->settings().dt_max ? std::string()
+                                          : " (default: eq. 2.5 or 0.9 × the contraction limit, eigenvalue estimate " +
+                                                format("%.3f", adaptive->limit_seconds()) + " s)"));
   log.line("end time " + format("%.6g", end) + " s, steps expected " + std::to_string(steps_expected) +
            (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
 

@@ -2,6 +2,7 @@
 #include "integrators/adaptive.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -34,8 +35,11 @@ void AdaptiveStep::configure(const Case& c) {
   const double dt_sa = stable_time_step(model_);
   const double scale = std::isfinite(dt_sa) ? dt_sa : c.time.end;
   double dt_max = scale;
+  limit_seconds_ = 0.0;
   if (!settings_.dt_max && std::isfinite(dt_sa)) {
+    const auto start = std::chrono::steady_clock::now();  // Lanczos: reported in run.log
     const double dt_exact = exact_time_step(model_);
+    limit_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (std::isfinite(dt_exact)) dt_max = std::min(dt_max, 0.9 * dt_exact / (2.0 * settings_.phi));
   }
   dt_max_ = settings_.dt_max.value_or(dt_max);

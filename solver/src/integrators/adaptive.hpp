@@ -61,6 +61,8 @@ class AdaptiveStep : public Integrator {
   const AdaptiveSettings& settings() const { return settings_; }
   double dt_min() const { return dt_min_; }
   double dt_max() const { return dt_max_; }
+  // Wall time of the eigenvalue estimate behind the default dt_max [s]; 0 when dt_max was given.
+  double limit_seconds() const { return limit_seconds_; }
 
  private:
   // One iterate: v_new, u_new from (u^n, v^n, f^n) in state and the implicit force f_imp at t1.
@@ -69,6 +71,7 @@ class AdaptiveStep : public Integrator {
   Model& model_;
   AdaptiveSettings settings_;
   double dt_min_ = 0.0, dt_max_ = 0.0;
+  double limit_seconds_ = 0.0;
   double proposal_ = 0.0;  // the last proposal handed out, to recognise a shortened step
   State trial_;            // u^{n+1,K−1} and f(u^{n+1,K−1}) (scratch: f, w, contact of trial states)
   Vec3Array u_new_, v_new_;
