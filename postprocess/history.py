@@ -1,6 +1,8 @@
 """Reader of the solver's history.csv (pipeline/formats.md §4): one numpy array per column."""
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from .errors import PostprocessError
@@ -70,3 +72,15 @@ def read_history(path: str) -> dict[str, np.ndarray]:
                                f"before its first step?")
     return {name: np.asarray(column, dtype=np.int64 if parse is _parse_int else np.float64)
             for name, parse, column in zip(names, parsers, columns)}
+
+
+def vector_column_names(history: dict, prefix: str) -> list[str]:
+    """The <name>s that have all three columns <prefix>_<name>_fx, _fy, _fz in history.csv, in
+    column order (formats.md §4: indenter reactions, reactions of node sets)."""
+    column = re.compile(rf"^{re.escape(prefix)}_([A-Za-z_][A-Za-z0-9_]*)_f([xyz])$")
+    found: dict[str, set] = {}
+    for name in history:
+        match = column.match(name)
+        if match:
+            found.setdefault(match.group(1), set()).add(match.group(2))
+    return [name for name, axes in found.items() if axes == {"x", "y", "z"}]

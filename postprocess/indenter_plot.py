@@ -2,24 +2,15 @@
 indenter_<name>_fx, _fy, _fz of pipeline/formats.md §4), drawn only when the case has indenters."""
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
 from .casefile import CaseSettings
+from .history import vector_column_names
 from .plotting import new_figure, save_figure
-
-COLUMN = re.compile(r"^indenter_([A-Za-z_][A-Za-z0-9_]*)_f([xyz])$")
-
 
 def indenter_names(history: dict) -> list[str]:
     """Names of the indenters that have all three force columns, in column order."""
-    found: dict[str, set] = {}
-    for column in history:
-        match = COLUMN.match(column)
-        if match:
-            found.setdefault(match.group(1), set()).add(match.group(2))
-    return [name for name, axes in found.items() if axes == {"x", "y", "z"}]
+    return vector_column_names(history, "indenter")
 
 
 def plot_indenter_forces(history: dict, case: CaseSettings, path: str):

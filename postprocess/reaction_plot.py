@@ -4,24 +4,16 @@ set's boundary condition prescribes: the force–displacement curve of a tensile
 from __future__ import annotations
 
 import json
-import re
 
 import numpy as np
 
 from .casefile import CaseSettings
+from .history import vector_column_names
 from .plotting import new_figure, save_figure
-
-COLUMN = re.compile(r"^reaction_([A-Za-z_][A-Za-z0-9_]*)_f([xyz])$")
-
 
 def reaction_sets(history: dict) -> list[str]:
     """Node sets that have all three reaction columns, in column order."""
-    found: dict[str, set] = {}
-    for column in history:
-        match = COLUMN.match(column)
-        if match:
-            found.setdefault(match.group(1), set()).add(match.group(2))
-    return [name for name, axes in found.items() if axes == {"x", "y", "z"}]
+    return vector_column_names(history, "reaction")
 
 
 def _table_value(times, values, t):

@@ -12,6 +12,7 @@
 #include "core/stability.hpp"
 #include "forces/pmb.hpp"
 #include "integrators/adaptive.hpp"
+#include "energy.hpp"
 #include "lattice.hpp"
 #include "one_thread.hpp"
 
@@ -39,12 +40,7 @@ pd::State smooth_state(const pd::Model& m) {
   return s;
 }
 
-double energy(const pd::Model& m, const pd::State& s) {
-  double e = pd::strain_energy(m, s.u);
-  for (std::size_t i = 0; i < s.size(); ++i)
-    e += 0.5 * m.density[i] * m.nodes.volume[i] * (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
-  return e;
-}
+double energy(const pd::Model& m, const pd::State& s) { return pdtest::mechanical_energy(m, s); }
 
 bool finite(const pd::State& s) {
   for (std::size_t d = 0; d < 3; ++d)

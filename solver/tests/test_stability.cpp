@@ -12,6 +12,7 @@
 #include "core/stability.hpp"
 #include "forces/pmb.hpp"
 #include "integrators/integrator.hpp"
+#include "energy.hpp"
 #include "lattice.hpp"
 #include "one_thread.hpp"
 
@@ -122,12 +123,7 @@ pd::State smooth_state(const pd::Model& m, double amplitude) {
   return s;
 }
 
-double energy(const pd::Model& m, const pd::State& s) {
-  double e = pd::strain_energy(m, s.u);
-  for (std::size_t i = 0; i < s.size(); ++i)
-    e += 0.5 * m.density[i] * m.nodes.volume[i] * (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
-  return e;
-}
+double energy(const pd::Model& m, const pd::State& s) { return pdtest::mechanical_energy(m, s); }
 
 }  // namespace
 
