@@ -54,9 +54,7 @@ inline BondTerms bond_terms(const PmbArrays& a, const double xi[3], const double
 // A candidate for breaking: an intact bond stretched beyond s0 of its block pair. Bitwise &, so
 // that the force loop stays free of branches; no-fail ends are left to break_row (a byte gather
 // would keep the force loop from vectorising).
-inline bool over_critical(const PmbArrays& a, std::int64_t k, double s, double s0) {
-  return (a.broken[k] == 0) & (s > s0);
-}
+inline bool over_critical(bool intact, double s, double s0) { return intact & (s > s0); }
 
 // The breaking criterion, in one place: a bond over its critical stretch breaks unless an end is in a
 // no-fail set. Breaks such bonds of row i: sets their flags (only row i's, so no other thread writes
@@ -73,7 +71,7 @@ std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i
   for (std::int64_t k = a.offsets[i]; k < end; ++k) {
     const std::int64_t j = a.neighbour[k];
     const BondTerms b = bond_terms(a, xi, yi, j);
-    if (!over_critical(a, k, b.s, s0_row[a.block[j]]) || br.no_fail[j]) continue;
+    if (!over_critical(a.broken[k] == 0, b.s, s0_row[a.block[j]]) || br.no_fail[j]) continue;
     br.broken[k] = 1;
     ++set;
     if (i < j) {
@@ -120,15 +118,24 @@ PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const doubl
   const std::int64_t end = a.offsets[i + 1];
   for (std::int64_t k0 = a.offsets[i]; k0 < end; k0 += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - k0));
+    // The chunk's bytes and 32-bit indices, widened first: GCC sizes the vector loop by its
+    // narrowest type, so one byte load in it would make it 32 bonds wide under AVX2 and spill
+    // most of its registers; with only 64-bit types it is 4 bonds wide (docs/performance.md §2).
+    std::int64_t j_q[kChunk], block_q[kChunk];
+    double intact_q[kChunk];
+    for (int q = 0; q < m; ++q) {
+      j_q[q] = a.neighbour[k0 + q];
+      intact_q[q] = a.broken[k0 + q] == 0 ? 1.0 : 0.0;
+      if constexpr (!kOneBlock) block_q[q] = a.block[j_q[q]];
+    }
     double t0[kChunk], t1[kChunk], t2[kChunk], te[kChunk];
     for (int q = 0; q < m; ++q) {
-      const std::int64_t k = k0 + q;
-      const std::int64_t j = a.neighbour[k];
+      const std::int64_t j = j_q[q];
       const BondTerms b = bond_terms(a, xi, yi, j);
-      const std::int64_t bj = kOneBlock ? 0 : a.block[j];
-      if constexpr (kBreaking) over += over_critical(a, k, b.s, s0_row[bj]);
+      const std::int64_t bj = kOneBlock ? 0 : block_q[q];
+      const double intact = intact_q[q];
+      if constexpr (kBreaking) over += over_critical(intact > 0.0, b.s, s0_row[bj]);
       // Broken bonds are multiplied by 0 rather than skipped: no branch, so the loop vectorises.
-      const double intact = a.broken[k] == 0 ? 1.0 : 0.0;
       const double c_vj = intact * c_row[bj] * a.volume[j] * a.volume_weight(b.length);
       const double scale = c_vj * b.s * b.inv_y;  // c s ν V_j / y
       t0[q] = scale * b.e0;
