@@ -89,12 +89,13 @@ std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i
 constexpr int kChunk = 64;
 
 // One binary for every x86-64 machine, each running the widest code it can: GCC compiles the row
-// twice, for baseline x86-64 (SSE2) and for x86-64-v3 (AVX2: hardware gathers, 4 lanes), and picks
-// one at load time. Both do the same IEEE operations in the same order (no FMA contraction, no
-// reassociation), so results are bitwise the same on any CPU — unlike -march=native, whose binary
-// may not run on the CI machine and whose FMAs would change the last bits (docs/performance.md).
+// three times, for baseline x86-64 (SSE2), x86-64-v2 (SSE4.2: 64-bit lane extracts, so the loop
+// vectorises) and x86-64-v3 (AVX2, 4 lanes), and picks one at load time. All do the same IEEE
+// operations in the same order (no FMA contraction, no reassociation), so results are bitwise the
+// same on any CPU — unlike -march=native, whose binary may not run on the CI machine and whose FMAs
+// would change the last bits (docs/performance.md).
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PD_KERNEL_CLONES __attribute__((target_clones("default", "arch=x86-64-v3")))
+#define PD_KERNEL_CLONES __attribute__((target_clones("default", "arch=x86-64-v2", "arch=x86-64-v3")))
 #else
 #define PD_KERNEL_CLONES
 #endif
