@@ -6,7 +6,7 @@
 #   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
 #   make fuzz                 libFuzzer on the solver's readers, FUZZ_SECONDS (60) each (clang)
-#   make bench                speed of the bond kernel on 3D bricks → out/bench/speed.csv (docs/performance.md)
+#   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
 #   make bench-accuracy       error against run time, Verlet vs adaptive → out/bench/accuracy.csv (docs/accuracy.md)
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
@@ -127,8 +127,13 @@ fuzz: | $(DEPS)
 
 # A benchmark, not a timed test: bricks of 64,000, ~10⁵ and 10⁶ nodes with 1 and 2 threads
 # (BENCH_SIDES to change), then the cost of output in the built cases. Prints the load average.
+# LAMMPS (Debian's, with PERI) runs the same 40³ brick for comparison.
 BENCH_SIDES ?= 40 46 100
-bench: $(SOLVER)
+BENCH_DEPS  := build/.bench-deps-ok
+$(BENCH_DEPS): pipeline/install-deps.sh
+	sh pipeline/install-deps.sh lammps openmpi-bin
+	@mkdir -p $(@D) && touch $@
+bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
 	$(PY) solver/bench/speed.py --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
 
 # Error against run time and force evaluations (issue 3): Verlet at several safety factors and at the

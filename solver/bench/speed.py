@@ -4,8 +4,11 @@ Runs pd_speed (solver/bench/speed.cpp) for each brick size and thread count, one
 so that peak memory is per run, writes out/bench/speed.csv and prints, for 1 and 2 threads:
 directed bond updates per second, time per step against N (with its growth exponent, which must
 be ≈ 1), bytes of bond storage per directed bond and peak memory, and set-up time per node.
-Then what the node numbering costs (x-fastest, shuffled, Morton-sorted), and the cost of output at each case's own interval: pdsolve on out/<case>/case.json as the case
-sets it, against the same run writing only its first and last frame (skipped for cases not built).
+Then LAMMPS's PERI package on the 40³ brick, serial and with 2 MPI ranks, against our 1 and 2 threads
+(solver/bench/lammps_brick.py, out/bench/lammps.csv), what the node numbering costs (x-fastest,
+shuffled, Morton-sorted), and the cost of output at each case's own interval: the share of the time
+loop pdsolve reports spending on frames and history rows, on out/<case>/case.json as the case sets
+it (skipped for cases not built).
 
     /usr/bin/python3 solver/bench/speed.py [--build build/solver] [--sides 40 46 100] [--quick]
 
@@ -63,42 +66,77 @@ def node_order_study(exe, header, side, steps, workdir):
     return rates
 
 
+def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=2):
+    """LAMMPS's PERI package on the same brick (solver/bench/lammps_brick.py), serial and with 2 MPI
+    ranks, against pd_speed with 1 and 2 threads: the two codes alternate, `repeats` runs each, and
+    the best run of each counts (a busy neighbour slows a run, nothing speeds it up). Rates are
+    counted with our directed bond count on that lattice."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import lammps_brick
+    missing = lammps_brick.available()
+    if missing:
+        print(f"LAMMPS comparison skipped: {missing} not found (apt-get install lammps openmpi-bin; make bench does)")
+        return
+    os.makedirs(workdir, exist_ok=True)
+    fields = ["code", "side", "nodes", "workers", "steps", "loop_s", "bond_updates_per_s", "load_average"]
+    with open(out_csv, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for workers in threads:
+            best_ours, best_lammps = None, None
+            for _ in range(repeats):
+                ours = dict(zip(header.split(","), run_speed(exe, side, workers, steps, workdir).split(",")))
+                if best_ours is None or float(ours["loop_s"]) < float(best_ours["loop_s"]):
+                    best_ours = ours
+                loop, atoms = lammps_brick.run_lammps(side, steps, workers, workdir)
+                if atoms != int(ours["nodes"]):
+                    raise RuntimeError(f"LAMMPS made {atoms} atoms, pd_speed {ours['nodes']} nodes: not the same brick")
+                best_lammps = loop if best_lammps is None else min(best_lammps, loop)
+            directed = float(best_ours["directed_bonds"])
+            rate = directed * steps / best_lammps
+            mine = float(best_ours["bond_updates_per_s"])
+            load = f"{os.getloadavg()[0]:.2f}"
+            w.writerow(dict(code="lammps peri/pmb", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
+                            loop_s=f"{best_lammps:.4f}", bond_updates_per_s=f"{rate:.4e}", load_average=load))
+            w.writerow(dict(code="pdsolve kernel", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
+                            loop_s=best_ours["loop_s"], bond_updates_per_s=f"{mine:.4e}", load_average=load))
+            print(f"  N = {best_ours['nodes']}, {workers} worker(s), best of {repeats}: LAMMPS peri/pmb "
+                  f"({workers} MPI rank(s)) {rate:.3e} directed bond updates/s, ours ({workers} thread(s)) "
+                  f"{mine:.3e}: {mine / rate:.1f}× as fast", flush=True)
+    print(f"wrote {out_csv}")
+
+
 def loop_seconds(log_text):
     m = re.search(r"done: (\d+) steps .* in ([0-9.]+) s wall", log_text)
     return (int(m.group(1)), float(m.group(2))) if m else (None, None)
 
 
 def output_cost(pdsolve, case_dir, repeats=3):
-    """CPU seconds (user + system, so file writing counts) of pdsolve with the case's own output, and
-    with frames only at the start and the end; one thread, because on a shared machine the CPU time
-    of a single-threaded run is far steadier than the wall time of a two-threaded one. The least of
-    `repeats` runs each, alternating: a difference of a few per cent is below the scatter of one run
-    on a shared machine (a busy neighbour slows a run, nothing speeds it up)."""
+    """The share of the time loop that writing frames and history rows takes, as pdsolve measures it
+    around its output calls (run.log "output: ... took X s wall, P % of the time loop"), for the case
+    as it is set up, one thread; the median of `repeats` runs. Timing the output inside the run,
+    rather than differencing two whole runs, keeps a busy neighbour's slowdown of a whole run from
+    showing up as output cost."""
     with open(os.path.join(case_dir, "case.json")) as f:
         case = json.load(f)
-    results = {}
+    shares, seconds = [], []
     with tempfile.TemporaryDirectory(prefix="pd-bench-") as tmp:
+        c = json.loads(json.dumps(case))
+        c["nodes_file"] = os.path.abspath(os.path.join(case_dir, case["nodes_file"]))
+        c["output_dir"] = os.path.join(tmp, "run")
+        path = os.path.join(tmp, "case.json")
+        with open(path, "w") as f:
+            json.dump(c, f)
         for _ in range(repeats):
-            for label in ("case output", "first+last frame"):
-                c = json.loads(json.dumps(case))
-                c["nodes_file"] = os.path.abspath(os.path.join(case_dir, case["nodes_file"]))
-                c["output_dir"] = os.path.join(tmp, label.replace(" ", "_").replace("+", "_"))
-                if label != "case output":
-                    c["output"]["every_time"] = c["time"]["end"]
-                    c["output"]["every_steps"] = None
-                    c["output"]["history_every"] = 10 ** 12
-                path = os.path.join(tmp, "case.json")
-                with open(path, "w") as f:
-                    json.dump(c, f)
-                before = os.times()
-                subprocess.run([pdsolve, path, "--threads", "1", "--quiet"], check=True, capture_output=True)
-                after = os.times()
-                cpu = (after.children_user - before.children_user) + (after.children_system - before.children_system)
-                with open(os.path.join(c["output_dir"], "run.log")) as f:
-                    steps, _ = loop_seconds(f.read())
-                if label not in results or cpu < results[label][1]:
-                    results[label] = (steps, cpu)
-    return results
+            subprocess.run([pdsolve, path, "--threads", "1", "--quiet"], check=True, capture_output=True)
+            with open(os.path.join(c["output_dir"], "run.log")) as f:
+                log = f.read()
+            steps, loop = loop_seconds(log)
+            m = re.search(r"output: frames and history.csv took ([0-9.]+) s wall, ([0-9.]+) % of the time loop", log)
+            seconds.append(float(m.group(1)))
+            shares.append(float(m.group(2)))
+    k = sorted(range(repeats), key=lambda i: shares[i])[repeats // 2]
+    return steps, loop, seconds[k], shares[k]
 
 
 def main():
@@ -108,6 +146,8 @@ def main():
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--out", default="out/bench/speed.csv")
     ap.add_argument("--quick", action="store_true", help="a quarter of the steps")
+    ap.add_argument("--lammps-side", type=int, default=40,
+                    help="brick side of the comparison with LAMMPS peri/pmb (0: skip it)")
     ap.add_argument("--order-side", type=int, default=40,
                     help="brick side of the node-order study (0: skip it)")
     args = ap.parse_args()
@@ -147,6 +187,11 @@ def main():
           f"(4 neighbour + 1 flag + offsets); a 10^7-node brick: ≈ "
           f"{float(r['peak_rss_mb']) / int(r['nodes']) * 1e7 / 1024:.1f} GB at this peak memory per node")
 
+    if args.lammps_side:
+        against_lammps(exe, header, args.lammps_side,
+                       max(2, STEPS.get(args.lammps_side, 10) // (4 if args.quick else 1)), args.threads,
+                       os.path.join(os.path.dirname(args.out), "lammps.csv"), workdir)
+
     if args.order_side:
         node_order_study(exe, header, args.order_side,
                          max(2, STEPS.get(args.order_side, 10) // (4 if args.quick else 1)), workdir)
@@ -157,10 +202,9 @@ def main():
         if not os.path.exists(os.path.join(case_dir, "case.json")):
             print(f"output cost: out/{case} not built (make case={case}), skipped")
             continue
-        res = output_cost(pdsolve, case_dir)
-        (s_with, t_with), (s_without, t_without) = res["case output"], res["first+last frame"]
-        print(f"output cost, {case} ({s_with} steps, 1 thread, least of 3 runs): {t_with:.2f} CPU s with the case's output, "
-              f"{t_without:.2f} without: {100 * (t_with - t_without) / t_with:+.1f}% of run time")
+        steps, loop, seconds, share = output_cost(pdsolve, case_dir)
+        print(f"output cost, {case} ({steps} steps, 1 thread, median of 3 runs): frames and history rows "
+              f"{seconds:.3f} s of a {loop:.2f} s time loop: {share:.1f}%")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -10,6 +10,7 @@ clamped and the right end is pulled by a smooth velocity pulse (a Hann pulse of 
 The stages are called as the Makefile calls them (pipeline.run mesh/preprocess, pdsolve).
 """
 import csv
+import json
 import os
 import re
 import subprocess
@@ -151,3 +152,27 @@ def test_energy_stays_below_the_work_put_in(runs, integrator):
     assert put_in[-1] > 1e-4  # J: the pulse did work (2.5·10⁻⁴ J measured)
     assert np.all(mechanical <= put_in + 0.02 * put_in.max())
     assert mechanical[-1] > 0.1 * put_in[-1]  # the energy did not vanish either (nothing NaN-clamped)
+
+
+@pytest.mark.parametrize("integrator", ["verlet", "adaptive"])
+def test_history_energies_are_those_of_the_state_written(runs, integrator):
+    # The time loop computes KE and U once per step (its blow-up watch needs them) and the history
+    # row of that step reuses them: the last row must hold the kinetic energy Σ ½ ρ V |v|² of the
+    # last frame, not of an earlier state. history.csv writes the shortest decimal form that reads
+    # back as the same double, so only the summation order (serial C++ vs numpy) differs.
+    run_dir = runs[integrator]
+    history = read_history(run_dir / "history.csv")
+    nodes = meshio.read(run_dir / "nodes.vtu")
+    last = meshio.read(sorted((run_dir / "frames").glob("frame_*.vtu"))[-1])
+    density = json.loads((run_dir / "case.json").read_text())["blocks"][0]["density"]
+    v = last.point_data["velocity"]
+    kinetic = 0.5 * density * np.sum(nodes.point_data["volume"] * np.sum(v * v, axis=1))
+    assert kinetic > 0.0
+    assert history["kinetic_energy"][-1] == pytest.approx(kinetic, rel=1e-12)
+    # The run times its own output and says what share of the time loop it took.
+    log = (run_dir / "run.log").read_text()
+    m = re.search(r"output: frames and history.csv took ([0-9.]+) s wall, ([0-9.]+) % of the time loop", log)
+    assert m, log
+    loop = float(re.search(r"done: \d+ steps .* in ([0-9.]+) s wall", log).group(1))
+    assert 0.0 < float(m.group(1)) <= loop
+    assert 0.0 < float(m.group(2)) <= 100.0

@@ -1,0 +1,113 @@
+"""The reference code on the bench's brick: LAMMPS's PERI package (pair_style peri/pmb) on the same
+side³ simple cubic lattice as pd_speed (dx = 1 mm, δ = 3.0002·dx, free faces, the top three layers
+moving down at 0.1 m/s, the same glass-like material), serial and with 2 MPI ranks.
+
+    /usr/bin/python3 solver/bench/lammps_brick.py [--side 40] [--steps 40] [--ranks 1 2]
+
+Needs Debian's `lammps` package (lmp, built with PERI) and `mpirun` (openmpi-bin); `make bench`
+installs both. The rate is counted as pd_speed counts it: directed bonds × steps / LAMMPS's own
+"Loop time", with the directed bond count of our bond list on the same lattice (each bond from both
+ends). LAMMPS's peri/pmb also computes its short-range repulsion over every neighbour-list pair in
+the same loop; pd_speed has no contact on this brick. That is the work each code does by default on
+this problem, and it is what a user switching codes would see.
+"""
+import argparse
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+# The material of pd_speed (solver/bench/speed.cpp): E = 72 GPa, ν = 1/4, ρ = 2440 kg/m³, G0 = 4 J/m².
+DX = 1e-3
+HORIZON = 3.0002 * DX
+YOUNG, DENSITY, FRACTURE_ENERGY = 72e9, 2440.0, 4.0
+BULK = YOUNG / (3.0 * (1.0 - 2.0 * 0.25))                          # k = E/(3(1−2ν)), ν = 1/4
+MICROMODULUS = 18.0 * BULK / (math.pi * HORIZON ** 4)              # c = 18k/(πδ⁴) (validation.md)
+CRITICAL_STRETCH = math.sqrt(5.0 * FRACTURE_ENERGY / (9.0 * BULK * HORIZON))  # s0 = √(5G0/(9kδ))
+
+
+def stable_time_step():
+    """Thesis eq. 2.5 for an interior node of the lattice, Δt = √(2ρ / Σ_p V_p c/|ξ_p|): 0.8 of it is
+    the step pd_speed takes (0.8 · stable_time_step of the model, whose minimum is at interior nodes)."""
+    reach = int(HORIZON / DX) + 1
+    total = 0.0
+    for i in range(-reach, reach + 1):
+        for j in range(-reach, reach + 1):
+            for k in range(-reach, reach + 1):
+                length = DX * math.sqrt(i * i + j * j + k * k)
+                if 0.0 < length <= HORIZON:
+                    total += DX ** 3 * MICROMODULUS / length
+    return math.sqrt(2.0 * DENSITY / total)
+
+
+TIME_STEP = 0.8 * stable_time_step()
+
+
+def lammps_input(side, steps):
+    """A LAMMPS input for the side³ brick (lattice units of dx, nodes at 0 … side−1)."""
+    hi = side - 0.5
+    return f"""# written by solver/bench/lammps_brick.py
+units si
+boundary s s s
+atom_style peri
+atom_modify map array
+lattice sc {DX}
+region box block -0.5 {hi} -0.5 {hi} -0.5 {hi}
+create_box 1 box
+create_atoms 1 region box
+pair_style peri/pmb
+pair_coeff * * {MICROMODULUS:.10e} {HORIZON:.10e} {CRITICAL_STRETCH:.10e} 0.0
+set group all density {DENSITY}
+set group all volume {DX ** 3:.10e}
+region top block INF INF INF INF {side - 3.5} INF
+group top region top
+velocity top set 0.0 0.0 -0.1 units box
+neighbor {0.1 * DX} bin
+neigh_modify every 100000 delay 100000 check no
+fix 1 all nve
+timestep {TIME_STEP:.10e}
+thermo 100000
+run {steps}
+"""
+
+
+def run_lammps(side, steps, ranks, workdir):
+    """Loop time [s] and atom count LAMMPS reports for the brick with `ranks` MPI ranks."""
+    path = os.path.abspath(os.path.join(workdir, f"in.brick-{side}"))
+    with open(path, "w") as f:
+        f.write(lammps_input(side, steps))
+    cmd = ["lmp", "-in", path, "-log", "none"]
+    if ranks > 1:
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)] + cmd
+    out = subprocess.run(cmd, capture_output=True, text=True, cwd=workdir)
+    m = re.search(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", out.stdout)
+    if out.returncode != 0 or not m:
+        raise RuntimeError(f"{' '.join(cmd)} failed (exit {out.returncode}):\n{out.stdout[-2000:]}{out.stderr[-2000:]}")
+    return float(m.group(1)), int(m.group(4))
+
+
+def available():
+    """None if lmp and mpirun are on PATH, else what is missing."""
+    missing = [p for p in ("lmp", "mpirun") if shutil.which(p) is None]
+    return None if not missing else " and ".join(missing)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--side", type=int, default=40)
+    ap.add_argument("--steps", type=int, default=40)
+    ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2])
+    args = ap.parse_args()
+    if available():
+        sys.exit(f"lammps_brick.py: {available()} not found: apt-get install lammps openmpi-bin (make bench does)")
+    with tempfile.TemporaryDirectory(prefix="pd-lammps-") as tmp:
+        for ranks in args.ranks:
+            loop, atoms = run_lammps(args.side, args.steps, ranks, tmp)
+            print(f"LAMMPS peri/pmb, {atoms} atoms, {ranks} rank(s): loop {loop:.3f} s for {args.steps} steps")
+
+
+if __name__ == "__main__":
+    main()
