@@ -1,6 +1,8 @@
 // Builds and refreshes the contact Verlet list (see verlet_list.hpp).
 #include "core/verlet_list.hpp"
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -12,13 +14,24 @@ namespace pd {
 
 ContactPairs VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
                                 const ContactParameters& p) {
-  const std::size_t n = x[0].size();
   ContactPairs out;
+  Scratch scratch;
+  search(x, u, block, p, out, scratch);
+  return out;
+}
+
+void VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
+                        const ContactParameters& p, ContactPairs& out, Scratch& scratch) {
+  const std::size_t n = x[0].size();
   out.offsets.assign(n + 1, 0);
-  if (n == 0) return out;
-  Vec3Array y = make_vec3(n);
-  for (std::size_t d = 0; d < 3; ++d)
+  out.neighbour.clear();
+  out.distance.clear();
+  if (n == 0) return;
+  Vec3Array& y = scratch.y;
+  for (std::size_t d = 0; d < 3; ++d) {
+    y[d].resize(n);
     for (std::size_t i = 0; i < n; ++i) y[d][i] = x[d][i] + u[d][i];
+  }
   const double reach = p.distance + p.skin;
   const double* const yp[3] = {y[0].data(), y[1].data(), y[2].data()};
   // Bins of edge ≥ contact distance + skin: every candidate lies in the neighbouring bins.
@@ -38,29 +51,42 @@ ContactPairs VerletList::search(const Vec3Array& x, const Vec3Array& u, const st
       visit(static_cast<std::int32_t>(j), contact_distance(std::sqrt(xi2), xi2 <= bonded2, p.distance));
     });
   };
-  // Two passes (count, then fill) so that each row is written by one thread only.
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-    std::int64_t count = 0;
-    for_each(static_cast<std::size_t>(i), [&](std::int32_t, double) { ++count; });
-    out.offsets[static_cast<std::size_t>(i) + 1] = count;
+  // One pass over the cells: each thread finds the rows of its contiguous share of the nodes
+  // (schedule static: one block per thread) into its own buffer, row after row, each row sorted by j
+  // so that the list (and every sum over it) does not depend on the bin layout or the thread count;
+  // then the offsets are summed and each thread copies its block into place.
+  auto& found = scratch.found;
+  auto& first_row = scratch.first_row;
+  found.resize(static_cast<std::size_t>(omp_get_max_threads()));
+  first_row.assign(found.size(), -1);
+#pragma omp parallel
+  {
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    std::vector<std::pair<std::int32_t, double>>& mine = found[t];
+    mine.clear();
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+      if (first_row[t] < 0) first_row[t] = i;
+      const std::size_t row_start = mine.size();
+      for_each(static_cast<std::size_t>(i), [&](std::int32_t j, double d) { mine.emplace_back(j, d); });
+      std::sort(mine.begin() + static_cast<std::ptrdiff_t>(row_start), mine.end());
+      out.offsets[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(mine.size() - row_start);
+    }
   }
   for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] += out.offsets[i];
   out.neighbour.resize(static_cast<std::size_t>(out.offsets[n]));
   out.distance.resize(out.neighbour.size());
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-    std::vector<std::pair<std::int32_t, double>> row;
-    for_each(static_cast<std::size_t>(i), [&](std::int32_t j, double d) { row.emplace_back(j, d); });
-    std::sort(row.begin(), row.end());  // ascending j: the sums do not depend on the bin layout
-    auto k = static_cast<std::size_t>(out.offsets[static_cast<std::size_t>(i)]);
-    for (const auto& [j, d] : row) {
+#pragma omp parallel for schedule(static, 1)
+  for (std::int64_t t = 0; t < static_cast<std::int64_t>(found.size()); ++t) {
+    const auto& mine = found[static_cast<std::size_t>(t)];
+    if (first_row[static_cast<std::size_t>(t)] < 0) continue;  // a thread that got no rows
+    auto k = static_cast<std::size_t>(out.offsets[static_cast<std::size_t>(first_row[static_cast<std::size_t>(t)])]);
+    for (const auto& [j, d] : mine) {
       out.neighbour[k] = j;
       out.distance[k] = d;
       ++k;
     }
   }
-  return out;
 }
 
 bool VerletList::update(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
@@ -86,7 +112,7 @@ bool VerletList::update(const Vec3Array& x, const Vec3Array& u, const std::vecto
   }
   if (!stale) return false;
   const auto start = std::chrono::steady_clock::now();
-  pairs_ = search(x, u, block, p);
+  search(x, u, block, p, pairs_, scratch_);
   u_build_ = u;
   ++rebuilds_;
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
