@@ -105,20 +105,23 @@ test-asan: | $(DEPS)
 
 # libFuzzer (clang) on the solver's readers, FUZZ_SECONDS each; a crash leaves its input in
 # $(FUZZ_DIR)/artifacts/: fix the reader and add the input to solver/fuzz/regressions/<target>/.
+# The binary checkpoint has no dictionary: its few constants are in the seeds, and libFuzzer
+# picks up the ones the reader compares against.
 FUZZ_DIR     := build/solver-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case
+FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case pd_fuzz_checkpoint
 fuzz: | $(DEPS)
 	cmake -S solver -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DPD_FUZZ=ON -DPD_BUILD_TESTS=OFF \
 	    -DCMAKE_BUILD_TYPE=RelWithDebInfo
 	cmake --build $(FUZZ_DIR) -j$(JOBS) --target pd_fuzz
 	@mkdir -p $(FUZZ_DIR)/artifacts
 	@for t in $(FUZZ_TARGETS); do \
-	    case $$t in pd_fuzz_case) dict=case.dict;; *) dict=vtu.dict;; esac; \
+	    case $$t in pd_fuzz_case) dict=-dict=solver/fuzz/case.dict;; pd_fuzz_checkpoint) dict=;; \
+	        *) dict=-dict=solver/fuzz/vtu.dict;; esac; \
 	    mkdir -p $(FUZZ_DIR)/work/$$t; \
 	    echo "fuzzing $$t for $(FUZZ_SECONDS) s (log: $(FUZZ_DIR)/$$t.log)"; \
 	    $(FUZZ_DIR)/fuzz/$$t -max_total_time=$(FUZZ_SECONDS) -max_len=16384 -timeout=10 -rss_limit_mb=2048 \
-	        -dict=solver/fuzz/$$dict -artifact_prefix=$(FUZZ_DIR)/artifacts/$$t- \
+	        $$dict -artifact_prefix=$(FUZZ_DIR)/artifacts/$$t- \
 	        $(FUZZ_DIR)/work/$$t $(FUZZ_DIR)/fuzz/corpus/$$t solver/fuzz/regressions/$$t \
 	        > $(FUZZ_DIR)/$$t.log 2>&1 \
 	    || { tail -n 40 $(FUZZ_DIR)/$$t.log; echo "$$t: failure, input in $(FUZZ_DIR)/artifacts/"; exit 1; }; \

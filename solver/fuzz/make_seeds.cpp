@@ -1,11 +1,13 @@
-// Writes the seed corpus of the fuzz targets: small valid node files, frames and case.json files
-// made by the solver's own writers, one directory per target (usage: pd_fuzz_seeds DIR).
+// Writes the seed corpus of the fuzz targets: small valid node files, frames, case.json files and
+// checkpoints made by the solver's own writers, one directory per target (usage: pd_fuzz_seeds DIR).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "integrators/integrator.hpp"
+#include "io/checkpoint.hpp"
 #include "io/node_file.hpp"
 #include "io/vtu.hpp"
 
@@ -52,6 +54,43 @@ pd::VtuGrid frame() {
   return g;
 }
 
+// The integrator state bytes as Integrator::save_state writes them (no model needed for that).
+struct SavedReport : pd::Integrator {
+  std::string name() const override { return "verlet"; }
+  void initialize(pd::State&, double) override {}
+  void step(pd::State&, double&, double&) override {}
+};
+
+// A checkpoint of `nodes` nodes partway through a run; `rich` fills every optional part (the
+// adaptive step's proposal, indenter forces, a contact list) so the seeds reach every field.
+pd::Checkpoint checkpoint(std::size_t nodes, bool rich) {
+  pd::Checkpoint c;
+  c.case_hash = 0x0123456789abcdefull;
+  c.nodes_hash = 0xfedcba9876543210ull;
+  c.nodes = nodes;
+  c.directed_bonds = 2 * nodes;
+  c.integrator = rich ? "adaptive" : "verlet";
+  c.step = 10, c.time = 1e-6, c.dt = 1e-7, c.dt_taken = 1e-7;
+  c.last_frame_step = 10, c.next_frame_index = 2, c.next_restart_index = 1;
+  c.broken = 1, c.force_evaluations = 11, c.broken_energy = 1e-9, c.wall_time = 0.25;
+  c.energy_before = 2e-6, c.energy_streak_start = 1e-6, c.growth_streak = 0;
+  c.integrator_state = SavedReport().save_state();
+  if (rich) {
+    const double proposal = 1.1e-7;  // AdaptiveStep::save_state appends its proposal
+    const auto* p = reinterpret_cast<const char*>(&proposal);
+    c.integrator_state.insert(c.integrator_state.end(), p, p + sizeof proposal);
+  }
+  c.state = pd::State(nodes);
+  for (std::size_t i = 0; i < nodes; ++i) c.state.u[0][i] = 1e-6 * static_cast<double>(i), c.state.w[i] = 0.5;
+  if (rich) c.state.indenter_force = {{0.0, -2.5, 0.0}};
+  c.broken_flags.assign(c.directed_bonds, 0);
+  c.broken_flags[1] = 1;
+  if (rich) c.contact_rebuilds = 3, c.contact_seconds = 1e-3, c.contact_u_build = pd::make_vec3(nodes, 1e-7);
+  c.frame_times = {0.0, 1e-6};
+  c.history_bytes = 1234;
+  return c;
+}
+
 void text(const fs::path& path, const std::string& body) { std::ofstream(path, std::ios::binary) << body; }
 
 // The formats.md §3 example, and a 3D variant with a fixed step and every_steps output.
@@ -88,12 +127,15 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = argv[1];
-  for (const char* target : {"pd_fuzz_node_file", "pd_fuzz_vtu", "pd_fuzz_case"}) fs::create_directories(dir / target);
+  for (const char* target : {"pd_fuzz_node_file", "pd_fuzz_vtu", "pd_fuzz_case", "pd_fuzz_checkpoint"})
+    fs::create_directories(dir / target);
   pd::write_node_file(dir / "pd_fuzz_node_file" / "lattice2d.vtu", lattice(3, 2, 1, 2));
   pd::write_node_file(dir / "pd_fuzz_node_file" / "lattice3d.vtu", lattice(2, 2, 2, 3));
   pd::write_node_file(dir / "pd_fuzz_vtu" / "nodes.vtu", lattice(2, 2, 1, 2));
   pd::write_vtu(dir / "pd_fuzz_vtu" / "frame.vtu", frame());
   text(dir / "pd_fuzz_case" / "membrane.json", kCase2d);
   text(dir / "pd_fuzz_case" / "three_d.json", kCase3d);
+  pd::write_checkpoint(dir / "pd_fuzz_checkpoint" / "verlet.bin", checkpoint(4, false));
+  pd::write_checkpoint(dir / "pd_fuzz_checkpoint" / "adaptive_contact.bin", checkpoint(3, true));
   return 0;
 }

@@ -9,8 +9,10 @@
 #include <map>
 #include <string>
 
+#include "../fuzz/checkpoint_seal.hpp"
 #include "core/error.hpp"
 #include "io/case_reader.hpp"
+#include "io/checkpoint.hpp"
 #include "io/node_file.hpp"
 #include "io/vtu.hpp"
 
@@ -21,6 +23,15 @@ TEST(FuzzRegressions, EveryStoredInputIsHandled) {
       {"pd_fuzz_node_file", [](const std::string& t, const std::string& f) { pd::parse_node_file(t, f); }},
       {"pd_fuzz_vtu", [](const std::string& t, const std::string& f) { pd::parse_vtu(t, f); }},
       {"pd_fuzz_case", [](const std::string& t, const std::string& f) { pd::parse_case(t, f); }},
+      // As pd_fuzz_checkpoint reads it: as stored, then sealed (fuzz/checkpoint_seal.hpp).
+      {"pd_fuzz_checkpoint",
+       [](const std::string& t, const std::string& f) {
+         try {
+           pd::parse_checkpoint(t, f);
+         } catch (const pd::Error&) {
+         }
+         pd::parse_checkpoint(pd_fuzz::sealed_checkpoint(t), f);
+       }},
   };
   const fs::path root = fs::path(PD_SOURCE_DIR) / "fuzz" / "regressions";
   int inputs = 0;

@@ -103,6 +103,9 @@ void fields(IO& io, Checkpoint& c) {
   std::vector<double> indenter;
   for (const auto& force : s.indenter_force) indenter.insert(indenter.end(), force.begin(), force.end());
   io.array(indenter);
+  // Three components per indenter: a remainder would be dropped without a word.
+  if constexpr (std::is_same_v<IO, Reader>)
+    if (indenter.size() % 3 != 0) io.fail("indenter forces are not whole (x, y, z) triples");
   s.indenter_force.resize(indenter.size() / 3);
   for (std::size_t k = 0; k < s.indenter_force.size(); ++k)
     for (std::size_t d = 0; d < 3; ++d) s.indenter_force[k][d] = indenter[3 * k + d];
@@ -141,7 +144,10 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open the checkpoint for reading");
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string file = path.string();
+  return parse_checkpoint(bytes, path.string());
+}
+
+Checkpoint parse_checkpoint(const std::string& bytes, const std::string& file) {
   constexpr std::size_t kHead = sizeof kMagic + 4 + 4 + 8;
   if (bytes.size() < kHead || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     throw Error(file + ": not a pdsolve checkpoint (no PDCKPT header)");
@@ -153,9 +159,11 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   if (version != kCheckpointVersion)
     throw Error(file + ": checkpoint format version " + std::to_string(version) + ", this pdsolve reads version " +
                 std::to_string(kCheckpointVersion));
+  // Named as the header gives it: kHead + size + 8 would wrap around for a size near 2⁶⁴.
   if (size > bytes.size() - kHead || bytes.size() - kHead - size != 8)
-    throw Error(file + ": checkpoint truncated or padded: " + std::to_string(bytes.size()) + " bytes, the header says " +
-                std::to_string(kHead + size + 8));
+    throw Error(file + ": checkpoint truncated or padded: " + std::to_string(bytes.size()) +
+                " bytes, the header says a payload of " + std::to_string(size) + " bytes (" +
+                std::to_string(kHead + 8) + " more for header and checksum)");
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + kHead + size, sizeof stored);
   if (stored != fnv1a(bytes.data() + kHead, static_cast<std::size_t>(size)))

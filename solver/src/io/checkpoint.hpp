@@ -63,4 +63,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
 // checksum does not match.
 Checkpoint read_checkpoint(const std::filesystem::path& path);
 
+// The same from the file's bytes (`file` only names it in messages); the fuzz targets call this.
+Checkpoint parse_checkpoint(const std::string& bytes, const std::string& file);
+
 }  // namespace pd
