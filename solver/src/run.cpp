@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "core/reactions.hpp"
 #include "core/work_plan.hpp"
+#include "forces/indenter.hpp"
 #include "forces/pmb.hpp"
 #include "core/stability.hpp"
 #include "integrators/adaptive.hpp"
@@ -315,6 +316,14 @@ int run(const RunOptions& opt) {
   if (c.time.dt_rule == "fixed" && dt > dt_stable)
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
   for (const auto& text : work_summary(model, c)) log.line(text);
+  // A fixed explicit step has no room for the indenter's stiffness 2K·h, which grows with depth:
+  // say how deep it may go, and (in the loop) warn once if a node gets deeper.
+  const bool indenter_watch = !model.indenters.empty() && integrator->name() == "verlet";
+  if (indenter_watch)
+    for (const auto& ind : model.indenters)
+      log.line("indenter '" + ind.name + "': dt stays stable while no node is deeper than " +
+               format("%.4g", indenter_stable_depth(model, ind, dt)) +
+               " m (its stiffness 2K·h joins eq. 2.5; at the stiffest node)");
   if (const auto* adaptive = dynamic_cast<const AdaptiveStep*>(integrator.get()))
     log.line("adaptive (thesis §2.2): TOL " + format("%g", adaptive->settings().tol) + ", Kd " +
              std::to_string(adaptive->settings().kd) + ", p " + format("%g", adaptive->settings().p) + ", phi " +
@@ -394,6 +403,7 @@ int run(const RunOptions& opt) {
     // step at 1.5× the limit); physical loading does not keep up ×1.5 per step for 20 steps.
     constexpr double kGrowthPerStep = 1.5;
     constexpr int kGrowthSteps = 20;
+    bool indenter_warned = false;
     double energy_before = -1.0, energy_streak_start = 0.0;
     int growth_streak = 0;
     if (restarting) {
@@ -506,6 +516,18 @@ int run(const RunOptions& opt) {
         status = kRunFailed;
         state_valid = false;
         break;
+      }
+      if (indenter_watch && !indenter_warned) {
+        const IndenterStepLimit limit = indenter_step_limit(model, t, state.u);
+        if (dt_taken > limit.dt) {
+          const IndenterSettings& ind = model.indenters[limit.indenter];
+          log.line("warning: step " + std::to_string(step) + " (t = " + format("%.6g", t) + " s): indenter '" +
+                   ind.name + "' is " + format("%.4g", limit.depth) + " m deep at " + node_text(model, limit.node) +
+                   "; its stiffness 2K·h lowers that node's stable step (eq. 2.5) to " + format("%.4g", limit.dt) +
+                   " s < dt " + format("%.4g", dt_taken) + " s: the run may blow up (lower indenters[].stiffness or "
+                   "time.safety_factor); warned once");
+          indenter_warned = true;
+        }
       }
       const bool frame_due = c.output.every_steps ? step % *c.output.every_steps == 0
                                                   : t >= static_cast<double>(next_frame_index) * *c.output.every_time - 1e-9 * h;

@@ -313,3 +313,52 @@ TEST(Contact, CaseReaderRechecksContactAndIndenterKeys) {
                 .find("indenters[0].radius: required key is missing"),
             std::string::npos);
 }
+
+TEST(Indenter, StepLimitIsEquation25WithTheIndenterStiffness2Kh) {
+  // One node inside a small disk: the limit is √(2ρ/(Σ_j c V_j/|ξ| + 2K·h)) at that node, the sum
+  // written out here bond by bond; indenter_stable_depth is the depth where that limit equals dt
+  // at the stiffest node (an interior one, as the centre of a 9 × 9 plate is).
+  const int n = 9;
+  pd::Case c = pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0, 1e-3);
+  pd::IndenterSettings disk;
+  disk.name = "d";
+  disk.shape = "cylinder";
+  disk.radius = 0.3 * kDx;
+  disk.axis = {0.0, 0.0, 1.0};
+  disk.stiffness = 1e19;
+  c.indenters.push_back(disk);
+  pd::Model m = pd::build_model(c, pdtest::cubic_lattice(n, n, 1, kDx, 2, 1e-3));
+  const std::size_t centre = pdtest::node_index(4, 4, 0, n, n);
+  const pd::Vec3Array u = pd::make_vec3(m.nodes.size());
+  // Nobody inside: no limit.
+  m.indenters[0].centre = {-5 * kDx, -5 * kDx, 0.0};
+  EXPECT_EQ(pd::indenter_step_limit(m, 0.0, u).node, -1);
+  EXPECT_TRUE(std::isinf(pd::indenter_step_limit(m, 0.0, u).dt));
+
+  double sum = 0.0;  // thesis eq. 2.5's sum at the centre node, full volumes
+  const double micromodulus = m.material.micromodulus_pair[0];
+  for (std::int64_t k = m.bonds.offsets[centre]; k < m.bonds.offsets[centre + 1]; ++k) {
+    const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+    const double dxj = m.nodes.x[0][j] - m.nodes.x[0][centre], dyj = m.nodes.x[1][j] - m.nodes.x[1][centre];
+    sum += micromodulus * m.nodes.volume[j] / std::sqrt(dxj * dxj + dyj * dyj);
+  }
+  const double rho = m.density[centre];
+  EXPECT_NEAR(pd::stable_time_step(m), std::sqrt(2.0 * rho / sum), 1e-12 * pd::stable_time_step(m));
+
+  for (const double offset : {0.05 * kDx, 0.2 * kDx}) {  // h = R − offset
+    m.indenters[0].centre = {m.nodes.x[0][centre] + offset, m.nodes.x[1][centre], 0.0};
+    const pd::IndenterStepLimit limit = pd::indenter_step_limit(m, 0.0, u);
+    const double h = disk.radius - offset;
+    EXPECT_EQ(limit.node, static_cast<std::int64_t>(centre));
+    EXPECT_EQ(limit.indenter, 0u);
+    EXPECT_NEAR(limit.depth, h, 1e-12 * kDx);
+    EXPECT_NEAR(limit.dt, std::sqrt(2.0 * rho / (sum + 2.0 * disk.stiffness * h)), 1e-12 * limit.dt);
+  }
+  // At the depth indenter_stable_depth gives for a step dt, the centre node's limit is dt.
+  const double dt = 0.8 * pd::stable_time_step(m);
+  const double depth = pd::indenter_stable_depth(m, m.indenters[0], dt);
+  EXPECT_NEAR(depth, (2.0 * rho / (dt * dt) - sum) / (2.0 * disk.stiffness), 1e-9 * depth);
+  m.indenters[0].radius = 0.3 * kDx;
+  m.indenters[0].centre = {m.nodes.x[0][centre] + (0.3 * kDx - depth), m.nodes.x[1][centre], 0.0};
+  EXPECT_NEAR(pd::indenter_step_limit(m, 0.0, u).dt, dt, 1e-9 * dt);
+}

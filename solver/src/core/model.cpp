@@ -65,26 +65,30 @@ Model build_model(const Case& c, Nodes nodes) {
   return m;
 }
 
+double node_stiffness(const Model& m, std::size_t i) {
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const auto bi = static_cast<std::size_t>(m.block_index[i]);
+  double sum = 0.0;
+  // thesis eq. 2.5 with the linearised PMB stiffness |C(ξ)| = c/|ξ| (Silling & Askari 2005).
+  for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+    const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+    const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
+    const double length = bond_length(m.nodes.x, i, j);
+    sum += m.nodes.volume[j] * m.bonds.volume_weight(length) * c / length;
+    // With contact, a node pressed into a surface meets about as many contact partners as it has
+    // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
+    // 15c needs extra margin in impacts).
+    if (m.contact.pairs && length <= m.contact.distance) sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
+  }
+  return sum;
+}
+
 double stable_time_step(const Model& m) {
   const std::size_t n = m.nodes.size();
-  const auto nb = static_cast<std::size_t>(m.material.blocks);
   double dt = std::numeric_limits<double>::infinity();
-  // thesis eq. 2.5 with the linearised PMB stiffness |C(ξ)| = c/|ξ| (Silling & Askari 2005).
 #pragma omp parallel for schedule(static) reduction(min : dt)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-    const auto bi = static_cast<std::size_t>(m.block_index[static_cast<std::size_t>(i)]);
-    double sum = 0.0;
-    for (std::int64_t k = m.bonds.offsets[static_cast<std::size_t>(i)]; k < m.bonds.offsets[static_cast<std::size_t>(i) + 1]; ++k) {
-      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-      const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
-      const double length = bond_length(m.nodes.x, static_cast<std::size_t>(i), j);
-      sum += m.nodes.volume[j] * m.bonds.volume_weight(length) * c / length;
-      // With contact, a node pressed into a surface meets about as many contact partners as it has
-      // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
-      // 15c needs extra margin in impacts).
-      if (m.contact.pairs && length <= m.contact.distance)
-        sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
-    }
+    const double sum = node_stiffness(m, static_cast<std::size_t>(i));
     if (sum > 0.0) dt = std::min(dt, std::sqrt(2.0 * m.density[static_cast<std::size_t>(i)] / sum));
   }
   return dt;  // min is exact, so the reduction is deterministic for any thread count

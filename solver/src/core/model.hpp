@@ -40,5 +40,8 @@ Model build_model(const Case& c, Nodes nodes);
 // ν_p (partial volume) multiplies V_p; with contact, every bond shorter than 2r_s adds a contact
 // spring V_p·c_s/δ to the sum.
 double stable_time_step(const Model& model);
+// The sum of eq. 2.5 for node i, Σ_p V_p ν_p c_ip/|ξ_p| (+ the contact springs) [N/m⁴]: the stiffness
+// per unit volume that bounds node i's stable step, √(2ρ_i / sum).
+double node_stiffness(const Model& model, std::size_t i);
 
 }  // namespace pd

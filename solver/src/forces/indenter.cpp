@@ -57,6 +57,65 @@ std::array<double, 3> indenter_position(const IndenterSettings& ind, double t) {
   return {ind.centre[0] + ind.velocity[0] * t, ind.centre[1] + ind.velocity[1] * t, ind.centre[2] + ind.velocity[2] * t};
 }
 
+IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array& u) {
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  std::vector<IndenterShape> shapes;
+  std::vector<std::array<double, 3>> centres;
+  for (const IndenterSettings& ind : m.indenters) {
+    shapes.push_back(indenter_shape_registry().get(ind.shape));
+    centres.push_back(indenter_position(ind, t));
+  }
+  // Per node the tightest indenter; the min over nodes is exact, so any thread count finds the same.
+  auto node_limit = [&](std::size_t q, std::size_t& which, double& depth) {
+    double best = HUGE_VAL;
+    const double y[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
+    for (std::size_t k = 0; k < m.indenters.size(); ++k) {
+      const IndenterSettings& ind = m.indenters[k];
+      double dir[3];
+      const double h = shapes[k](ind, centres[k].data(), y, dir);
+      if (!(h > 0.0)) continue;
+      const double dt = std::sqrt(2.0 * m.density[q] / (node_stiffness(m, q) + 2.0 * ind.stiffness * h));
+      if (dt < best) {
+        best = dt;
+        which = k;
+        depth = h;
+      }
+    }
+    return best;
+  };
+  double limit = HUGE_VAL;
+#pragma omp parallel for schedule(static) reduction(min : limit)
+  for (std::int64_t i = 0; i < n; ++i) {
+    std::size_t which = 0;
+    double depth = 0.0;
+    limit = std::min(limit, node_limit(static_cast<std::size_t>(i), which, depth));
+  }
+  IndenterStepLimit out;
+  if (!(limit < HUGE_VAL)) return out;
+  out.dt = limit;
+  for (std::int64_t i = 0; i < n; ++i) {  // the first node that sets it (serial, rarely needed)
+    std::size_t which = 0;
+    double depth = 0.0;
+    if (node_limit(static_cast<std::size_t>(i), which, depth) == limit) {
+      out.node = i;
+      out.indenter = which;
+      out.depth = depth;
+      break;
+    }
+  }
+  return out;
+}
+
+double indenter_stable_depth(const Model& m, const IndenterSettings& ind, double dt) {
+  double depth = HUGE_VAL;
+#pragma omp parallel for schedule(static) reduction(min : depth)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(m.nodes.size()); ++i) {
+    const auto q = static_cast<std::size_t>(i);
+    depth = std::min(depth, (2.0 * m.density[q] / (dt * dt) - node_stiffness(m, q)) / (2.0 * ind.stiffness));
+  }
+  return std::max(depth, 0.0);
+}
+
 double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
                               std::vector<std::array<double, 3>>& force_on_body) const {
   const Model& m = model_;

@@ -4,6 +4,8 @@
 // for r < R). In a PERI model LAMMPS's f is a force density, so K is in N/m⁵ here too.
 #pragma once
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,22 @@ const Registry<IndenterShape>& indenter_shape_registry();
 
 // Where an indenter's centre (or plane point) is at time t.
 std::array<double, 3> indenter_position(const IndenterSettings& ind, double t);
+
+// The indenter in the stable step. A node h deep is pushed with K·h², so its stiffness along the
+// push is d(K h²)/dh = 2K·h per unit volume [N/m⁴]: it adds to the sum of thesis eq. 2.5
+// (node_stiffness), and the node's stable step √(2ρ/(Σ + 2K·h)) shrinks as the indenter goes in.
+struct IndenterStepLimit {
+  double dt = HUGE_VAL;      // min over nodes inside an indenter of √(2ρ_i / (Σ_i + 2K·h_i)) [s]
+  std::int64_t node = -1;    // where (the lowest index if several), −1 if no node is inside
+  std::size_t indenter = 0;  // which indenter
+  double depth = 0.0;        // h of that node [m]
+};
+IndenterStepLimit indenter_step_limit(const Model& model, double t, const Vec3Array& u);
+
+// The depth beyond which a step dt is no longer stable for indenter `ind` at the stiffest node of
+// the body (the largest Σ_i/ρ_i): (2ρ_i/dt² − Σ_i)/(2K), minimised over nodes, ≥ 0. A lower bound:
+// nodes at a surface have fewer bonds and tolerate more.
+double indenter_stable_depth(const Model& model, const IndenterSettings& ind, double dt);
 
 class IndenterForce {
  public:
