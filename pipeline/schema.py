@@ -84,7 +84,10 @@ INDENTER = {
                   default=None),
     "axis": Key("numbers", "cylinder: axis direction (default z: a disk in a 2D case)", default=None),
     "stiffness": Key("number", "K of the force density K·h² (LAMMPS fix indent; a force density "
-                     "as in LAMMPS PERI)", default=REQUIRED, unit="N/m⁵", above=0.0),
+                     "as in LAMMPS PERI). Its stiffness 2K·h at depth h joins the stable step, so a "
+                     "Verlet run's log says how deep the indenter may push a node with the step "
+                     "still guaranteed stable, and warns once (step, node, depth) if a node gets "
+                     "deeper", default=REQUIRED, unit="N/m⁵", above=0.0),
 }
 
 CRACK = {

@@ -174,7 +174,7 @@ int run(const RunOptions& opt) {
   }
 
   const double dt_stable = stable_time_step(model);
-  double dt = 0.0, dt_exact = 0.0;  // dt_exact: computed when time.dt is "exact" or a run fails
+  double dt = 0.0, dt_exact = 0.0;  // dt_exact: computed for time.dt "exact", a failed run, or indenters above eq. 2.5
   if (c.time.dt_rule == "stable") {
     if (!std::isfinite(dt_stable))
       throw Error(c.file.string() + ": time.dt: \"stable\" needs bonds, but no node has a partner within the horizon " +
@@ -317,13 +317,20 @@ int run(const RunOptions& opt) {
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
   for (const auto& text : work_summary(model, c)) log.line(text);
   // A fixed explicit step has no room for the indenter's stiffness 2K·h, which grows with depth:
-  // say how deep it may go, and (in the loop) warn once if a node gets deeper.
+  // say how deep it may go, and (in the loop) warn once if a node gets deeper (forces/indenter.hpp).
+  // A step above eq. 2.5 (dt: exact, or a fixed dt) is judged against the exact limit, computed
+  // here for a fixed dt (once, about as costly as tens of force evaluations).
   const bool indenter_watch = !model.indenters.empty() && integrator->name() == "verlet";
+  double omega2_exact = 0.0;
+  if (indenter_watch && dt > dt_stable) {
+    if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
+    if (dt_exact > 0.0 && std::isfinite(dt_exact)) omega2_exact = 4.0 / (dt_exact * dt_exact);
+  }
   if (indenter_watch)
     for (const auto& ind : model.indenters)
       log.line("indenter '" + ind.name + "': dt stays stable while no node is deeper than " +
-               format("%.4g", indenter_stable_depth(model, ind, dt)) +
-               " m (its stiffness 2K·h joins eq. 2.5; at the stiffest node)");
+               format("%.4g", indenter_stable_depth(model, ind, dt, omega2_exact)) + " m (its stiffness 2K·h with " +
+               (omega2_exact > 0.0 ? "the exact limit" : "eq. 2.5") + "; a bound, the step may hold deeper)");
   if (const auto* adaptive = dynamic_cast<const AdaptiveStep*>(integrator.get()))
     log.line("adaptive (thesis §2.2): TOL " + format("%g", adaptive->settings().tol) + ", Kd " +
              std::to_string(adaptive->settings().kd) + ", p " + format("%g", adaptive->settings().p) + ", phi " +
@@ -518,12 +525,12 @@ int run(const RunOptions& opt) {
         break;
       }
       if (indenter_watch && !indenter_warned) {
-        const IndenterStepLimit limit = indenter_step_limit(model, t, state.u);
-        if (dt_taken > limit.dt) {
+        const IndenterStepLimit limit = indenter_step_limit(model, t, state.u, omega2_exact);
+        if (limit.node >= 0 && dt_taken > limit.dt) {
           const IndenterSettings& ind = model.indenters[limit.indenter];
           log.line("warning: step " + std::to_string(step) + " (t = " + format("%.6g", t) + " s): indenter '" +
                    ind.name + "' is " + format("%.4g", limit.depth) + " m deep at " + node_text(model, limit.node) +
-                   "; its stiffness 2K·h lowers that node's stable step (eq. 2.5) to " + format("%.4g", limit.dt) +
+                   "; with its stiffness 2K·h the step is guaranteed stable only below " + format("%.4g", limit.dt) +
                    " s < dt " + format("%.4g", dt_taken) + " s: the run may blow up (lower indenters[].stiffness or "
                    "time.safety_factor); warned once");
           indenter_warned = true;

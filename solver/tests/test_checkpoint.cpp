@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "../fuzz/checkpoint_seal.hpp"
 #include "core/error.hpp"
 #include "integrators/adaptive.hpp"
 #include "io/checkpoint.hpp"
@@ -286,6 +287,29 @@ TEST(Checkpoint, RefusedForAnotherCaseOrWhenDamaged) {
   std::ofstream(ck, std::ios::binary) << good;
   EXPECT_EQ(run(dir / "case.json", {}, ck), pd::kOk);
   fs::remove_all(dir);
+}
+
+// Two inputs the fuzzer's regression set keeps (solver/fuzz/regressions/pd_fuzz_checkpoint): a
+// header whose payload size is 2⁶⁴ − 1 is named as stored (kHead + size + 8 would wrap around to
+// a small number), and a checksum-valid file with indenter forces that are not whole triples is
+// refused rather than silently shortened.
+TEST(Checkpoint, ReaderNamesAHugePayloadSizeAndRefusesPartialIndenterTriples) {
+  const fs::path inputs = fs::path(PD_SOURCE_DIR) / "fuzz" / "regressions" / "pd_fuzz_checkpoint";
+  auto error_of = [](const std::string& bytes) -> std::string {
+    try {
+      pd::parse_checkpoint(bytes, "ck.bin");
+    } catch (const pd::Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  const std::string huge = error_of(slurp(inputs / "huge-payload-size"));
+  EXPECT_NE(huge.find("ck.bin: checkpoint truncated or padded: 770 bytes, the header says a payload of "
+                      "18446744073709551615 bytes"),
+            std::string::npos)
+      << huge;
+  const std::string triples = error_of(pd_fuzz::sealed_checkpoint(slurp(inputs / "indenter-force-not-triple-sealed")));
+  EXPECT_NE(triples.find("indenter forces are not whole (x, y, z) triples"), std::string::npos) << triples;
 }
 
 // A blow-up names the step, the time and the node (index and position) where it most likely

@@ -314,10 +314,12 @@ TEST(Contact, CaseReaderRechecksContactAndIndenterKeys) {
             std::string::npos);
 }
 
-TEST(Indenter, StepLimitIsEquation25WithTheIndenterStiffness2Kh) {
-  // One node inside a small disk: the limit is √(2ρ/(Σ_j c V_j/|ξ| + 2K·h)) at that node, the sum
-  // written out here bond by bond; indenter_stable_depth is the depth where that limit equals dt
-  // at the stiffest node (an interior one, as the centre of a 9 × 9 plate is).
+TEST(Indenter, StepLimitIsEquation25WithTheOneEndedIndenterSpring) {
+  // One node inside a small disk. Bound (a): √(2ρ/(Σ_j c V_j/|ξ| + K·h)) at that node, the sum
+  // written out here bond by bond; the indenter's spring 2K·h has one moving end, so it enters
+  // eq. 2.5's sum (which counts each two-ended bond spring once) as K·h. indenter_stable_depth is
+  // the depth where (a) equals dt at the stiffest node (an interior one, as the centre of a 9 × 9
+  // plate is). Bound (b), with ω_max known: 2/√(ω_max² + 2K·h/ρ).
   const int n = 9;
   pd::Case c = pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0, 1e-3);
   pd::IndenterSettings disk;
@@ -352,13 +354,23 @@ TEST(Indenter, StepLimitIsEquation25WithTheIndenterStiffness2Kh) {
     EXPECT_EQ(limit.node, static_cast<std::int64_t>(centre));
     EXPECT_EQ(limit.indenter, 0u);
     EXPECT_NEAR(limit.depth, h, 1e-12 * kDx);
-    EXPECT_NEAR(limit.dt, std::sqrt(2.0 * rho / (sum + 2.0 * disk.stiffness * h)), 1e-12 * limit.dt);
+    EXPECT_NEAR(limit.dt, std::sqrt(2.0 * rho / (sum + disk.stiffness * h)), 1e-12 * limit.dt);
+    // (b) wins when the exact ω_max is well below eq. 2.5's bound (here: its square root of 2/3).
+    const double omega2 = (2.0 / 3.0) * 2.0 * sum / rho;
+    const double weyl = 2.0 / std::sqrt(omega2 + 2.0 * disk.stiffness * h / rho);
+    EXPECT_NEAR(pd::indenter_step_limit(m, 0.0, u, omega2).dt, std::max(weyl, limit.dt), 1e-12 * weyl);
   }
-  // At the depth indenter_stable_depth gives for a step dt, the centre node's limit is dt.
+  // At the depth indenter_stable_depth gives for a step dt, the centre node's bound (a) is dt.
   const double dt = 0.8 * pd::stable_time_step(m);
   const double depth = pd::indenter_stable_depth(m, m.indenters[0], dt);
-  EXPECT_NEAR(depth, (2.0 * rho / (dt * dt) - sum) / (2.0 * disk.stiffness), 1e-9 * depth);
-  m.indenters[0].radius = 0.3 * kDx;
+  EXPECT_NEAR(depth, (2.0 * rho / (dt * dt) - sum) / disk.stiffness, 1e-9 * depth);
   m.indenters[0].centre = {m.nodes.x[0][centre] + (0.3 * kDx - depth), m.nodes.x[1][centre], 0.0};
   EXPECT_NEAR(pd::indenter_step_limit(m, 0.0, u).dt, dt, 1e-9 * dt);
+  // A single bondless node: bound (a) is exactly velocity Verlet's 2/ω with ω² = 2K·h/ρ.
+  pd::Case lone = c;
+  pd::Nodes one = pdtest::cubic_lattice(1, 1, 1, kDx, 2, 1e-3);
+  pd::Model single = pd::build_model(lone, std::move(one));
+  single.indenters[0].centre = {0.1 * kDx, 0.0, 0.0};  // h = 0.2 dx
+  const double h1 = 0.2 * kDx, omega = std::sqrt(2.0 * disk.stiffness * h1 / single.density[0]);
+  EXPECT_NEAR(pd::indenter_step_limit(single, 0.0, pd::make_vec3(1)).dt, 2.0 / omega, 1e-12 / omega);
 }

@@ -174,5 +174,5 @@ def test_history_energies_are_those_of_the_state_written(runs, integrator):
     m = re.search(r"output: frames and history.csv took ([0-9.]+) s wall, ([0-9.]+) % of the time loop", log)
     assert m, log
     loop = float(re.search(r"done: \d+ steps .* in ([0-9.]+) s wall", log).group(1))
-    assert 0.0 < float(m.group(1)) <= loop
-    assert 0.0 < float(m.group(2)) <= 100.0
+    assert 0.0 <= float(m.group(1)) <= loop  # printed to the ms: a fast run may show 0.000
+    assert 0.0 <= float(m.group(2)) <= 100.0

@@ -39,53 +39,56 @@ void VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vecto
   const double reach2 = reach * reach;
   const double bonded2 = p.bond_cutoff * p.bond_cutoff;
 
+  // The candidates j of row i within contact distance + skin of node i now.
   auto for_each = [&](std::size_t i, auto&& visit) {
     const double pi[3] = {y[0][i], y[1][i], y[2][i]};
     grid.for_each_near(pi, i, [&](std::size_t j) {
       if (!p.self_contact && block[i] == block[j]) return;
       const double e0 = y[0][j] - pi[0], e1 = y[1][j] - pi[1], e2 = y[2][j] - pi[2];
       if (e0 * e0 + e1 * e1 + e2 * e2 > reach2) return;
-      // Reference length from x_j − x_i: bitwise the same from both ends, so d_ij = d_ji.
-      const double x0 = x[0][j] - x[0][i], x1 = x[1][j] - x[1][i], x2 = x[2][j] - x[2][i];
-      const double xi2 = x0 * x0 + x1 * x1 + x2 * x2;
-      visit(static_cast<std::int32_t>(j), contact_distance(std::sqrt(xi2), xi2 <= bonded2, p.distance));
+      visit(static_cast<std::int32_t>(j));
     });
   };
+  // d_ij of a pair from the reference length x_j − x_i: bitwise the same from both ends, so d_ij = d_ji.
+  auto pair_distance = [&](std::size_t i, std::size_t j) {
+    const double x0 = x[0][j] - x[0][i], x1 = x[1][j] - x[1][i], x2 = x[2][j] - x[2][i];
+    const double xi2 = x0 * x0 + x1 * x1 + x2 * x2;
+    return contact_distance(std::sqrt(xi2), xi2 <= bonded2, p.distance);
+  };
   // One pass over the cells: each thread finds the rows of its contiguous share of the nodes
-  // (schedule static: one block per thread) into its own buffer, row after row, each row sorted by j
-  // so that the list (and every sum over it) does not depend on the bin layout or the thread count;
-  // then the offsets are summed and each thread copies its block into place.
+  // (schedule static: one block per thread) into its own buffer of j's, row after row, each row
+  // sorted so that the list (and every sum over it) does not depend on the bin layout or the
+  // thread count; then the offsets are summed and each thread writes its rows into place.
   auto& found = scratch.found;
-  auto& first_row = scratch.first_row;
   found.resize(static_cast<std::size_t>(omp_get_max_threads()));
-  first_row.assign(found.size(), -1);
 #pragma omp parallel
   {
-    const auto t = static_cast<std::size_t>(omp_get_thread_num());
-    std::vector<std::pair<std::int32_t, double>>& mine = found[t];
+    std::vector<std::int32_t>& mine = found[static_cast<std::size_t>(omp_get_thread_num())];
     mine.clear();
+    std::int64_t first = 0, last = -1;  // this thread's rows [first, last]
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-      if (first_row[t] < 0) first_row[t] = i;
+      if (last < first) first = i;
+      last = i;
       const std::size_t row_start = mine.size();
-      for_each(static_cast<std::size_t>(i), [&](std::int32_t j, double d) { mine.emplace_back(j, d); });
+      for_each(static_cast<std::size_t>(i), [&](std::int32_t j) { mine.push_back(j); });
       std::sort(mine.begin() + static_cast<std::ptrdiff_t>(row_start), mine.end());
       out.offsets[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(mine.size() - row_start);
     }
-  }
-  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] += out.offsets[i];
-  out.neighbour.resize(static_cast<std::size_t>(out.offsets[n]));
-  out.distance.resize(out.neighbour.size());
-#pragma omp parallel for schedule(static, 1)
-  for (std::int64_t t = 0; t < static_cast<std::int64_t>(found.size()); ++t) {
-    const auto& mine = found[static_cast<std::size_t>(t)];
-    if (first_row[static_cast<std::size_t>(t)] < 0) continue;  // a thread that got no rows
-    auto k = static_cast<std::size_t>(out.offsets[static_cast<std::size_t>(first_row[static_cast<std::size_t>(t)])]);
-    for (const auto& [j, d] : mine) {
-      out.neighbour[k] = j;
-      out.distance[k] = d;
-      ++k;
-    }
+#pragma omp single
+    {
+      for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] += out.offsets[i];
+      out.neighbour.resize(static_cast<std::size_t>(out.offsets[n]));
+      out.distance.resize(out.neighbour.size());
+    }  // the barrier after single: the offsets and arrays are ready for every thread
+    std::size_t from = 0;
+    for (std::int64_t i = first; i <= last; ++i)
+      for (auto k = static_cast<std::size_t>(out.offsets[static_cast<std::size_t>(i)]);
+           k < static_cast<std::size_t>(out.offsets[static_cast<std::size_t>(i) + 1]); ++k) {
+        const std::int32_t j = mine[from++];
+        out.neighbour[k] = j;
+        out.distance[k] = pair_distance(static_cast<std::size_t>(i), static_cast<std::size_t>(j));
+      }
   }
 }
 

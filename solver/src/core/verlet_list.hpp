@@ -50,9 +50,8 @@ class VerletList {
   // steps would otherwise allocate them afresh, and the page faults of that cost a quarter of
   // the search (cases/impact, perf).
   struct Scratch {
-    Vec3Array y;                                                    // current positions x + u
-    std::vector<std::vector<std::pair<std::int32_t, double>>> found;  // per thread: its rows' (j, d_ij)
-    std::vector<std::int64_t> first_row;                            // per thread: its first row, or −1
+    Vec3Array y;                                   // current positions x + u
+    std::vector<std::vector<std::int32_t>> found;  // per thread: the j's of its rows, row after row
   };
   // search() into `out`, reusing its storage and that of `scratch`.
   static void search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,

@@ -57,7 +57,7 @@ std::array<double, 3> indenter_position(const IndenterSettings& ind, double t) {
   return {ind.centre[0] + ind.velocity[0] * t, ind.centre[1] + ind.velocity[1] * t, ind.centre[2] + ind.velocity[2] * t};
 }
 
-IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array& u) {
+IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array& u, double omega2_exact) {
   const auto n = static_cast<std::int64_t>(m.nodes.size());
   std::vector<IndenterShape> shapes;
   std::vector<std::array<double, 3>> centres;
@@ -65,55 +65,78 @@ IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array&
     shapes.push_back(indenter_shape_registry().get(ind.shape));
     centres.push_back(indenter_position(ind, t));
   }
-  // Per node the tightest indenter; the min over nodes is exact, so any thread count finds the same.
-  auto node_limit = [&](std::size_t q, std::size_t& which, double& depth) {
-    double best = HUGE_VAL;
+  // Per node: bound (a) and the diagonal 2K·h/ρ that bound (b) needs, for its tightest indenter.
+  struct NodeBound {
+    double gershgorin = HUGE_VAL;  // (a) √(2ρ/(Σ + K·h))
+    double diagonal = 0.0;         // 2K·h/ρ [1/s²]
+    std::int64_t node = -1;
+    std::size_t indenter = 0;
+    double depth = 0.0;
+  };
+  auto node_bound = [&](std::size_t q) {
+    NodeBound b;
     const double y[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
+    double sum = -1.0;  // eq. 2.5's Σ_q, computed only for a node inside an indenter
     for (std::size_t k = 0; k < m.indenters.size(); ++k) {
       const IndenterSettings& ind = m.indenters[k];
       double dir[3];
       const double h = shapes[k](ind, centres[k].data(), y, dir);
       if (!(h > 0.0)) continue;
-      const double dt = std::sqrt(2.0 * m.density[q] / (node_stiffness(m, q) + 2.0 * ind.stiffness * h));
-      if (dt < best) {
-        best = dt;
-        which = k;
-        depth = h;
+      if (sum < 0.0) sum = node_stiffness(m, q);
+      const double gershgorin = std::sqrt(2.0 * m.density[q] / (sum + ind.stiffness * h));
+      if (gershgorin < b.gershgorin) {
+        b.gershgorin = gershgorin;
+        b.node = static_cast<std::int64_t>(q);
+        b.indenter = k;
+        b.depth = h;
       }
+      b.diagonal = std::max(b.diagonal, 2.0 * ind.stiffness * h / m.density[q]);
     }
-    return best;
+    return b;
   };
-  double limit = HUGE_VAL;
-#pragma omp parallel for schedule(static) reduction(min : limit)
-  for (std::int64_t i = 0; i < n; ++i) {
-    std::size_t which = 0;
-    double depth = 0.0;
-    limit = std::min(limit, node_limit(static_cast<std::size_t>(i), which, depth));
+  // Fixed chunks of nodes, combined in chunk order: the node named is the same for any thread count.
+  constexpr std::int64_t kNodes = 4096;
+  const std::int64_t chunks = (n + kNodes - 1) / kNodes;
+  std::vector<NodeBound> tightest(static_cast<std::size_t>(chunks));
+  std::vector<double> diagonal(static_cast<std::size_t>(chunks), 0.0);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t c = 0; c < chunks; ++c) {
+    NodeBound& best = tightest[static_cast<std::size_t>(c)];
+    for (std::int64_t i = c * kNodes; i < std::min(n, (c + 1) * kNodes); ++i) {
+      const NodeBound b = node_bound(static_cast<std::size_t>(i));
+      if (b.gershgorin < best.gershgorin) best = b;
+      diagonal[static_cast<std::size_t>(c)] = std::max(diagonal[static_cast<std::size_t>(c)], b.diagonal);
+    }
+  }
+  NodeBound best;
+  double max_diagonal = 0.0;
+  for (std::size_t c = 0; c < tightest.size(); ++c) {
+    if (tightest[c].gershgorin < best.gershgorin) best = tightest[c];
+    max_diagonal = std::max(max_diagonal, diagonal[c]);
   }
   IndenterStepLimit out;
-  if (!(limit < HUGE_VAL)) return out;
-  out.dt = limit;
-  for (std::int64_t i = 0; i < n; ++i) {  // the first node that sets it (serial, rarely needed)
-    std::size_t which = 0;
-    double depth = 0.0;
-    if (node_limit(static_cast<std::size_t>(i), which, depth) == limit) {
-      out.node = i;
-      out.indenter = which;
-      out.depth = depth;
-      break;
-    }
-  }
+  if (best.node < 0) return out;  // no node inside any indenter
+  out.node = best.node;
+  out.indenter = best.indenter;
+  out.depth = best.depth;
+  out.dt = best.gershgorin;
+  // (b): the indenter springs add a diagonal to M⁻¹K, raising ω_max² by at most its largest entry.
+  if (omega2_exact > 0.0) out.dt = std::max(out.dt, 2.0 / std::sqrt(omega2_exact + max_diagonal));
   return out;
 }
 
-double indenter_stable_depth(const Model& m, const IndenterSettings& ind, double dt) {
-  double depth = HUGE_VAL;
-#pragma omp parallel for schedule(static) reduction(min : depth)
+double indenter_stable_depth(const Model& m, const IndenterSettings& ind, double dt, double omega2_exact) {
+  double depth = HUGE_VAL, lightest = HUGE_VAL;
+#pragma omp parallel for schedule(static) reduction(min : depth, lightest)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(m.nodes.size()); ++i) {
     const auto q = static_cast<std::size_t>(i);
-    depth = std::min(depth, (2.0 * m.density[q] / (dt * dt) - node_stiffness(m, q)) / (2.0 * ind.stiffness));
+    depth = std::min(depth, (2.0 * m.density[q] / (dt * dt) - node_stiffness(m, q)) / ind.stiffness);  // (a)
+    lightest = std::min(lightest, m.density[q]);
   }
-  return std::max(depth, 0.0);
+  depth = std::max(depth, 0.0);
+  if (omega2_exact > 0.0)  // (b): 2K·h/ρ ≤ 4/dt² − ω_max² at every node
+    depth = std::max(depth, (4.0 / (dt * dt) - omega2_exact) * lightest / (2.0 * ind.stiffness));
+  return depth;
 }
 
 double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,

@@ -23,21 +23,29 @@ const Registry<IndenterShape>& indenter_shape_registry();
 // Where an indenter's centre (or plane point) is at time t.
 std::array<double, 3> indenter_position(const IndenterSettings& ind, double t);
 
-// The indenter in the stable step. A node h deep is pushed with K·h², so its stiffness along the
-// push is d(K h²)/dh = 2K·h per unit volume [N/m⁴]: it adds to the sum of thesis eq. 2.5
-// (node_stiffness), and the node's stable step √(2ρ/(Σ + 2K·h)) shrinks as the indenter goes in.
+// The indenter in the stable step. A node h deep is pushed with K·h², so along the push it feels a
+// spring of stiffness d(K h²)/dh = 2K·h per unit volume [N/m⁴], tied to the rigid indenter: it adds
+// to the diagonal of the stiffness only. Two sufficient conditions for velocity Verlet to stay stable
+// with it (the true limit is above both):
+//  (a) thesis eq. 2.5 with it: √(2ρ_i/(Σ_i + K·h_i)) at every node. Eq. 2.5 counts each bond's
+//      spring c·V/|ξ| once although a bond has two moving ends (the worst mode doubles it: the
+//      Gershgorin bound of the row is 2Σ_i); a one-ended spring 2K·h counts once, i.e. as K·h in
+//      eq. 2.5's sum (a node with no bonds: √(2ρ/(K·h)) = 2/ω, ω² = 2K·h/ρ).
+//  (b) when the exact limit ω_max (core/stability) is known: a positive diagonal D raises the
+//      largest eigenvalue of M⁻¹K by at most max_i D_i/ρ_i (Weyl), so 2/√(ω_max² + max_i 2K·h_i/ρ_i).
 struct IndenterStepLimit {
-  double dt = HUGE_VAL;      // min over nodes inside an indenter of √(2ρ_i / (Σ_i + 2K·h_i)) [s]
-  std::int64_t node = -1;    // where (the lowest index if several), −1 if no node is inside
-  std::size_t indenter = 0;  // which indenter
-  double depth = 0.0;        // h of that node [m]
+  double dt = HUGE_VAL;      // the larger of (a), minimised over nodes, and (b) [s]
+  std::int64_t node = -1;    // the node that sets (a) (the lowest index if several); −1: no node inside
+  std::size_t indenter = 0;  // its indenter
+  double depth = 0.0;        // its depth h [m]
 };
-IndenterStepLimit indenter_step_limit(const Model& model, double t, const Vec3Array& u);
+// omega2_exact: ω_max² of the body without indenters [1/s²], or 0 if not computed (then (a) only).
+IndenterStepLimit indenter_step_limit(const Model& model, double t, const Vec3Array& u, double omega2_exact = 0.0);
 
-// The depth beyond which a step dt is no longer stable for indenter `ind` at the stiffest node of
-// the body (the largest Σ_i/ρ_i): (2ρ_i/dt² − Σ_i)/(2K), minimised over nodes, ≥ 0. A lower bound:
-// nodes at a surface have fewer bonds and tolerate more.
-double indenter_stable_depth(const Model& model, const IndenterSettings& ind, double dt);
+// How deep indenter `ind` may push any node while step dt keeps satisfying (a) or (b): the larger of
+// min_i (2ρ_i/dt² − Σ_i)/K and (4/dt² − ω_max²)·min_i ρ_i/(2K), ≥ 0. A lower bound of the depth
+// at which the step actually becomes unstable.
+double indenter_stable_depth(const Model& model, const IndenterSettings& ind, double dt, double omega2_exact = 0.0);
 
 class IndenterForce {
  public:
