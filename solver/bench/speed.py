@@ -201,7 +201,7 @@ def main():
                          max(2, STEPS.get(args.order_side, 10) // (4 if args.quick else 1)), workdir)
 
     pdsolve = os.path.join(args.build, "pdsolve")
-    for case in ("membrane", "impact"):
+    for case in ("membrane", "impact", "branching"):
         case_dir = os.path.join("out", case)
         if not os.path.exists(os.path.join(case_dir, "case.json")):
             print(f"output cost: out/{case} not built (make case={case}), skipped")

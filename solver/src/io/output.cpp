@@ -37,25 +37,39 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
   g.point_data.push_back(make_array("damage", damage(model)));
   g.point_data.push_back(make_array("block", model.nodes.block));
 
-  std::vector<std::int64_t> conn, offs;
-  std::vector<std::uint8_t> types(n, 1), broken_flag(n, 0);
-  conn.reserve(n);
-  offs.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    conn.push_back(static_cast<std::int64_t>(i));
-    offs.push_back(static_cast<std::int64_t>(i) + 1);
-  }
+  // Cells: a vertex per node, then a line per broken bond (each once, from its end i < j), in node
+  // order. Counted per node in parallel, so a frame does not walk every bond on one thread.
   const auto& b = model.bonds;
-  for (std::size_t i = 0; i < n; ++i)
-    for (auto k = static_cast<std::size_t>(b.offsets[i]); k < static_cast<std::size_t>(b.offsets[i + 1]); ++k) {
-      const auto j = static_cast<std::size_t>(b.neighbour[k]);
-      if (!b.broken[k] || j < i) continue;  // each broken bond once, i < j
-      conn.push_back(static_cast<std::int64_t>(i));
-      conn.push_back(static_cast<std::int64_t>(j));
-      offs.push_back(static_cast<std::int64_t>(conn.size()));
-      types.push_back(3);  // VTK_LINE
-      broken_flag.push_back(1);
+  std::vector<std::int64_t> first_line(n + 1, 0);  // broken bonds i < j before node i
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+    std::int64_t count = 0;
+    for (std::int64_t k = b.offsets[static_cast<std::size_t>(i)]; k < b.offsets[static_cast<std::size_t>(i) + 1]; ++k)
+      count += b.broken[static_cast<std::size_t>(k)] && b.neighbour[static_cast<std::size_t>(k)] > i;
+    first_line[static_cast<std::size_t>(i) + 1] = count;
+  }
+  for (std::size_t i = 0; i < n; ++i) first_line[i + 1] += first_line[i];
+  const auto lines = static_cast<std::size_t>(first_line[n]);
+  std::vector<std::int64_t> conn(n + 2 * lines), offs(n + lines);
+  std::vector<std::uint8_t> types(n + lines, 3), broken_flag(n + lines, 1);  // VTK_LINE, broken
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+    const auto q = static_cast<std::size_t>(i);
+    conn[q] = i;  // the vertex cell of node i
+    offs[q] = i + 1;
+    types[q] = 1;  // VTK_VERTEX
+    broken_flag[q] = 0;
+    std::size_t cell = n + static_cast<std::size_t>(first_line[q]);
+    for (std::int64_t k = b.offsets[q]; k < b.offsets[q + 1]; ++k) {
+      const std::int64_t j = b.neighbour[static_cast<std::size_t>(k)];
+      if (!b.broken[static_cast<std::size_t>(k)] || j < i) continue;
+      const std::size_t at = n + 2 * (cell - n);
+      conn[at] = i;
+      conn[at + 1] = j;
+      offs[cell] = static_cast<std::int64_t>(at + 2);
+      ++cell;
     }
+  }
   g.connectivity = make_array("connectivity", conn);
   g.offsets = make_array("offsets", offs);
   g.types = make_array("types", types);

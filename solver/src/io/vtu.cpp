@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include "core/error.hpp"
 
@@ -24,29 +25,36 @@ std::size_t VtuArray::value_size() const {
 
 VtuArray make_vec3_array(const std::string& name, const std::vector<double>& x, const std::vector<double>& y,
                          const std::vector<double>& z) {
-  std::vector<double> v(3 * x.size());
+  // Straight into the array's bytes: a frame has three of these, each 24 bytes per node.
+  VtuArray a{name, vtk_type_name<double>(), 3, {}};
+  a.bytes.reserve(3 * x.size() * sizeof(double));
   for (std::size_t i = 0; i < x.size(); ++i) {
-    v[3 * i] = x[i];
-    v[3 * i + 1] = y[i];
-    v[3 * i + 2] = z[i];
+    const double point[3] = {x[i], y[i], z[i]};
+    const auto* first = reinterpret_cast<const unsigned char*>(point);
+    a.bytes.insert(a.bytes.end(), first, first + sizeof point);
   }
-  return make_array(name, v, 3);
+  return a;
 }
 
 // ---------------------------------------------------------------- writing
 
-void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+void write_file_atomically(const std::filesystem::path& path, const std::vector<std::string_view>& pieces) {
   const std::filesystem::path tmp = path.string() + ".part";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw Error(tmp.string() + ": cannot open for writing");
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    // Piece by piece from where the data lie: a frame's arrays are not first copied into one string.
+    for (const std::string_view piece : pieces) out.write(piece.data(), static_cast<std::streamsize>(piece.size()));
     out.close();
     if (!out) throw Error(tmp.string() + ": write failed (disk full?)");
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) throw Error(path.string() + ": cannot rename " + tmp.string() + " into place: " + ec.message());
+}
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+  write_file_atomically(path, std::vector<std::string_view>{text});
 }
 
 void write_vtu(const std::filesystem::path& path, const VtuGrid& g) {
@@ -81,15 +89,16 @@ void write_vtu(const std::filesystem::path& path, const VtuGrid& g) {
   array_tag(g.offsets, false);
   array_tag(g.types, false);
   head << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n_";
-  std::string text = head.str();
-  text.reserve(text.size() + offset + 64);
-  for (const VtuArray* a : order) {
-    const std::uint64_t count = a->bytes.size();
-    text.append(reinterpret_cast<const char*>(&count), 8);
-    text.append(reinterpret_cast<const char*>(a->bytes.data()), a->bytes.size());
+  const std::string text = head.str();
+  std::vector<std::uint64_t> counts;  // each array's byte count, the header of its appended block
+  for (const VtuArray* a : order) counts.push_back(a->bytes.size());
+  std::vector<std::string_view> pieces{text};
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    pieces.emplace_back(reinterpret_cast<const char*>(&counts[k]), 8);
+    pieces.emplace_back(reinterpret_cast<const char*>(order[k]->bytes.data()), order[k]->bytes.size());
   }
-  text += "\n  </AppendedData>\n</VTKFile>\n";
-  write_file_atomically(path, text);
+  pieces.emplace_back("\n  </AppendedData>\n</VTKFile>\n");
+  write_file_atomically(path, pieces);
 }
 
 // ---------------------------------------------------------------- reading

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pd {
@@ -30,8 +31,8 @@ template <> inline const char* vtk_type_name<std::uint8_t>() { return "UInt8"; }
 template <class T>
 VtuArray make_array(const std::string& name, const std::vector<T>& values, int components = 1) {
   VtuArray a{name, vtk_type_name<T>(), components, {}};
-  a.bytes.resize(values.size() * sizeof(T));
-  if (!values.empty()) std::memcpy(a.bytes.data(), values.data(), a.bytes.size());
+  const auto* first = reinterpret_cast<const unsigned char*>(values.data());
+  a.bytes.assign(first, first + values.size() * sizeof(T));  // one copy, no zero fill before it
   return a;
 }
 
@@ -68,6 +69,8 @@ VtuGrid parse_vtu(const std::string& text, const std::string& file);
 
 // Writes `text` to `path` through a temporary file and a rename.
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+// The same for text given in pieces, written one after the other.
+void write_file_atomically(const std::filesystem::path& path, const std::vector<std::string_view>& pieces);
 
 // Typed copy of an array's values.
 template <class T>
