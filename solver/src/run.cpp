@@ -200,7 +200,7 @@ int run(const RunOptions& opt) {
   const auto steps_for_end = static_cast<std::int64_t>(std::ceil(end / dt * (1.0 - kLastStepSlack)));
   const std::int64_t steps_expected = std::min(steps_for_end, max_steps);
   std::unique_ptr<Integrator> integrator = integrator_registry().get(c.time.integrator)(model);
-  integrator->configure(c);
+  integrator->configure(c, dt_exact);
 
   State state(n);
   double t = 0.0;
@@ -337,8 +337,10 @@ int run(const RunOptions& opt) {
              format("%g", adaptive->settings().phi) + ", dt_min " + format("%.6g", adaptive->dt_min()) + " s, dt_max " +
              format("%.6g", adaptive->dt_max()) + " s" +
              (adaptive->settings().dt_max ? std::string()
-                                          : " (default: eq. 2.5 or 0.9 × the contraction limit, eigenvalue estimate " +
-                                                format("%.3f", adaptive->limit_seconds()) + " s)"));
+              : dt_exact > 0.0
+                  ? std::string(" (default: eq. 2.5 or 0.9 × the contraction limit, from the exact limit above)")
+                  : " (default: eq. 2.5 or 0.9 × the contraction limit, eigenvalue estimate " +
+                        format("%.3f", adaptive->limit_seconds()) + " s)"));
   log.line("end time " + format("%.6g", end) + " s, steps expected " + std::to_string(steps_expected) +
            (steps_for_end > max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(threads));
 

@@ -160,3 +160,21 @@ TEST(TimeLoop, AnIndenterTooStiffForTheStepIsReportedOnceWithItsDepth) {
     }
   }
 }
+
+TEST(TimeLoop, AdaptiveWithTheExactRuleReusesTheExactLimitForItsDefaultDtMax) {
+  // time.dt "exact" already ran the Lanczos estimate; the adaptive default Δt_max
+  // min(eq. 2.5, 0.9·Δt_exact/(2φ)) takes that value instead of estimating it again.
+  const fs::path dir = temp_dir("adaptive_exact");
+  write_case(dir, R"({"end": 1e-6, "integrator": "adaptive", "dt": "exact", "safety_factor": 0.5})",
+             R"(, "adaptive": {"tol": 1e-3, "kd": 20, "p": 3.0, "phi": 1.0})");
+  ASSERT_EQ(run_solver(dir), 0) << slurp(dir / "log.txt");
+  const std::string log = slurp(dir / "out" / "run.log");
+  std::smatch exact, stable, dt_max;
+  ASSERT_TRUE(std::regex_search(log, exact, std::regex("exact limit ([0-9.e+-]+) s = ([0-9.e+-]+) × eq. 2.5"))) << log;
+  ASSERT_TRUE(std::regex_search(log, dt_max, std::regex("dt_max ([0-9.e+-]+) s \\(default: eq. 2.5 or 0.9 × the "
+                                                        "contraction limit, from the exact limit above\\)")))
+      << log;
+  const double dt_exact = std::stod(exact[1]), eq25 = dt_exact / std::stod(exact[2]);
+  EXPECT_NEAR(std::stod(dt_max[1]), std::min(eq25, 0.9 * dt_exact / 2.0), 1e-5 * std::stod(dt_max[1])) << log;
+  EXPECT_EQ(log.find("eigenvalue estimate"), std::string::npos) << log;
+}

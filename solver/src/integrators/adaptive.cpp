@@ -24,7 +24,7 @@ std::string number(double value) {
 
 }  // namespace
 
-void AdaptiveStep::configure(const Case& c) {
+void AdaptiveStep::configure(const Case& c, double dt_exact_known) {
   settings_ = c.adaptive;
   // Default Δt_max: eq. 2.5 (validation.md §3: keep Δt ≤ Δt_SA), and below the step where the
   // fixed-point iteration stops contracting, φΔtω_max < 1, i.e. Δt < Δt_exact/(2φ) (adaptive.hpp).
@@ -38,7 +38,7 @@ void AdaptiveStep::configure(const Case& c) {
   limit_seconds_ = 0.0;
   if (!settings_.dt_max && std::isfinite(dt_sa)) {
     const auto start = std::chrono::steady_clock::now();  // Lanczos: reported in run.log
-    const double dt_exact = exact_time_step(model_);
+    const double dt_exact = dt_exact_known > 0.0 ? dt_exact_known : exact_time_step(model_);
     limit_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (std::isfinite(dt_exact)) dt_max = std::min(dt_max, 0.9 * dt_exact / (2.0 * settings_.phi));
   }

@@ -48,7 +48,7 @@ class AdaptiveStep : public Integrator {
  public:
   explicit AdaptiveStep(Model& model) : model_(model) {}
   std::string name() const override { return "adaptive"; }
-  void configure(const Case& c) override;
+  void configure(const Case& c, double dt_exact = 0.0) override;
   void initialize(State& state, double t) override;
   // dt in: the step to try (the caller's proposal, possibly shortened to land on an output time);
   // dt out: the step taken. last_step().next_dt is the controller's proposal for the next step.

@@ -36,7 +36,9 @@ class Integrator {
   virtual ~Integrator() = default;
   virtual std::string name() const = 0;
   // Reads the integrator's own settings from the case (the adaptive section); Verlet has none.
-  virtual void configure(const Case&) {}
+  // dt_exact: the exact stability limit (core/stability) if the caller has already computed it
+  // (time.dt "exact"), else 0; it saves a second Lanczos run.
+  virtual void configure(const Case&, double /*dt_exact*/ = 0.0) {}
   // Imposes the prescribed motion at t and evaluates f and the powers there; call once first.
   virtual void initialize(State& state, double t) = 0;
   virtual void step(State& state, double& t, double& dt) = 0;
