@@ -7,6 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 
+def _finish(ax, xlabel: str, ylabel: str, title: str, grid: str):
+    """Labels, title, legend and grid, the same for every panel."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which=grid)
+
+
 def figure(static_result: dict | None, wave_result: dict | None, path: str, drum_result: list | None = None):
     from postprocess.plotting import new_figure, save_figure
     fig, axes = new_figure(1, 3, size=(16.0, 4.5))
@@ -23,11 +32,7 @@ def figure(static_result: dict | None, wave_result: dict | None, path: str, drum
                 for r, x in zip(rows, d):
                     ax.annotate(f"m={r['m']:.0f}", (x, abs(r["exx"] / r["exx0"] - 1)), fontsize=7)
         ax.set_yscale("log")
-    ax.set_xlabel("δ [mm]")
-    ax.set_ylabel("relative error of the interior strain")
-    ax.set_title("static tension (C3): error vs δ and m", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, which="both")
+    _finish(ax, "δ [mm]", "relative error of the interior strain", "static tension (C3): error vs δ and m", "both")
     ax = axes[0, 1]
     if wave_result:
         d = np.array([r[1] for r in wave_result["pulse_dx"]]) * 1e3
@@ -37,11 +42,8 @@ def figure(static_result: dict | None, wave_result: dict | None, path: str, drum
         dm = np.array([r[1] for r in wave_result["pulse_m"]]) * 1e3
         em = np.array([r[2] for r in wave_result["pulse_m"]])
         ax.loglog(dm, em, "s--", label="dx = 1 mm, m = 2, 3, 4")
-    ax.set_xlabel("δ [mm]")
-    ax.set_ylabel("max |u − d'Alembert| / amplitude")
-    ax.set_title("Gaussian pulse after 0.4 m (C2): error vs δ and m", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, which="both")
+    _finish(ax, "δ [mm]", "max |u − d'Alembert| / amplitude", "Gaussian pulse after 0.4 m (C2): error vs δ and m",
+            "both")
     ax = axes[0, 2]
     if drum_result:
         h = np.array([p[0] for p in drum_result])
@@ -52,9 +54,5 @@ def figure(static_result: dict | None, wave_result: dict | None, path: str, drum
         ax.plot(hh, intercept + slope * hh, "k:", lw=1, label=f"line {intercept:+.3f} {slope:+.2f}·dx/L")
         ax.axhline(np.sqrt(1.0254) - 1.0, color="C2", ls="--", lw=1, label="√R_W − 1 (C1 lattice sum, δ = 3.015 dx)")
     ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("dx / L")
-    ax.set_ylabel("relative frequency error")
-    ax.set_title("drum: fundamental frequency vs dx", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
+    _finish(ax, "dx / L", "relative frequency error", "drum: fundamental frequency vs dx", "major")
     save_figure(fig, path)

@@ -20,30 +20,34 @@ import subprocess
 import sys
 import tempfile
 
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, ROOT)
+from pipeline.stability import micromodulus, stable_time_step  # noqa: E402  (the solver's formulas)
+
 # The material of pd_speed (solver/bench/speed.cpp): E = 72 GPa, ν = 1/4, ρ = 2440 kg/m³, G0 = 4 J/m².
 DX = 1e-3
 HORIZON = 3.0002 * DX
 YOUNG, DENSITY, FRACTURE_ENERGY = 72e9, 2440.0, 4.0
 BULK = YOUNG / (3.0 * (1.0 - 2.0 * 0.25))                          # k = E/(3(1−2ν)), ν = 1/4
-MICROMODULUS = 18.0 * BULK / (math.pi * HORIZON ** 4)              # c = 18k/(πδ⁴) (validation.md)
+MICROMODULUS = micromodulus("3d", YOUNG, HORIZON, None)            # c = 18k/(πδ⁴) (validation.md F1)
 CRITICAL_STRETCH = math.sqrt(5.0 * FRACTURE_ENERGY / (9.0 * BULK * HORIZON))  # s0 = √(5G0/(9kδ))
 
 
-def stable_time_step():
-    """Thesis eq. 2.5 for an interior node of the lattice, Δt = √(2ρ / Σ_p V_p c/|ξ_p|): 0.8 of it is
-    the step pd_speed takes (0.8 · stable_time_step of the model, whose minimum is at interior nodes)."""
-    reach = int(HORIZON / DX) + 1
-    total = 0.0
-    for i in range(-reach, reach + 1):
-        for j in range(-reach, reach + 1):
-            for k in range(-reach, reach + 1):
-                length = DX * math.sqrt(i * i + j * j + k * k)
-                if 0.0 < length <= HORIZON:
-                    total += DX ** 3 * MICROMODULUS / length
-    return math.sqrt(2.0 * DENSITY / total)
+def lattice_stable_time_step():
+    """Thesis eq. 2.5 on the brick's lattice, as pipeline/stability.py computes it for any cloud: its
+    minimum is at an interior node, so a 9³ lattice (an interior node with its whole family) gives
+    the brick's. 0.8 of it is the step pd_speed takes (0.8 · stable_time_step of the model)."""
+    side = 2 * (int(HORIZON / DX) + 1) + 1
+    k, j, i = np.meshgrid(np.arange(side), np.arange(side), np.arange(side), indexing="ij")
+    points = np.column_stack([i.ravel(), j.ravel(), k.ravel()]).astype(float) * DX
+    dt, _ = stable_time_step(points, np.full(len(points), DX ** 3), np.ones(len(points), np.int64),
+                             np.array([DENSITY]), np.array([[MICROMODULUS]]), HORIZON)
+    return dt
 
 
-TIME_STEP = 0.8 * stable_time_step()
+TIME_STEP = 0.8 * lattice_stable_time_step()
 
 
 def lammps_input(side, steps):

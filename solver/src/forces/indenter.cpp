@@ -94,15 +94,15 @@ IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array&
     }
     return b;
   };
-  // Fixed chunks of nodes, combined in chunk order: the node named is the same for any thread count.
-  constexpr std::int64_t kNodes = 4096;
-  const std::int64_t chunks = (n + kNodes - 1) / kNodes;
+  // The force's fixed chunks of nodes, combined in chunk order: the node named is the same for any
+  // thread count.
+  const std::int64_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<NodeBound> tightest(static_cast<std::size_t>(chunks));
   std::vector<double> diagonal(static_cast<std::size_t>(chunks), 0.0);
 #pragma omp parallel for schedule(static)
   for (std::int64_t c = 0; c < chunks; ++c) {
     NodeBound& best = tightest[static_cast<std::size_t>(c)];
-    for (std::int64_t i = c * kNodes; i < std::min(n, (c + 1) * kNodes); ++i) {
+    for (std::int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
       const NodeBound b = node_bound(static_cast<std::size_t>(i));
       if (b.gershgorin < best.gershgorin) best = b;
       diagonal[static_cast<std::size_t>(c)] = std::max(diagonal[static_cast<std::size_t>(c)], b.diagonal);

@@ -191,27 +191,26 @@ std::vector<double> OutputWriter::frame_times() const {
 
 namespace {
 
-// ",value" in the shortest form that reads back as the same double (std::to_chars): every digit a
-// reader needs and none it does not, several times faster than printf's %.17g (run per step when
-// history_every is 1).
-void append_value(std::string& out, long long value) {
+// ",value" by std::to_chars: for a double, the shortest form that reads back as the same double,
+// every digit a reader needs and none it does not, several times faster than printf's %.17g (run
+// per step when history_every is 1).
+template <class T>
+void append_chars(std::string& out, T value) {
   char text[32];
   text[0] = ',';
   const auto end = std::to_chars(text + 1, text + sizeof text, value).ptr;
   out.append(text, end);
 }
 
+void append_value(std::string& out, long long value) { append_chars(out, value); }
+
 void append_value(std::string& out, double value) {
   // A whole number (a count such as contact_rebuilds) as an integer: the shortest form of 100000.0
   // is "1e+05". Exact below 2⁵³, where every integer is a double.
-  if (std::fabs(value) < 9007199254740992.0 && value == std::trunc(value) && !(value == 0.0 && std::signbit(value))) {
-    append_value(out, static_cast<long long>(value));
-    return;
-  }
-  char text[32];
-  text[0] = ',';
-  const auto end = std::to_chars(text + 1, text + sizeof text, value).ptr;
-  out.append(text, end);
+  if (std::fabs(value) < 9007199254740992.0 && value == std::trunc(value) && !(value == 0.0 && std::signbit(value)))
+    append_chars(out, static_cast<long long>(value));
+  else
+    append_chars(out, value);
 }
 
 }  // namespace
