@@ -2,7 +2,7 @@
 // Run: build/solver/pd_bench [--benchmark_filter=...]; OMP_NUM_THREADS sets the threads.
 #include <benchmark/benchmark.h>
 
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "lattice.hpp"
 
 namespace {

@@ -24,7 +24,7 @@
 #include <string>
 
 #include "core/model.hpp"
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "integrators/integrator.hpp"
 #include "io/node_file.hpp"
 #include "lattice.hpp"
@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
   const double top = (side - 3) * dx - 0.5 * dx;
   for (std::size_t i = 0; i < n; ++i)
     if (model.nodes.x[2][i] > top) state.v[2][i] = -0.1;
-  auto integrator = pd::integrator_registry().get("verlet")(model);
+  pd::ForceOperator op_integrator(model);
+  auto integrator = pd::integrator_registry().get("verlet")(op_integrator);
   double t = 0.0;
   integrator->initialize(state, t);
   const double dt0 = 0.8 * pd::stable_time_step(model);

@@ -19,7 +19,7 @@
 #include "core/reactions.hpp"
 #include "core/work_plan.hpp"
 #include "forces/indenter.hpp"
-#include "forces/pmb.hpp"
+#include "operator/force_operator.hpp"
 #include "core/stability.hpp"
 #include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
@@ -40,20 +40,6 @@ std::string format(const char* fmt, double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, fmt, value);
   return buffer;
-}
-
-double kinetic_energy(const Model& m, const State& s) {
-  double sum = 0.0;  // serial, node order: the same for any thread count
-  for (std::size_t i = 0; i < s.size(); ++i)
-    sum += 0.5 * m.density[i] * m.nodes.volume[i] *
-           (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
-  return sum;
-}
-
-double stored_strain_energy(const Model& m, const State& s) {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < s.size(); ++i) sum += s.w[i] * m.nodes.volume[i];
-  return sum;
 }
 
 // The first node (lowest index) with a non-finite displacement or velocity, or −1.
@@ -199,7 +185,8 @@ int run(const RunOptions& opt) {
   constexpr double kLastStepSlack = 1e-6;
   const auto steps_for_end = static_cast<std::int64_t>(std::ceil(end / dt * (1.0 - kLastStepSlack)));
   const std::int64_t steps_expected = std::min(steps_for_end, max_steps);
-  std::unique_ptr<Integrator> integrator = integrator_registry().get(c.time.integrator)(model);
+  ForceOperator op(model);
+  std::unique_ptr<Integrator> integrator = integrator_registry().get(c.time.integrator)(op);
   integrator->configure(c, dt_exact);
 
   State state(n);
@@ -268,8 +255,7 @@ int run(const RunOptions& opt) {
   for (const auto& ind : model.indenters)
     for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("indenter_" + ind.name + "_" + axis);
   // Energy of broken bonds (validation.md C4 with breaking): when some block pair can break.
-  const bool breakable = std::any_of(model.material.critical_pair.begin(), model.material.critical_pair.end(),
-                                     [](double s0) { return std::isfinite(s0); });
+  const bool breakable = op.can_break();
   if (breakable) extra_columns.push_back("broken_bond_energy");
   for (const auto& set : c.output.reactions)
     for (const char* axis : {"fx", "fy", "fz"}) extra_columns.push_back("reaction_" + set + "_" + axis);
@@ -315,7 +301,7 @@ int run(const RunOptions& opt) {
              node_text(model, first_isolated));
   if (c.time.dt_rule == "fixed" && dt > dt_stable)
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
-  for (const auto& text : work_summary(model, c)) log.line(text);
+  for (const auto& text : work_summary(op, c)) log.line(text);
   // A fixed explicit step has no room for the indenter's stiffness 2K·h, which grows with depth:
   // say how deep it may go, and (in the loop) warn once if a node gets deeper (forces/indenter.hpp).
   // A step above eq. 2.5 (dt: exact, or a fixed dt) is judged against the exact limit, computed
@@ -357,8 +343,8 @@ int run(const RunOptions& opt) {
     double kinetic = 0.0, strain = 0.0;
     auto update_energies = [&]() {
       if (energies_step == step) return;
-      kinetic = kinetic_energy(model, state);
-      strain = stored_strain_energy(model, state);
+      kinetic = op.kinetic_energy(state);
+      strain = op.strain_energy(state);
       energies_step = step;
     };
     auto history_row = [&](double dt_taken) {

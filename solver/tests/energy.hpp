@@ -3,7 +3,7 @@
 #pragma once
 #include "core/model.hpp"
 #include "core/state.hpp"
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 
 namespace pdtest {
 

@@ -36,8 +36,8 @@ pd::Case lattice_case(int dimension, const std::string& analysis, double dx, dou
   pd::BlockMaterial b;
   b.name = "body";
   b.density = density;
-  b.youngs_modulus = youngs_modulus;
-  if (fracture_energy >= 0.0) b.fracture_energy = fracture_energy;
+  b.parameters["youngs_modulus"] = youngs_modulus;
+  if (fracture_energy >= 0.0) b.parameters["fracture_energy"] = fracture_energy;
   c.blocks.push_back(b);
   c.time.end = 1.0;
   c.output.every_steps = 1;

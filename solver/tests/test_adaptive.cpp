@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "core/stability.hpp"
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "integrators/adaptive.hpp"
 #include "energy.hpp"
 #include "lattice.hpp"
@@ -59,7 +59,8 @@ struct AdaptiveRun {
 
 // Adaptive steps to t_end, proposing the controller's dt each time and landing on t_end.
 AdaptiveRun run_adaptive(pd::Model& m, const pd::Case& c, double dt0, double t_end, pd::State s) {
-  pd::AdaptiveStep integrator(m);
+  pd::ForceOperator op_integrator(m);
+  pd::AdaptiveStep integrator(op_integrator);
   integrator.configure(c);
   AdaptiveRun r;
   const double e0 = energy(m, s);
@@ -112,7 +113,8 @@ TEST(Adaptive, PhiHalfIsSecondOrderAndPhiOneFirstOrder) {
   const double dt_sa = pd::stable_time_step(m), dt0 = 0.5 * dt_sa, t_end = 50 * dt0;
   pd::State ref = smooth_state(m);
   {
-    auto verlet = pd::integrator_registry().get("verlet")(m);
+    pd::ForceOperator op_verlet(m);
+    auto verlet = pd::integrator_registry().get("verlet")(op_verlet);
     double t = 0.0;
     verlet->initialize(ref, t);
     for (int k = 0; k < 50 * 64; ++k) {
@@ -156,7 +158,8 @@ TEST(Adaptive, PhiHalfIsSecondOrderAndPhiOneFirstOrder) {
 TEST(Adaptive, AtRestTheStepIsExactAndGrowsToDtMax) {
   pd::Case c = plate_case();
   pd::Model m = plate(c);
-  pd::AdaptiveStep integrator(m);
+  pd::ForceOperator op_integrator(m);
+  pd::AdaptiveStep integrator(op_integrator);
   integrator.configure(c);
   pd::State s(m.nodes.size());
   double t = 0.0, h = 1e-9;
@@ -177,7 +180,8 @@ TEST(Adaptive, NoConvergenceAtDtMinThrowsAndKeepsTheState) {
   pd::Model m = plate(c);
   const double dt_sa = pd::stable_time_step(m);
   c.adaptive.dt_min = c.adaptive.dt_max = 100.0 * dt_sa;
-  pd::AdaptiveStep integrator(m);
+  pd::ForceOperator op_integrator(m);
+  pd::AdaptiveStep integrator(op_integrator);
   integrator.configure(c);
   pd::State s = smooth_state(m);
   double t = 0.0;

@@ -85,8 +85,8 @@ TEST(Bonds, StableTimeStepIsThesisEq25) {
 TEST(Material, CriticalStretchMatchesPeridynamicsJl) {
   // validation.md F1 unit test: E = 1, ν = 0.25, δ = 2, Gc = 1 → εc = 0.6454972243679028 (3D).
   pd::BlockMaterial b;
-  b.youngs_modulus = 1.0;
-  b.fracture_energy = 1.0;
+  b.parameters["youngs_modulus"] = 1.0;
+  b.parameters["fracture_energy"] = 1.0;
   const pd::MaterialTable t = pd::make_material_table({b}, "3d", 2.0, 0.0);
   EXPECT_NEAR(t.block[0].critical_stretch, 0.6454972243679028, 1e-15);
 }

@@ -381,7 +381,8 @@ TEST(Checkpoint, AdaptiveIntegratorStateCarriesItsProposal) {
   c.adaptive.kd = 1;  // accepted at K = 1 or rejected: the regime where a shortened step keeps its proposal
   pd::State s(m1.nodes.size());
   for (std::size_t i = 0; i < s.size(); ++i) s.v[2][i] = std::sin(300.0 * m1.nodes.x[0][i]) * std::sin(250.0 * m1.nodes.x[1][i]);
-  pd::AdaptiveStep a(m1);
+  pd::ForceOperator op_a(m1);
+  pd::AdaptiveStep a(op_a);
   a.configure(c);
   double t = 0.0, dt = 10.0 * dt_sa;
   a.initialize(s, t);
@@ -391,16 +392,17 @@ TEST(Checkpoint, AdaptiveIntegratorStateCarriesItsProposal) {
     dt = a.last_step().next_dt;
   }
   const std::vector<char> saved = a.save_state();
-  auto restored = [&](pd::Model& m, bool load) {
-    auto b = std::make_unique<pd::AdaptiveStep>(m);
+  pd::ForceOperator op_m2(m2), op_m3(m3);
+  auto restored = [&](pd::ForceOperator& op, bool load) {
+    auto b = std::make_unique<pd::AdaptiveStep>(op);
     b->configure(c);
-    pd::State scratch(m.nodes.size());
+    pd::State scratch(op.size());
     b->initialize(scratch, t);
     if (load) b->load_state(saved);
     return b;
   };
   {
-    auto b = restored(m2, true);
+    auto b = restored(op_m2, true);
     EXPECT_EQ(b->save_state(), saved);
     EXPECT_THROW(b->load_state(std::vector<char>(saved.begin(), saved.end() - 1)), std::runtime_error);
   }
@@ -409,7 +411,7 @@ TEST(Checkpoint, AdaptiveIntegratorStateCarriesItsProposal) {
   int differs = 0;
   for (double fraction : {0.99, 0.95, 0.9, 0.8, 0.6, 0.4, 0.2}) {
     pd::AdaptiveStep orig(a);  // a copy of the original integrator itself, never saved or loaded
-    auto b = restored(m2, true), fresh = restored(m3, false);
+    auto b = restored(op_m2, true), fresh = restored(op_m3, false);
     pd::State sa = s, sb = s, sc = s;
     double ta = t, tb = t, tc = t, ha = fraction * dt, hb = ha, hc = ha;
     orig.step(sa, ta, ha);

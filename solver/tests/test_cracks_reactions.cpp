@@ -6,7 +6,7 @@
 
 #include "core/cracks.hpp"
 #include "core/reactions.hpp"
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "integrators/integrator.hpp"
 #include "lattice.hpp"
 
@@ -121,10 +121,10 @@ TEST(Reactions, ReactionOfAStretchedBarEndBalancesTheBondForce) {
   const double strain = 1e-4;
   c.boundary_conditions = {{"left", "displacement", 0, {0.0}, {0.0}},
                            {"right", "displacement", 0, {0.0}, {strain * 9 * kDx}}};
-  const pd::Model m = pd::build_model(c, std::move(nodes));
+  pd::Model m = pd::build_model(c, std::move(nodes));
   pd::State state(m.nodes.size());
   for (std::size_t i = 0; i < m.nodes.size(); ++i) state.u[0][i] = strain * m.nodes.x[0][i];  // affine
-  pd::evaluate_forces(m, state, 0.0);
+  pd::ForceOperator(m).evaluate(state, 0.0);
   const auto r_left = pd::reaction_force(m, state, "left", 0.0);
   const auto r_right = pd::reaction_force(m, state, "right", 0.0);
   // Force across the section x = 4.5 dx: Σ over bonds i (left of it) – j (right of it) of the

@@ -161,7 +161,7 @@ TEST(CaseFile, ReadsTheFormatsExample) {
   EXPECT_EQ(c.analysis, "plane_stress");
   EXPECT_EQ(c.thickness, 0.001);
   ASSERT_EQ(c.blocks.size(), 1u);
-  EXPECT_FALSE(c.blocks[0].fracture_energy.has_value());
+  EXPECT_FALSE(c.blocks[0].parameter("fracture_energy").has_value());
   ASSERT_EQ(c.boundary_conditions.size(), 1u);
   EXPECT_EQ(c.boundary_conditions[0].component, 2);
   EXPECT_EQ(c.initial_conditions[0].value, 5.0);

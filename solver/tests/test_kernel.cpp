@@ -9,7 +9,7 @@
 #include <random>
 
 #include "core/partial_volume.hpp"
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "lattice.hpp"
 
 namespace {
@@ -26,8 +26,8 @@ pd::Model brick(bool two_blocks, const std::string& partial_volume = "none") {
   if (two_blocks) {
     pd::BlockMaterial stiff = c.blocks[0];
     stiff.name = "stiff";
-    stiff.youngs_modulus = 3e9;
-    stiff.fracture_energy = 0.2;
+    stiff.parameters["youngs_modulus"] = 3e9;
+    stiff.parameters["fracture_energy"] = 0.2;
     c.blocks.push_back(stiff);
     for (std::size_t i = 0; i < nodes.size(); ++i)
       if (nodes.x[2][i] > 3.5 * kDx) nodes.block[i] = 2;
@@ -66,7 +66,7 @@ TEST(Kernel, FusedBreakingGivesBitwiseTheSeparatePassThenTheForce) {
       std::vector<double> w_sep(n), w_fused(n);
       double e_sep = 0.0, e_fused = 0.0;
       const std::int64_t n_sep = pd::update_broken_bonds(separate, u, &e_sep);
-      pd::PmbBondForce(separate).AddMult(u, f_sep, w_sep.data());
+      pd::add_pmb_force(separate, u, f_sep, w_sep.data());
       const std::int64_t n_fused = pd::break_bonds_and_add_pmb_force(fused, u, f_fused, w_fused.data(), &e_fused);
       EXPECT_GT(n_sep, 0) << "round " << round << " breaks nothing: the test would prove nothing";
       EXPECT_EQ(n_fused, n_sep);
@@ -122,7 +122,7 @@ TEST(Kernel, MatchesTheTextbookFormulaBondByBond) {
     m.bonds.broken[5] = m.bonds.broken[77] = 1;  // one direction of two bonds: the flag is per copy
     pd::Vec3Array f = pd::make_vec3(n);
     std::vector<double> w(n);
-    pd::PmbBondForce(m).AddMult(u, f, w.data());
+    pd::add_pmb_force(m, u, f, w.data());
     double worst = 0.0, scale = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       double ref[3] = {0, 0, 0}, ref_w = 0.0;
@@ -161,7 +161,7 @@ TEST(Kernel, ABondCrushedToAPointHasNoForceAndStretchMinusOne) {
   u[0][j] = -kDx;                                                      // j moved onto i
   pd::Vec3Array f = pd::make_vec3(n);
   std::vector<double> w(n);
-  pd::PmbBondForce(m).AddMult(u, f, w.data());
+  pd::add_pmb_force(m, u, f, w.data());
   for (std::size_t d = 0; d < 3; ++d) {
     EXPECT_TRUE(std::isfinite(f[d][i]));
     EXPECT_TRUE(std::isfinite(f[d][j]));

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "lattice.hpp"
 
 namespace {
@@ -33,7 +33,7 @@ Lattice bulk_lattice(int dimension, const std::string& analysis, int m = 3) {
 
 std::array<double, 3> force_on(const pd::Model& model, const pd::Vec3Array& u, std::size_t node) {
   pd::Vec3Array f = pd::make_vec3(model.nodes.size());
-  pd::PmbBondForce(model).AddMult(u, f);
+  pd::add_pmb_force(model, u, f);
   return {f[0][node], f[1][node], f[2][node]};
 }
 

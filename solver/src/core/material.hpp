@@ -1,6 +1,8 @@
-// PMB material constants: micromodulus c and critical stretch s0 per block (validation.md F1),
-// and the per-pair table used by bonds whose ends lie in different blocks.
+// A block's material as the case gives it (model name, density, the model's own parameters), the
+// table of per-pair constants every bond model provides, and the analyses (3D, plane stress,
+// plane strain). The laws themselves live in materials/<model>/ (materials/bond_model.hpp).
 #pragma once
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,22 +14,21 @@ namespace pd {
 struct BlockMaterial {
   std::string name;
   std::string model = "pmb";
-  double density = 0.0;                   // ρ [kg/m³]
-  double youngs_modulus = 0.0;            // E [Pa]
-  std::optional<double> fracture_energy;  // G0 [J/m²]; empty: the block never breaks
+  double density = 0.0;  // ρ [kg/m³]
+  // The model's parameters by name (materials/<model>: e.g. PMB's youngs_modulus [Pa] and
+  // fracture_energy [J/m²]); a parameter the case leaves out is absent.
+  std::map<std::string, double> parameters;
+
+  std::optional<double> parameter(const std::string& key) const {
+    const auto it = parameters.find(key);
+    return it == parameters.end() ? std::nullopt : std::optional<double>(it->second);
+  }
 };
 
-struct PmbConstants {
+struct PairConstants {
   double micromodulus = 0.0;      // c [N/m⁶] (3D) so that c·s·V_j is a force density
   double critical_stretch = 0.0;  // s0; +inf for an unbreakable block
 };
-
-// One formula per analysis ("3d", "plane_stress", "plane_strain"); thickness h is ignored in 3D.
-using PmbFormula = PmbConstants (*)(const BlockMaterial&, double horizon, double thickness);
-const Registry<PmbFormula>& analysis_registry();
-
-// The dimension an analysis belongs to (3 for "3d", 2 for the plane ones).
-int analysis_dimension(const std::string& analysis);
 
 // c and s0 for every ordered pair of blocks (row-major, blocks × blocks). A bond between blocks
 // a and b takes the arithmetic mean of the two micromoduli (a series-spring harmonic mean would
@@ -36,12 +37,20 @@ int analysis_dimension(const std::string& analysis);
 // that a bond with an end in an unbreakable block (no fracture energy) never breaks.
 struct MaterialTable {
   int blocks = 0;
-  std::vector<PmbConstants> block;        // per block id − 1
+  std::vector<PairConstants> block;       // per block id − 1
   std::vector<double> micromodulus_pair;  // c_ab
   std::vector<double> critical_pair;      // s0_ab
+
+  // False when no bond can ever break (every pair unbreakable): then no pass tests breaking.
+  // The one place that answers "can anything break?".
+  bool can_break() const;
 };
 
-MaterialTable make_material_table(const std::vector<BlockMaterial>& blocks, const std::string& analysis,
-                                  double horizon, double thickness);
+// The pair table from the per-block constants, by the rule above.
+MaterialTable make_pair_table(std::vector<PairConstants> per_block);
+
+// The analyses a case may name, each with its dimension (3 for "3d", 2 for the plane ones).
+const Registry<int>& analysis_registry();
+int analysis_dimension(const std::string& analysis);
 
 }  // namespace pd

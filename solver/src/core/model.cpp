@@ -36,6 +36,7 @@ Model build_model(const Case& c, Nodes nodes) {
   m.horizon = c.horizon;
   m.grid_spacing = c.grid_spacing;
   m.damping = c.damping;
+  // Every block uses one material model (the reader checks it); its formulas give c and s0.
   m.material = make_material_table(c.blocks, c.analysis, c.horizon, c.thickness);
   m.density.resize(n);
   m.block_index.resize(n);
@@ -62,23 +63,32 @@ Model build_model(const Case& c, Nodes nodes) {
   m.contact = plan_contact(c, m.block_index, cutoff * (1.0 + kHorizonTolerance));
   m.indenters = c.indenters;
   m.nodes = std::move(nodes);
+  m.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(m);
   return m;
+}
+
+std::int64_t broken_bond_count(const Model& m) {
+  std::int64_t count = 0;
+  for (std::uint8_t b : m.bonds.broken) count += b;
+  return count / 2;
 }
 
 double node_stiffness(const Model& m, std::size_t i) {
   const auto nb = static_cast<std::size_t>(m.material.blocks);
   const auto bi = static_cast<std::size_t>(m.block_index[i]);
   double sum = 0.0;
-  // thesis eq. 2.5 with the linearised PMB stiffness |C(ξ)| = c/|ξ| (Silling & Askari 2005).
+  // thesis eq. 2.5 with the material's linearised bond stiffness (c/|ξ| for PMB).
   for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
     const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-    const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
     const double length = bond_length(m.nodes.x, i, j);
-    sum += m.nodes.volume[j] * m.bonds.volume_weight(length) * c / length;
+    sum += m.bond_model->bond_stiffness(m, i, j, length);
     // With contact, a node pressed into a surface meets about as many contact partners as it has
     // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
     // 15c needs extra margin in impacts).
-    if (m.contact.pairs && length <= m.contact.distance) sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
+    if (m.contact.pairs && length <= m.contact.distance) {
+      const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
+      sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
+    }
   }
   return sum;
 }

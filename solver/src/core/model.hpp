@@ -1,6 +1,7 @@
 // Everything the time loop needs that does not change with time: nodes, bonds, material, conditions.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/bonds.hpp"
@@ -9,13 +10,15 @@
 #include "core/material.hpp"
 #include "core/nodes.hpp"
 #include "core/verlet_list.hpp"
+#include "materials/bond_model.hpp"
 
 namespace pd {
 
 struct Model {
   Nodes nodes;
   BondList bonds;  // the only part that changes: bonds break
-  MaterialTable material;
+  MaterialTable material;  // c and s0 per block pair, from the material model's formulas
+  std::shared_ptr<const BondModel> bond_model;  // the material law (materials/<model>/)
   double horizon = 0.0;  // δ [m]
   double grid_spacing = 0.0;  // dx [m]
   double damping = 0.0;  // α [1/s]
@@ -35,13 +38,17 @@ struct Model {
 // Checks the node file against the case (blocks in range, sets present) and builds the bonds.
 Model build_model(const Case& c, Nodes nodes);
 
+// Broken bonds, each counted once (both stored copies of a bond break together).
+std::int64_t broken_bond_count(const Model& model);
+
 // Stable step of the explicit scheme, thesis eq. 2.5 (validation.md F2):
-// Δt = min_i √(2ρ_i / Σ_p V_p c_ip/|ξ_p|), without safety factor; +inf if no node has a bond.
+// Δt = min_i √(2ρ_i / Σ_p V_p C_ip), C_ip = c_ip/|ξ_p| for PMB, without safety factor; +inf if no node has a bond.
 // ν_p (partial volume) multiplies V_p; with contact, every bond shorter than 2r_s adds a contact
 // spring V_p·c_s/δ to the sum.
 double stable_time_step(const Model& model);
-// The sum of eq. 2.5 for node i, Σ_p V_p ν_p c_ip/|ξ_p| (+ the contact springs) [N/m⁴]: the stiffness
-// per unit volume that bounds node i's stable step, √(2ρ_i / sum).
+// The sum of eq. 2.5 for node i, Σ_p V_p ν_p C_ip (the material's bond_stiffness, c_ip/|ξ_p| for
+// PMB; + the contact springs) [N/m⁴]: the stiffness per unit volume that bounds node i's stable
+// step, √(2ρ_i / sum).
 double node_stiffness(const Model& model, std::size_t i);
 
 }  // namespace pd

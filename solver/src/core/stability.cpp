@@ -1,4 +1,4 @@
-// Lanczos on the linearised PMB operator for ω_max², and the exact explicit step 2/ω_max.
+// Lanczos on the material's linearised operator for ω_max², and the exact explicit step 2/ω_max.
 #include "core/stability.hpp"
 
 #include <algorithm>
@@ -9,9 +9,6 @@
 namespace pd {
 
 namespace {
-
-// Minimum image of a bond component on a periodic axis (period p > 0); unchanged otherwise.
-inline double wrap(double d, double p) { return p > 0.0 ? d - p * std::nearbyint(d / p) : d; }
 
 // Serial sums in node order: the Lanczos coefficients, and so dt, do not depend on the thread count.
 double dot(const Vec3Array& a, const Vec3Array& b) {
@@ -55,43 +52,7 @@ double tridiagonal_max(const std::vector<double>& alpha, const std::vector<doubl
 
 void apply_symmetric_operator(const Model& m, const std::array<double, 3>& period, const Vec3Array& x,
                               Vec3Array& y) {
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
-  const auto nb = static_cast<std::size_t>(m.material.blocks);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i64 = 0; i64 < n; ++i64) {
-    const auto i = static_cast<std::size_t>(i64);
-    const double inv_sqrt_mi = 1.0 / std::sqrt(m.density[i] * m.nodes.volume[i]);
-    const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
-    double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      if (m.bonds.broken[ku]) continue;
-      const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
-      // |ξ| of the minimum image (core/bonds.hpp stores no lengths; without a period this is
-      // bitwise bond_length).
-      const double xi0 = wrap(m.nodes.x[0][j] - m.nodes.x[0][i], period[0]);
-      const double xi1 = wrap(m.nodes.x[1][j] - m.nodes.x[1][i], period[1]);
-      const double xi2 = wrap(m.nodes.x[2][j] - m.nodes.x[2][i], period[2]);
-      const double len = std::sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2);
-      const double e0 = xi0 / len, e1 = xi1 / len, e2 = xi2 / len;
-      const double inv_sqrt_mj = 1.0 / std::sqrt(m.density[j] * m.nodes.volume[j]);
-      // bond stiffness k_ij = c ν V_i V_j/|ξ| (force per unit relative displacement along e; ν the
-      // partial-volume factor of validation.md F3, from |ξ|)
-      const double nu = m.bonds.volume_weight(len);
-      const double kij = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] * nu *
-                         m.nodes.volume[i] * m.nodes.volume[j] / len;
-      const double d0 = x[0][i] * inv_sqrt_mi - x[0][j] * inv_sqrt_mj;
-      const double d1 = x[1][i] * inv_sqrt_mi - x[1][j] * inv_sqrt_mj;
-      const double d2 = x[2][i] * inv_sqrt_mi - x[2][j] * inv_sqrt_mj;
-      const double along = kij * (e0 * d0 + e1 * d1 + e2 * d2);
-      y0 += along * e0;
-      y1 += along * e1;
-      y2 += along * e2;
-    }
-    y[0][i] = y0 * inv_sqrt_mi;
-    y[1][i] = y1 * inv_sqrt_mi;
-    y[2][i] = y2 * inv_sqrt_mi;
-  }
+  m.bond_model->apply_reference_stiffness(m, period, x, y);
 }
 
 LanczosReport largest_eigenvalue(const Model& m, std::array<double, 3> period) {

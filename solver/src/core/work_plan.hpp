@@ -1,6 +1,5 @@
-// Decides from the case what work a run needs, so the solver does only that and says so at start:
-// no contact search for a single body (unless self-contact is asked for), no breakage test for
-// unbreakable materials, indenters only when the case has some.
+// Decides from the case whether the scene needs contact at all (the operator builds the other terms
+// only when the case has them, operator/force_operator.hpp), and the work plan run.log prints.
 #pragma once
 #include <string>
 #include <vector>
@@ -10,17 +9,15 @@
 
 namespace pd {
 
-struct Model;
-
 // contact.enabled: off → no pairs; on → pairs; auto → pairs when the node file holds more than one
 // block or self_contact is set. Between different blocks always, inside a block only with
 // self_contact. Contact distance 2r_s = 1.35·(r_i + r_j) with r = dx/2 (validation.md F4).
 ContactParameters plan_contact(const Case& c, const std::vector<std::int32_t>& block_index, double bond_cutoff);
 
-// True when some block pair can break (a bond between an unbreakable block and any other never does).
-bool breakage_possible(const Model& model);
+class ForceOperator;
 
-// One line per kind of work, for run.log.
-std::vector<std::string> work_summary(const Model& model, const Case& c);
+// One line per kind of work, for run.log: the operator's plan (bonds, every registered term,
+// breaking) and the output schedule.
+std::vector<std::string> work_summary(const ForceOperator& op, const Case& c);
 
 }  // namespace pd

@@ -1,6 +1,8 @@
 // Body-force density from the piecewise-linear tables of the case.
 #include "forces/body_force.hpp"
 
+#include <memory>
+
 namespace pd {
 
 void BodyForceTerm::AddMult(double t, Vec3Array& f) const {
@@ -19,6 +21,32 @@ double BodyForceTerm::power(double t, const Vec3Array& v) const {
     for (std::int32_t i : b.nodes) p += model_.nodes.volume[static_cast<std::size_t>(i)] * value * vc[static_cast<std::size_t>(i)];
   }
   return p;
+}
+
+}  // namespace pd
+
+namespace pd {
+
+namespace {
+
+// The body force as a term of the operator (forces/force_term.hpp): it does not depend on u.
+class BodyForceOnSets : public ForceTerm {
+ public:
+  explicit BodyForceOnSets(const Model& model) : model_(model) {}
+  void add_force(State& s, double t) const override { BodyForceTerm(model_).AddMult(t, s.f); }
+  void add_power(const State& s, double t, double& p) const override { p += BodyForceTerm(model_).power(t, s.v); }
+  void add_jacobian_product(const State&, double, const Vec3Array&, Vec3Array&) const override {}
+  std::vector<std::string> work_plan() const override { return {}; }
+
+ private:
+  const Model& model_;
+};
+
+}  // namespace
+
+std::unique_ptr<ForceTerm> make_body_force_term(const Model& model) {
+  if (model.conditions.body_forces.empty()) return nullptr;
+  return std::make_unique<BodyForceOnSets>(model);
 }
 
 }  // namespace pd

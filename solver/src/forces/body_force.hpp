@@ -2,6 +2,7 @@
 #pragma once
 #include "core/model.hpp"
 #include "core/state.hpp"
+#include "forces/force_term.hpp"
 
 namespace pd {
 

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <memory>
 #include <vector>
 
 namespace pd {
@@ -64,6 +66,76 @@ double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, V
   double total = 0.0;
   for (std::size_t i = 0; i < e.size(); ++i) total += e[i] * m.nodes.volume[i];
   return total;
+}
+
+}  // namespace pd
+
+namespace pd {
+
+void ShortRangeForce::AddJacobianProduct(const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  const Model& m = model_;
+  const ContactPairs& pairs = m.contact_list.pairs();
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const double factor = m.contact.stiffness_factor / m.horizon;
+  const auto& X = m.nodes.x;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i64 = 0; i64 < n; ++i64) {
+    const auto i = static_cast<std::size_t>(i64);
+    const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    for (std::int64_t k = pairs.offsets[i]; k < pairs.offsets[i + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      const auto j = static_cast<std::size_t>(pairs.neighbour[ku]);
+      const double e0 = (X[0][j] + u[0][j]) - yi0, e1 = (X[1][j] + u[1][j]) - yi1, e2 = (X[2][j] + u[2][j]) - yi2;
+      const double r = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+      const double gap = pairs.distance[ku] - r;
+      if (!(gap > 0.0) || !(r > 0.0)) continue;  // apart, or at one point (no direction, no force)
+      const double k_vj = factor * m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
+                                                                static_cast<std::size_t>(m.block_index[j])] *
+                          m.nodes.volume[j];
+      // f_i = −k (d − r) n, n = e/r: δf_i = k [n nᵀ − ((d − r)/r)(I − n nᵀ)] (δu_j − δu_i)
+      const double n0 = e0 / r, n1 = e1 / r, n2 = e2 / r;
+      const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
+      const double along = n0 * d0 + n1 * d1 + n2 * d2, lateral = -k_vj * gap / r;
+      s0 += k_vj * along * n0 + lateral * (d0 - along * n0);
+      s1 += k_vj * along * n1 + lateral * (d1 - along * n1);
+      s2 += k_vj * along * n2 + lateral * (d2 - along * n2);
+    }
+    y[0][i] += s0;
+    y[1][i] += s1;
+    y[2][i] += s2;
+  }
+}
+
+namespace {
+
+// Contact as a term of the operator (forces/force_term.hpp).
+class ContactTerm : public ForceTerm {
+ public:
+  explicit ContactTerm(const Model& model) : model_(model) {}
+  void add_force(State& s, double) const override { s.contact_energy += ShortRangeForce(model_).AddMult(s.u, s.f); }
+  void add_power(const State&, double, double&) const override {}  // conservative, at rest
+  void add_jacobian_product(const State& s, double, const Vec3Array& x, Vec3Array& y) const override {
+    ShortRangeForce(model_).AddJacobianProduct(s.u, x, y);
+  }
+  std::vector<std::string> work_plan() const override {
+    char buffer[256];
+    std::snprintf(buffer, sizeof buffer, ", contact distance 2r_s %.4g m, skin %.4g m, c_s = %.4g·c",
+                  model_.contact.distance, model_.contact.skin, model_.contact.stiffness_factor);
+    return {std::string("work: contact search (cell list + Verlet list) ") +
+            (model_.contact.self_contact ? "between all nodes (self_contact)" : "between blocks") + buffer};
+  }
+
+ private:
+  const Model& model_;
+};
+
+}  // namespace
+
+std::unique_ptr<ForceTerm> make_contact_term(const Model& model) {
+  if (!model.contact.pairs) return nullptr;
+  return std::make_unique<ContactTerm>(model);
 }
 
 }  // namespace pd

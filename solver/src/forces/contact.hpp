@@ -12,6 +12,7 @@
 #include "core/model.hpp"
 #include "core/state.hpp"
 #include "core/verlet_list.hpp"
+#include "forces/force_term.hpp"
 
 namespace pd {
 
@@ -43,6 +44,9 @@ class ShortRangeForce {
   double AddMult(const Vec3Array& u, Vec3Array& f) const;
   // The same force from a given list (the tests compare the Verlet list with a fresh search).
   double AddMult(const ContactPairs& pairs, const Vec3Array& u, Vec3Array& f) const;
+  // y += ∂f/∂u·x over the pairs of the current list (each pair closer than d_ij is a spring along
+  // its line and, for the pressed gap, a negative lateral stiffness).
+  void AddJacobianProduct(const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const;
 
  private:
   const Model& model_;

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <memory>
 
 namespace pd {
 
@@ -175,6 +177,85 @@ double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
     }
   }
   return energy;
+}
+
+}  // namespace pd
+
+namespace pd {
+
+void IndenterForce::AddJacobianProduct(double t, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  const Model& m = model_;
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  for (const IndenterSettings& ind : m.indenters) {
+    const IndenterShape shape = indenter_shape_registry().get(ind.shape);
+    const std::array<double, 3> c = indenter_position(ind, t);
+    const bool curved = ind.shape != "plane", along_axis = ind.shape == "cylinder";
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      const auto q = static_cast<std::size_t>(i);
+      const double yq[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
+      double dir[3];
+      const double h = shape(ind, c.data(), yq, dir);
+      if (!(h > 0.0)) continue;
+      // f = K h² n with h = R − r (sphere, cylinder) or the depth below the plane, so δh = −n·δy and
+      // δn = P δy / r with P the projection off n (and off the axis for a cylinder); a plane's n is fixed:
+      //   δf = −2K h (n·δy) n + K h²/r · P δy
+      const double dy[3] = {x[0][q], x[1][q], x[2][q]};
+      const double along = dir[0] * dy[0] + dir[1] * dy[1] + dir[2] * dy[2];
+      double out[3];
+      for (int d = 0; d < 3; ++d) out[d] = -2.0 * ind.stiffness * h * along * dir[d];
+      if (curved) {
+        const double r = ind.radius - h;
+        const double axial = along_axis ? ind.axis[0] * dy[0] + ind.axis[1] * dy[1] + ind.axis[2] * dy[2] : 0.0;
+        for (int d = 0; d < 3; ++d) {
+          const double projected = dy[d] - along * dir[d] - (along_axis ? axial * ind.axis[static_cast<std::size_t>(d)] : 0.0);
+          out[d] += ind.stiffness * h * h / r * projected;
+        }
+      }
+      for (std::size_t d = 0; d < 3; ++d) y[d][q] += out[d];
+    }
+  }
+}
+
+namespace {
+
+// The indenters as a term of the operator (forces/force_term.hpp).
+class IndenterTerm : public ForceTerm {
+ public:
+  explicit IndenterTerm(const Model& model) : model_(model) {}
+  void add_force(State& s, double t) const override {
+    s.contact_energy += IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force);
+  }
+  // A moving indenter works on the body at the rate (force on the body)·(indenter velocity): the
+  // contact potential depends on y − c(t), so d(KE + potential)/dt = F·ċ.
+  void add_power(const State& s, double, double& p) const override {
+    for (std::size_t k = 0; k < model_.indenters.size() && k < s.indenter_force.size(); ++k)
+      for (std::size_t d = 0; d < 3; ++d) p += s.indenter_force[k][d] * model_.indenters[k].velocity[d];
+  }
+  void add_jacobian_product(const State& s, double t, const Vec3Array& x, Vec3Array& y) const override {
+    IndenterForce(model_).AddJacobianProduct(t, s.u, x, y);
+  }
+  std::vector<std::string> work_plan() const override {
+    std::vector<std::string> lines;
+    for (const auto& ind : model_.indenters) {
+      char radius[64] = "", rest[192];
+      if (ind.shape != "plane") std::snprintf(radius, sizeof radius, ", R %.4g m", ind.radius);
+      std::snprintf(rest, sizeof rest, ", K %.4g N/m⁵, velocity (%.4g, %.4g, %.4g) m/s)", ind.stiffness,
+                    ind.velocity[0], ind.velocity[1], ind.velocity[2]);
+      lines.push_back("work: indenter '" + ind.name + "' (" + ind.shape + radius + rest);
+    }
+    return lines;
+  }
+
+ private:
+  const Model& model_;
+};
+
+}  // namespace
+
+std::unique_ptr<ForceTerm> make_indenter_term(const Model& model) {
+  if (model.indenters.empty()) return nullptr;
+  return std::make_unique<IndenterTerm>(model);
 }
 
 }  // namespace pd

@@ -12,6 +12,7 @@
 #include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/registry.hpp"
+#include "forces/force_term.hpp"
 
 namespace pd {
 
@@ -55,6 +56,9 @@ class IndenterForce {
   // chunks of nodes so that it does not depend on the thread count. Returns the potential
   // Σ_k Σ_i V_i·K h_i³/3 [J] (−d/dh of it is the force).
   double AddMult(double t, const Vec3Array& u, Vec3Array& f, std::vector<std::array<double, 3>>& force_on_body) const;
+  // y += ∂f/∂u·x at (u, t): the stiffness of the push, 2K·h along n, and for a curved surface the
+  // turn of n with the node, K h²/r across it.
+  void AddJacobianProduct(double t, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const;
 
  private:
   const Model& model_;

@@ -9,8 +9,6 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "core/stability.hpp"
-#include "forces/pmb.hpp"
 
 namespace pd {
 
@@ -32,13 +30,13 @@ void AdaptiveStep::configure(const Case& c, double dt_exact_known) {
   // membrane (Δt_exact/2 = 0.84 × eq. 2.5) the default eq. 2.5 cost a rejection on every other
   // step (cases/membrane/README.md). 0.9 keeps the contraction factor (φΔtω_max)² ≤ 0.81.
   // Δt_min = 1e-6·Δt_SA is far below any useful step.
-  const double dt_sa = stable_time_step(model_);
+  const double dt_sa = op_.stable_time_step();
   const double scale = std::isfinite(dt_sa) ? dt_sa : c.time.end;
   double dt_max = scale;
   limit_seconds_ = 0.0;
   if (!settings_.dt_max && std::isfinite(dt_sa)) {
     const auto start = std::chrono::steady_clock::now();  // Lanczos: reported in run.log
-    const double dt_exact = dt_exact_known > 0.0 ? dt_exact_known : exact_time_step(model_);
+    const double dt_exact = dt_exact_known > 0.0 ? dt_exact_known : op_.exact_time_step();
     limit_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (std::isfinite(dt_exact)) dt_max = std::min(dt_max, 0.9 * dt_exact / (2.0 * settings_.phi));
   }
@@ -58,9 +56,9 @@ void AdaptiveStep::initialize(State& state, double t) {
     defaults.time.end = 1.0;
     configure(defaults);
   }
-  impose_prescribed_motion(model_, state, t);
-  evaluate_forces(model_, state, t);
-  update_work(model_, state, t, 0.0);
+  op_.impose_prescribed_motion(state, t);
+  op_.evaluate(state, t);
+  op_.update_work(state, t, 0.0);
   const std::size_t n = state.size();
   trial_ = State(n);
   u_new_ = make_vec3(n);
@@ -86,16 +84,16 @@ void AdaptiveStep::load_state(const std::vector<char>& bytes) {
 
 void AdaptiveStep::update(const State& s, const Vec3Array& f_imp, double t, double t1, double dt) {
   const auto n = static_cast<std::int64_t>(s.size());
-  const double phi = settings_.phi, alpha = model_.damping;
+  const double phi = settings_.phi, alpha = op_.damping();
   const double keep = 1.0 - (1.0 - phi) * alpha * dt;  // damping weights, see adaptive.hpp
   const double divide = 1.0 / (1.0 + phi * alpha * dt);
-  const double* rho = model_.density.data();
+  const double* rho = op_.density().data();
   for (std::size_t d = 0; d < 3; ++d) {
     const double* u0 = s.u[d].data();
     const double* v0 = s.v[d].data();
     const double* f0 = s.f[d].data();
     const double* f1 = f_imp[d].data();
-    const std::uint8_t* fx = model_.conditions.fixed[d].data();
+    const std::uint8_t* fx = op_.fixed()[d].data();
     double* u = u_new_[d].data();
     double* v = v_new_[d].data();
 #pragma omp parallel for schedule(static)
@@ -106,22 +104,7 @@ void AdaptiveStep::update(const State& s, const Vec3Array& f_imp, double t, doub
     }
   }
   // Prescribed components follow their tables exactly as in Verlet (the same at every iterate).
-  for (const auto& p : model_.conditions.prescribed) {
-    const auto c = static_cast<std::size_t>(p.component);
-    if (p.kind == Kinematic::displacement) {
-      const double u1 = p.table.value(t1), mean_v = (u1 - p.table.value(t)) / dt;
-      for (std::int32_t i : p.nodes) {
-        u_new_[c][static_cast<std::size_t>(i)] = u1;
-        v_new_[c][static_cast<std::size_t>(i)] = mean_v;
-      }
-    } else {
-      const double du = p.table.integral(t, t1), v1 = p.table.value(t1);
-      for (std::int32_t i : p.nodes) {
-        u_new_[c][static_cast<std::size_t>(i)] = s.u[c][static_cast<std::size_t>(i)] + du;
-        v_new_[c][static_cast<std::size_t>(i)] = v1;
-      }
-    }
-  }
+  op_.advance_prescribed_motion(s.u, u_new_, v_new_, t, t1, dt, true);
 }
 
 void AdaptiveStep::step(State& state, double& t, double& dt) {
@@ -141,7 +124,7 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
     int k = 1;
     for (; k <= kd; ++k) {
       std::swap(trial_.u, u_new_);  // u^{n+1,K−1} → trial
-      evaluate_forces(model_, trial_, t1);
+      op_.evaluate(trial_, t1);
       ++report_.force_evaluations;
       update(state, trial_.f, t, t1, h);  // → u^{n+1,K}
       // Eq. 2.6, per node first and summed serially, so accept/reject decisions (and every result)
@@ -191,9 +174,11 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
       std::swap(state.u, u_new_);
       std::swap(state.v, v_new_);
       // Bonds break on the accepted state only, then the force there for the next step.
-      break_bonds_and_evaluate_forces(model_, state, t1, report_);
+      const BreakReport broke = op_.break_bonds_and_evaluate(state, t1);
+      report_.broken_now += broke.broken;
+      report_.broken_energy_now += broke.energy;
       ++report_.force_evaluations;
-      update_work(model_, state, t1, h);
+      op_.update_work(state, t1, h);
       t = t1;
       dt = h;
       double next = std::min(phi_k * h, dt_max_);

@@ -46,7 +46,7 @@ namespace pd {
 
 class AdaptiveStep : public Integrator {
  public:
-  explicit AdaptiveStep(Model& model) : model_(model) {}
+  explicit AdaptiveStep(ForceOperator& op) : op_(op) {}
   std::string name() const override { return "adaptive"; }
   void configure(const Case& c, double dt_exact = 0.0) override;
   void initialize(State& state, double t) override;
@@ -68,7 +68,7 @@ class AdaptiveStep : public Integrator {
   // One iterate: v_new, u_new from (u^n, v^n, f^n) in state and the implicit force f_imp at t1.
   void update(const State& state, const Vec3Array& f_imp, double t, double t1, double dt);
 
-  Model& model_;
+  ForceOperator& op_;
   AdaptiveSettings settings_;
   double dt_min_ = 0.0, dt_max_ = 0.0;
   double limit_seconds_ = 0.0;

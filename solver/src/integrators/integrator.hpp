@@ -1,7 +1,7 @@
 // The integrator contract (MFEM's ODESolver::Step): step(state, t, dt) advances the state from t;
 // on return t is the new time and dt the step actually taken, which a step-size controller
-// (the adaptive Zohdi scheme, integrators/adaptive.hpp) may have changed. Plus the force evaluation and
-// energy bookkeeping every integrator shares.
+// (the adaptive Zohdi scheme, integrators/adaptive.hpp) may have changed. An integrator sees the
+// physics only through the operator (operator/force_operator.hpp).
 #pragma once
 #include <cstring>
 #include <memory>
@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "core/case.hpp"
-#include "core/model.hpp"
 #include "core/registry.hpp"
 #include "core/state.hpp"
+#include "operator/force_operator.hpp"
 
 namespace pd {
 
@@ -21,7 +21,7 @@ struct StepReport {
   int rejected = 0;           // rejected attempts before acceptance (0 for Verlet)
   std::int64_t broken_now = 0;  // bonds broken during the step, each counted once
   double broken_energy_now = 0.0;  // energy those bonds held when they broke [J] (forces/pmb.hpp)
-  int force_evaluations = 1;  // evaluate_forces calls of the step, rejected attempts included
+  int force_evaluations = 1;  // force evaluations of the step, rejected attempts included
   double next_dt = 0.0;       // the step the integrator proposes next [s]; 0: no proposal (fixed dt)
 };
 
@@ -75,30 +75,7 @@ class Integrator {
   StepReport report_;
 };
 
-using IntegratorFactory = std::unique_ptr<Integrator> (*)(Model&);
+using IntegratorFactory = std::unique_ptr<Integrator> (*)(ForceOperator&);
 const Registry<IntegratorFactory>& integrator_registry();
-
-// f = bond forces + contact forces + indenter forces + body forces at (u, t): clears f, then
-// every force term the scene needs adds into it; also sets state.w, state.contact_energy and
-// state.indenter_force. The one force path every integrator calls.
-void evaluate_forces(const Model& model, State& state, double t);
-
-// update_broken_bonds (bonds break after the state update, before the force at the new state)
-// followed by evaluate_forces, with the breaking done inside the bond-force sweep: one pass over
-// the bonds instead of two (docs/performance.md), bitwise the same result. Adds the bonds broken
-// now and their energy to report.broken_now and report.broken_energy_now.
-void break_bonds_and_evaluate_forces(Model& model, State& state, double t, StepReport& report);
-
-// Imposes the prescribed displacement / velocity at t (used at the start of a run).
-void impose_prescribed_motion(const Model& model, State& state, double t);
-
-// Body-force power plus the power of moving indenters, plus the power of the reactions at prescribed components, Σ V (ρa − f)·v
-// where a is the prescribed acceleration (the slope of a velocity table; 0 for a piecewise-linear
-// displacement — the impulses at its kinks are not counted) [W].
-double external_power(const Model& model, const State& state, double t);
-
-// Recomputes state.external_power and state.damping_power at t and adds the trapezoidal work
-// increments dt/2·(P_old + P_new) to the ledger; pass dt = 0 to only initialise the powers.
-void update_work(const Model& model, State& state, double t, double dt);
 
 }  // namespace pd

@@ -6,14 +6,14 @@ namespace pd {
 
 class VelocityVerlet : public Integrator {
  public:
-  explicit VelocityVerlet(Model& model) : model_(model) {}
+  explicit VelocityVerlet(ForceOperator& op) : op_(op) {}
   std::string name() const override { return "verlet"; }
   void initialize(State& state, double t) override;
   // Takes exactly the dt it is given.
   void step(State& state, double& t, double& dt) override;
 
  private:
-  Model& model_;
+  ForceOperator& op_;
 };
 
 }  // namespace pd

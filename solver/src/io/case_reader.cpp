@@ -15,6 +15,7 @@
 #include "core/partial_volume.hpp"
 #include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
+#include "materials/bond_model.hpp"
 
 namespace pd {
 
@@ -127,24 +128,40 @@ class Checker {
   std::string file_;
 };
 
+// A block: its id, name, density and model, then the parameters that model declares
+// (materials/bond_model.hpp), each a number in the model's range; unknown keys are errors.
 BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "blocks[" + std::to_string(k) + "]";
   ck.object(j, where);
-  ck.known_keys(j, where, {"id", "name", "model", "density", "youngs_modulus", "fracture_energy"});
+  BlockMaterial b;
+  if (const json* m = ck.optional(j, "model")) {
+    b.model = ck.string(*m, where + ".model");
+    if (!material_registry().contains(b.model)) ck.fail(where + ".model", material_registry().unknown_message(b.model));
+  }
+  const MaterialDefinition& law = material_registry().get(b.model);
+  std::vector<std::string> allowed = {"id", "name", "model", "density"};
+  for (const auto& p : law.parameters) allowed.push_back(p.name);
+  ck.known_keys(j, where, allowed);
   const std::int64_t id = ck.integer(ck.required(j, "id", where + ".id"), where + ".id", 1, 1 << 30);
   if (id != static_cast<std::int64_t>(k) + 1)
     ck.fail(where + ".id", "must be " + std::to_string(k + 1) + " (blocks are numbered 1, 2, … in order), got " +
                                std::to_string(id));
-  BlockMaterial b;
   b.name = ck.string(ck.required(j, "name", where + ".name"), where + ".name");
-  if (const json* m = ck.optional(j, "model")) {
-    b.model = ck.string(*m, where + ".model");
-    if (b.model != "pmb") ck.fail(where + ".model", "unknown model '" + b.model + "'; known: pmb");
-  }
   b.density = ck.positive(ck.required(j, "density", where + ".density"), where + ".density");
-  b.youngs_modulus = ck.positive(ck.required(j, "youngs_modulus", where + ".youngs_modulus"), where + ".youngs_modulus");
-  if (const json* g = ck.optional(j, "fracture_energy"); g && !g->is_null())
-    b.fracture_energy = ck.positive(*g, where + ".fracture_energy");
+  for (const auto& p : law.parameters) {
+    const std::string key = where + "." + p.name;
+    const json* value = p.required ? &ck.required(j, p.name, key) : ck.optional(j, p.name);
+    if (!value || (!p.required && value->is_null())) continue;
+    const double v = ck.number(*value, key);
+    if (p.lower == 0.0 && std::isinf(p.upper)) {
+      b.parameters[p.name] = ck.positive(*value, key);
+      continue;
+    }
+    if (!(v > p.lower && v < p.upper))
+      ck.fail(key, "must be between " + show(json(p.lower)) + " and " + show(json(p.upper)) + " (exclusive), got " +
+                       show(*value));
+    b.parameters[p.name] = v;
+  }
   return b;
 }
 
@@ -346,6 +363,12 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   const json& blocks = ck.array(ck.required(root, "blocks", "blocks"), "blocks");
   if (blocks.empty()) ck.fail("blocks", "needs at least one block");
   for (std::size_t k = 0; k < blocks.size(); ++k) c.blocks.push_back(read_block(ck, blocks[k], k));
+  // A bond joins two blocks, so its law must be one both ends share.
+  for (std::size_t k = 1; k < c.blocks.size(); ++k)
+    if (c.blocks[k].model != c.blocks[0].model)
+      ck.fail("blocks[" + std::to_string(k) + "].model",
+              "is '" + c.blocks[k].model + "' but blocks[0] is '" + c.blocks[0].model +
+                  "': every block of a case must use the same material model");
 
   if (const json* j = ck.optional(root, "no_fail_sets")) c.no_fail_sets = ck.strings(*j, "no_fail_sets");
   if (const json* j = ck.optional(root, "node_sets")) c.node_sets = ck.strings(*j, "node_sets");

@@ -17,7 +17,6 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "forces/pmb.hpp"
 #include "io/vtu.hpp"
 
 namespace pd {
@@ -34,7 +33,7 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
   g.points = make_vec3_array("Points", model.nodes.x[0], model.nodes.x[1], model.nodes.x[2]);
   g.point_data.push_back(make_vec3_array("displacement", state.u[0], state.u[1], state.u[2]));
   g.point_data.push_back(make_vec3_array("velocity", state.v[0], state.v[1], state.v[2]));
-  g.point_data.push_back(make_array("damage", damage(model)));
+  g.point_data.push_back(make_array("damage", model.bond_model->damage(model)));
   g.point_data.push_back(make_array("block", model.nodes.block));
 
   // Cells: a vertex per node, then a line per broken bond (each once, from its end i < j), in node

@@ -1,5 +1,5 @@
 // The PMB bond-force kernel and the bond-level quantities derived from stretches.
-#include "forces/pmb.hpp"
+#include "materials/pmb/pmb.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -182,17 +182,11 @@ std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, d
   return newly;
 }
 
-void PmbBondForce::AddMult(const Vec3Array& u, Vec3Array& f, double* energy_density) const {
-  add_pmb_force_density(pmb_arrays(model_, u), f[0].data(), f[1].data(), f[2].data(), energy_density);
+void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* energy_density) {
+  add_pmb_force_density(pmb_arrays(model, u), f[0].data(), f[1].data(), f[2].data(), energy_density);
 }
 
 namespace {
-
-// Nothing can break when every block pair is unbreakable: then no pass looks at breaking at all.
-bool nothing_can_break(const Model& m) {
-  return std::all_of(m.material.critical_pair.begin(), m.material.critical_pair.end(),
-                     [](double s0) { return std::isinf(s0); });
-}
 
 PmbBreaking pmb_breaking(Model& m, double* lost) {
   return PmbBreaking{m.bonds.broken.data(), m.material.critical_pair.data(), m.no_fail.data(), lost};
@@ -201,7 +195,7 @@ PmbBreaking pmb_breaking(Model& m, double* lost) {
 }  // namespace
 
 std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
-  if (nothing_can_break(m)) return 0;
+  if (!m.material.can_break()) return 0;  // then no pass looks at breaking at all
   const PmbArrays a = pmb_arrays(m, u);
   // Energy of the bonds broken now, per node i (the i < j copy of each bond), summed serially below.
   std::vector<double> lost(energy ? static_cast<std::size_t>(a.nodes) : 0, 0.0);
@@ -217,7 +211,7 @@ std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
 std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Array& f, double* energy_density,
                                            double* broken_energy) {
   const PmbArrays a = pmb_arrays(m, u);
-  if (nothing_can_break(m)) {
+  if (!m.material.can_break()) {
     add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density);
     return 0;
   }
@@ -258,7 +252,7 @@ double strain_energy(const Model& m, const Vec3Array& u) {
   return total;
 }
 
-std::vector<double> damage(const Model& m) {
+std::vector<double> pmb_damage(const Model& m) {
   const auto n = static_cast<std::int64_t>(m.nodes.size());
   std::vector<double> out(static_cast<std::size_t>(n), 0.0);
 #pragma omp parallel for schedule(static)
@@ -272,12 +266,6 @@ std::vector<double> damage(const Model& m) {
     out[static_cast<std::size_t>(i)] = all > 0.0 ? 1.0 - intact / all : 0.0;
   }
   return out;
-}
-
-std::int64_t broken_bond_count(const Model& m) {
-  std::int64_t count = 0;
-  for (std::uint8_t b : m.bonds.broken) count += b;
-  return count / 2;
 }
 
 }  // namespace pd

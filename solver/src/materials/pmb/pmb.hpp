@@ -1,5 +1,6 @@
-// The PMB bond force (thesis eqs. 1.9–1.11, 2.1): the kernel every integrator calls, bond breaking,
-// strain energy and damage.
+// The prototype microelastic brittle material, PMB (thesis eqs. 1.9–1.12, 2.1; Silling & Askari
+// 2005): its bond-force kernel, bond breaking, strain energy and damage as free functions over the
+// model's arrays, and PmbModel, the BondModel (materials/bond_model.hpp) the operator calls.
 #pragma once
 #include <cfloat>
 #include <cstdint>
@@ -7,6 +8,7 @@
 
 #include "core/model.hpp"
 #include "core/state.hpp"
+#include "materials/bond_model.hpp"
 
 namespace pd {
 
@@ -56,15 +58,8 @@ struct PmbBreaking {
 std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w = nullptr,
                                    const PmbBreaking* breaking = nullptr);
 
-// The force term as a small class with one verb (MFEM's AddMult).
-class PmbBondForce {
- public:
-  explicit PmbBondForce(const Model& model) : model_(model) {}
-  void AddMult(const Vec3Array& u, Vec3Array& f, double* energy_density = nullptr) const;
-
- private:
-  const Model& model_;
-};
+// f += the PMB force density at u (add_pmb_force_density over the model's arrays).
+void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* energy_density = nullptr);
 
 // After the state update: every intact bond whose stretch exceeds s0 of its block pair breaks for
 // good, unless an end is in a no-fail set. The stretch is computed from y_j − y_i, which is the
@@ -88,9 +83,29 @@ double strain_energy(const Model& model, const Vec3Array& u);
 std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u);
 
 // Damage per node: 1 − Σ_intact V_j / Σ_all V_j (0 for a node without bonds).
-std::vector<double> damage(const Model& model);
+std::vector<double> pmb_damage(const Model& model);
 
-// Broken bonds, each counted once.
-std::int64_t broken_bond_count(const Model& model);
+// The constants of thesis eqs. 1.11–1.12 for one block (validation.md F1), by analysis.
+PairConstants pmb_constants(const BlockMaterial& block, const std::string& analysis, double horizon, double thickness);
+
+// The linearised PMB force. About the reference configuration (thesis eq. 2.3; Silling & Askari
+// 2005: C(ξ) = c/|ξ|·e⊗e), and at a deformed state u: per intact bond
+//   ∂f_i/∂u_j = c ν V_j·[(1/|ξ|)·n nᵀ + (s/y)·(I − n nᵀ)],  n = (y_j − y_i)/y, y = |y_j − y_i|,
+// and ∂f_i/∂u_i = −Σ_j of the same (f depends on u_j − u_i only).
+class PmbModel : public BondModel {
+ public:
+  std::string name() const override { return "pmb"; }
+  void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const override;
+  BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                        bool want_energy) const override;
+  BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
+  std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
+  std::vector<double> damage(const Model& model) const override { return pmb_damage(model); }
+  double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
+  void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
+                                 Vec3Array& y) const override;
+  void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
+};
+
 
 }  // namespace pd

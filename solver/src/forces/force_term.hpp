@@ -1,0 +1,50 @@
+// The interface of every force term besides the material's bonds (contact, indenters, body force),
+// and their registry. The operator (operator/force_operator.hpp) builds the terms a scene needs
+// once, from this registry, and calls each through this interface; integrators never name one.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/case.hpp"
+#include "core/model.hpp"
+#include "core/state.hpp"
+
+namespace pd {
+
+class ForceTerm {
+ public:
+  virtual ~ForceTerm() = default;
+  // s.f += the term's force density at (s.u, t); adds its potential energy to s.contact_energy
+  // and sets what it reports (the indenters' forces on the body). Accumulates; never clears.
+  virtual void add_force(State& s, double t) const = 0;
+  // p += the power the term puts into the body at (s.u, s.v, t) [W] (0 for a conservative term
+  // that does not move: contact).
+  virtual void add_power(const State& s, double t, double& p) const = 0;
+  // y += ∂f/∂u·x at (s.u, t): the term's part of the linearised force (implicit solves).
+  virtual void add_jacobian_product(const State& s, double t, const Vec3Array& x, Vec3Array& y) const = 0;
+  // Lines of the work plan (run.log) for this term.
+  virtual std::vector<std::string> work_plan() const = 0;
+};
+
+// One registered term: how to build it for a scene (null when the scene does not need it) and
+// what the work plan says then. `order` fixes the order in which terms add into f (and so the bits
+// of f), `power_order` the order of their powers in the external power: both are those of every
+// run before the operator existed, so results stay bitwise the same.
+struct ForceTermEntry {
+  std::string name;
+  int order = 0;
+  int power_order = 0;
+  std::unique_ptr<ForceTerm> (*make)(const Model& model) = nullptr;
+  std::string (*absent)(const Model& model, const Case& c) = nullptr;  // work-plan line when not built; may be ""
+};
+
+// Every force term, sorted by `order`.
+const std::vector<ForceTermEntry>& force_term_registry();
+
+// The factories, one per file of forces/ (force_terms.cpp lists them).
+std::unique_ptr<ForceTerm> make_contact_term(const Model& model);
+std::unique_ptr<ForceTerm> make_indenter_term(const Model& model);
+std::unique_ptr<ForceTerm> make_body_force_term(const Model& model);
+
+}  // namespace pd

@@ -1,0 +1,105 @@
+// The interface every material model implements (one folder per model under materials/<name>/),
+// and the registry that chooses one by the case's `blocks[].model` (pipeline/formats.md §3).
+//
+// A material owns everything that depends on its constitutive law: its parameters from the case,
+// its constants per block (micromodulus c, critical stretch s0: Model::material, the pair table of
+// core/material.hpp, which contact and run.log read too), its force and strain-energy
+// kernel, its breaking rule and damage, its term of the stable step (thesis eq. 2.5), its linearised
+// force (for the exact step limit and for implicit solves). Nothing outside materials/<name>/ knows
+// the law; the operator (operator/force_operator.hpp) calls it through this interface, in the way
+// Peridigm's Material and LAMMPS's pair styles are separate from the time integrators.
+//
+// To add a model: a folder materials/<name>/ whose .cpp files define
+//   void register_material_<name>(MaterialRegistry&);
+// (CMake finds the folder and calls it: no other file lists the models), a test file
+// tests/materials/test_<name>.cpp, and its schema entry in pipeline/schema.py.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/material.hpp"
+#include "core/nodes.hpp"
+#include "core/registry.hpp"
+
+namespace pd {
+
+struct Model;
+
+// A number a model reads from its block in case.json (blocks[k].<name>), checked by the reader.
+struct MaterialParameter {
+  std::string name;
+  std::string unit;  // SI
+  std::string doc;   // one line
+  bool required = true;
+  // The reader requires lower < value < upper (strict; +inf: no upper bound).
+  double lower = 0.0;
+  double upper = std::numeric_limits<double>::infinity();
+};
+
+// Bonds broken by one call, each counted once, and the energy they held then [J].
+struct BreakReport {
+  std::int64_t broken = 0;
+  double energy = 0.0;
+};
+
+class BondModel {
+ public:
+  virtual ~BondModel() = default;
+  virtual std::string name() const = 0;
+
+  // f += the bond force density at u over intact bonds; w (if not null) = strain-energy density
+  // W_i per node (overwritten). Each node writes only its own row: bitwise the same for any
+  // thread count. Accumulates; never clears f.
+  virtual void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const = 0;
+  // Breaks every intact bond over its critical stretch at u, then adds the force of the intact
+  // bonds as add_force does (the thesis §2.2 order: bonds break after the state update, before the
+  // force there). want_energy: also the energy the broken bonds held.
+  virtual BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                bool want_energy) const = 0;
+  // Only the breaking of break_bonds_and_add_force.
+  virtual BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const = 0;
+  // W_i per node at u [J/m³].
+  virtual std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const = 0;
+  // Damage φ_i ∈ [0, 1] per node (0 intact, 1 every bond broken).
+  virtual std::vector<double> damage(const Model& model) const = 0;
+
+  // Bond i→j's term of thesis eq. 2.5, V_j ν C [N/m⁴], C the linearised bond stiffness at the
+  // reference configuration (c/|ξ| for PMB): node i's stable step is √(2ρ_i / Σ_j (this + other
+  // terms)), core/model.hpp node_stiffness.
+  virtual double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const = 0;
+  // y = M^{-1/2} K M^{-1/2} x with K the stiffness linearised about the reference configuration
+  // and M the lumped masses ρ_i V_i (core/stability: its largest eigenvalue is ω_max²). period[d] > 0
+  // makes axis d periodic for the bond direction (the tests' infinite lattice).
+  virtual void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
+                                         Vec3Array& y) const = 0;
+  // y += J(u)·x, J = ∂f/∂u the linearised force density at u (a Jacobian–vector product, matrix-free):
+  // the Newton and Krylov solves of the implicit integrators use it.
+  virtual void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const = 0;
+};
+
+// What the registry holds per model: its parameters (the reader checks them and --describe prints
+// them), its constants per block, and its law (every block of a case uses one model).
+struct MaterialDefinition {
+  std::string doc;
+  std::vector<MaterialParameter> parameters;
+  // c and s0 of one block from its parameters; thickness h is ignored in 3D.
+  PairConstants (*constants)(const BlockMaterial& block, const std::string& analysis, double horizon,
+                             double thickness) = nullptr;
+  // The law, built once the bonds exist (so a model may precompute per-node quantities).
+  std::shared_ptr<const BondModel> (*make)(const Model& model) = nullptr;
+};
+
+using MaterialRegistry = Registry<MaterialDefinition>;
+const MaterialRegistry& material_registry();
+
+// c and s0 per block and block pair (core/material.hpp) from the formulas of the blocks' model
+// (every block uses blocks[0]'s; the case reader checks that they agree).
+MaterialTable make_material_table(const std::vector<BlockMaterial>& blocks, const std::string& analysis, double horizon,
+                                  double thickness);
+
+}  // namespace pd

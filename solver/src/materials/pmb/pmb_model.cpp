@@ -1,0 +1,138 @@
+// PmbModel: PMB behind the BondModel interface, its linearisation, and its registry entry.
+#include <cmath>
+#include <memory>
+
+#include "core/model.hpp"
+#include "materials/pmb/pmb.hpp"
+
+namespace pd {
+
+void PmbModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const {
+  add_pmb_force(model, u, f, w);
+}
+
+BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                bool want_energy) const {
+  BreakReport r;
+  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, want_energy ? &r.energy : nullptr);
+  return r;
+}
+
+BreakReport PmbModel::break_bonds(Model& model, const Vec3Array& u, bool want_energy) const {
+  BreakReport r;
+  r.broken = update_broken_bonds(model, u, want_energy ? &r.energy : nullptr);
+  return r;
+}
+
+std::vector<double> PmbModel::strain_energy_density(const Model& model, const Vec3Array& u) const {
+  return pd::strain_energy_density(model, u);
+}
+
+double PmbModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, double length) const {
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const double c = m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
+                                                static_cast<std::size_t>(m.block_index[j])];
+  // thesis eq. 2.5 with the linearised PMB stiffness |C(ξ)| = c/|ξ| (Silling & Askari 2005).
+  return m.nodes.volume[j] * m.bonds.volume_weight(length) * c / length;
+}
+
+namespace {
+
+// Minimum image of a bond component on a periodic axis (period p > 0); unchanged otherwise.
+inline double wrap(double d, double p) { return p > 0.0 ? d - p * std::nearbyint(d / p) : d; }
+
+}  // namespace
+
+void PmbModel::apply_reference_stiffness(const Model& m, const std::array<double, 3>& period, const Vec3Array& x,
+                                         Vec3Array& y) const {
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i64 = 0; i64 < n; ++i64) {
+    const auto i = static_cast<std::size_t>(i64);
+    const double inv_sqrt_mi = 1.0 / std::sqrt(m.density[i] * m.nodes.volume[i]);
+    const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
+    double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      if (m.bonds.broken[ku]) continue;
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
+      // |ξ| of the minimum image (core/bonds.hpp stores no lengths; without a period this is
+      // bitwise bond_length).
+      const double xi0 = wrap(m.nodes.x[0][j] - m.nodes.x[0][i], period[0]);
+      const double xi1 = wrap(m.nodes.x[1][j] - m.nodes.x[1][i], period[1]);
+      const double xi2 = wrap(m.nodes.x[2][j] - m.nodes.x[2][i], period[2]);
+      const double len = std::sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2);
+      const double e0 = xi0 / len, e1 = xi1 / len, e2 = xi2 / len;
+      const double inv_sqrt_mj = 1.0 / std::sqrt(m.density[j] * m.nodes.volume[j]);
+      // bond stiffness k_ij = c ν V_i V_j/|ξ| (force per unit relative displacement along e; ν the
+      // partial-volume factor of validation.md F3, from |ξ|)
+      const double nu = m.bonds.volume_weight(len);
+      const double kij = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] * nu *
+                         m.nodes.volume[i] * m.nodes.volume[j] / len;
+      const double d0 = x[0][i] * inv_sqrt_mi - x[0][j] * inv_sqrt_mj;
+      const double d1 = x[1][i] * inv_sqrt_mi - x[1][j] * inv_sqrt_mj;
+      const double d2 = x[2][i] * inv_sqrt_mi - x[2][j] * inv_sqrt_mj;
+      const double along = kij * (e0 * d0 + e1 * d1 + e2 * d2);
+      y0 += along * e0;
+      y1 += along * e1;
+      y2 += along * e2;
+    }
+    y[0][i] = y0 * inv_sqrt_mi;
+    y[1][i] = y1 * inv_sqrt_mi;
+    y[2][i] = y2 * inv_sqrt_mi;
+  }
+}
+
+void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const auto& X = m.nodes.x;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i64 = 0; i64 < n; ++i64) {
+    const auto i = static_cast<std::size_t>(i64);
+    const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
+    const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;  // in bond order: the same for any thread count
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      if (m.bonds.broken[ku]) continue;
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
+      const double length = bond_length(X, i, j);
+      const double e0 = (X[0][j] + u[0][j]) - yi0, e1 = (X[1][j] + u[1][j]) - yi1, e2 = (X[2][j] + u[2][j]) - yi2;
+      const double len_y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+      if (!(len_y > 0.0)) continue;  // a bond crushed to a point has no direction (the kernel gives it no force)
+      const double n0 = e0 / len_y, n1 = e1 / len_y, n2 = e2 / len_y;
+      const double raw_s = (len_y - length) / length;
+      const double s = std::fabs(raw_s) > kStretchZero ? raw_s : 0.0;  // as the kernel (thesis §2.2)
+      const double c_vj = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] *
+                          m.nodes.volume[j] * m.bonds.volume_weight(length);
+      // δe = x_j − x_i;  δf_i = c ν V_j [(1/|ξ|) n nᵀ + (s/y)(I − n nᵀ)] δe
+      const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
+      const double along = n0 * d0 + n1 * d1 + n2 * d2;
+      const double axial = c_vj * along / length, lateral = c_vj * s / len_y;
+      s0 += axial * n0 + lateral * (d0 - along * n0);
+      s1 += axial * n1 + lateral * (d1 - along * n1);
+      s2 += axial * n2 + lateral * (d2 - along * n2);
+    }
+    y[0][i] += s0;
+    y[1][i] += s1;
+    y[2][i] += s2;
+  }
+}
+
+// The registry entry (materials/bond_model.hpp): the parameters PMB reads from a block.
+void register_material_pmb(MaterialRegistry& registry) {
+  MaterialDefinition d;
+  d.doc = "prototype microelastic brittle, bond-based (Silling & Askari 2005); fixes Poisson's ratio "
+          "(1/4 in 3D and plane strain, 1/3 in plane stress)";
+  d.parameters = {
+      {"youngs_modulus", "Pa", "Young's modulus E", true},
+      {"fracture_energy", "J/m^2", "critical energy release rate G0; absent or null: the block never breaks", false},
+  };
+  d.constants = &pmb_constants;
+  d.make = [](const Model&) -> std::shared_ptr<const BondModel> { return std::make_shared<PmbModel>(); };
+  registry.add("pmb", d);
+}
+
+}  // namespace pd

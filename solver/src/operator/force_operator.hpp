@@ -1,0 +1,78 @@
+// The operator between the integrators and the physics (MFEM's TimeDependentOperator idea): built
+// once from the model, it owns the material law and every force term the scene needs, and the
+// prescribed motion. An integrator sees only this: the force at (u, t), the breaking step, the
+// prescribed motion at t, energies and powers, and the linearised force for implicit solves.
+// No integrator names a force term or a material; no force term or material names an integrator.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/case.hpp"
+#include "core/model.hpp"
+#include "core/state.hpp"
+#include "forces/force_term.hpp"
+
+namespace pd {
+
+class ForceOperator {
+ public:
+  explicit ForceOperator(Model& model);
+
+  const Model& model() const { return model_; }
+  Model& model() { return model_; }
+  std::size_t size() const { return model_.nodes.size(); }
+  const std::vector<double>& density() const { return model_.density; }  // ρ_i [kg/m³]
+  double damping() const { return model_.damping; }                     // α [1/s]
+  // 1 where a component is prescribed (its motion comes from the tables, not from the force).
+  const std::array<std::vector<std::uint8_t>, 3>& fixed() const { return model_.conditions.fixed; }
+  // "Can anything break?", asked of the material's constants: the one place.
+  bool can_break() const { return model_.material.can_break(); }
+
+  // s.f = force density at (s.u, t) (cleared, then the bonds and every active term add into it);
+  // also s.w (strain-energy density), s.contact_energy and s.indenter_force.
+  void evaluate(State& s, double t) const;
+  // Bonds over their critical stretch at s.u break (thesis §2.2: after the state update, before the
+  // force there), then evaluate(s, t) in the same sweep over the bonds. Returns what broke now.
+  BreakReport break_bonds_and_evaluate(State& s, double t);
+
+  // y = ∂f/∂u·x at (s.u, t): the linearised force density (matrix-free). Prescribed components are
+  // not treated specially: a solver constrains them itself.
+  void apply_jacobian(const State& s, double t, const Vec3Array& x, Vec3Array& y) const;
+
+  // Prescribed motion. impose: u and v of every prescribed component at t.
+  void impose_prescribed_motion(State& s, double t) const;
+  // Prescribed components over a step t → t1 = t + dt: u_to = their u at t1 (a displacement table)
+  // or u_from + ∫v dt (a velocity table); v_to = the mean velocity over the step, or for a velocity
+  // table with `end_velocity` its value at t1. u_from may be u_to.
+  void advance_prescribed_motion(const Vec3Array& u_from, Vec3Array& u_to, Vec3Array& v_to, double t, double t1,
+                                 double dt, bool end_velocity) const;
+  // v of every velocity-table component = its value at t1 (the end of a Verlet step).
+  void impose_prescribed_velocity(Vec3Array& v, double t1) const;
+
+  // Energies [J], summed serially in node order (the same for any thread count).
+  double kinetic_energy(const State& s) const;
+  double strain_energy(const State& s) const;  // Σ W_i V_i from the last force evaluation
+  // Body-force and moving-indenter power plus the power of the reactions at prescribed components,
+  // Σ V (ρa − f)·v with a the prescribed acceleration (the slope of a velocity table; 0 for a
+  // piecewise-linear displacement — the impulses at its kinks are not counted) [W].
+  double external_power(const State& s, double t) const;
+  // Recomputes s.external_power and s.damping_power at t and adds the trapezoidal work increments
+  // dt/2·(P_old + P_new) to the ledger; dt = 0 only initialises the powers.
+  void update_work(State& s, double t, double dt) const;
+
+  // The stable step of thesis eq. 2.5 and the exact explicit limit 2/ω_max (core/stability) [s].
+  double stable_time_step() const;
+  double exact_time_step() const;
+
+  // The work plan for run.log, from the material and the registered terms: what runs, what not.
+  std::vector<std::string> work_plan(const Case& c) const;
+
+ private:
+  Model& model_;
+  std::vector<std::unique_ptr<ForceTerm>> terms_;        // in force order (forces/force_term.hpp)
+  std::vector<const ForceTerm*> power_terms_;            // the same, in power order
+  std::vector<const ForceTerm*> built_;                  // per registry entry: its term, or null
+};
+
+}  // namespace pd
