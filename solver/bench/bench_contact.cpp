@@ -2,7 +2,7 @@
 // over the Verlet list and of one full rebuild of the list, next to one PMB bond-force pass.
 #include <benchmark/benchmark.h>
 
-#include "core/verlet_list.hpp"
+#include "core/neighbour_list.hpp"
 #include "forces/contact.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "lattice.hpp"
@@ -51,7 +51,7 @@ void BM_ContactRebuild2D(benchmark::State& st) {
   const pd::Model m = contact_lattice(static_cast<int>(st.range(0)));
   const pd::Vec3Array u = shear(m);
   for (auto _ : st) {
-    const pd::ContactPairs p = pd::VerletList::search(m.nodes.x, u, m.block_index, m.contact);
+    const pd::ContactPairs p = pd::NeighbourList::search(m.nodes.x, u, m.block_index, m.contact);
     benchmark::DoNotOptimize(p.neighbour.data());
   }
 }

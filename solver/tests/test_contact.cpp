@@ -91,7 +91,7 @@ TEST(Contact, TwoBodiesBounceConservingMomentumWithoutInterpenetration) {
   EXPECT_GT(m.contact_list.rebuilds(), 1);
 }
 
-TEST(Contact, VerletListGivesTheForcesOfAFreshSearchAtEveryStep) {
+TEST(Contact, NeighbourListGivesTheForcesOfAFreshSearchAtEveryStep) {
   // A breakable single body with self-contact under random velocities: nodes move, bonds break,
   // fragments touch; the list is rebuilt only now and then.
   pd::Case c = pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, 0.01, 1e-3);
@@ -116,7 +116,7 @@ TEST(Contact, VerletListGivesTheForcesOfAFreshSearchAtEveryStep) {
     integrator->step(s, t, h);
     pd::Vec3Array f_list = pd::make_vec3(s.size()), f_fresh = pd::make_vec3(s.size());
     const double e_list = pd::ShortRangeForce(m).AddMult(s.u, f_list);
-    const pd::ContactPairs fresh = pd::VerletList::search(m.nodes.x, s.u, m.block_index, m.contact);
+    const pd::ContactPairs fresh = pd::NeighbourList::search(m.nodes.x, s.u, m.block_index, m.contact);
     const double e_fresh = pd::ShortRangeForce(m).AddMult(fresh, s.u, f_fresh);
     for (std::size_t d = 0; d < 3; ++d) ASSERT_EQ(f_list[d], f_fresh[d]) << "step " << k << " component " << d;
     ASSERT_EQ(e_list, e_fresh) << "step " << k;

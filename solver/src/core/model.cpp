@@ -86,8 +86,8 @@ double node_stiffness(const Model& m, std::size_t i) {
     // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
     // 15c needs extra margin in impacts).
     if (m.contact.pairs && length <= m.contact.distance) {
-      const double c = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
-      sum += m.nodes.volume[j] * m.contact.stiffness_factor * c / m.horizon;
+      const double micromodulus = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];
+      sum += m.nodes.volume[j] * m.contact.stiffness_factor * micromodulus / m.horizon;
     }
   }
   return sum;

@@ -9,7 +9,7 @@
 #include "core/conditions.hpp"
 #include "core/material.hpp"
 #include "core/nodes.hpp"
-#include "core/verlet_list.hpp"
+#include "core/neighbour_list.hpp"
 #include "materials/bond_model.hpp"
 
 namespace pd {
@@ -32,7 +32,7 @@ struct Model {
   std::vector<IndenterSettings> indenters;
   // A cache of the proximity search, not state: the forces are the same whether or not it was
   // rebuilt (tested), so it may change behind a const Model.
-  mutable VerletList contact_list;
+  mutable NeighbourList contact_list;
 };
 
 // Checks the node file against the case (blocks in range, sets present) and builds the bonds.

@@ -10,7 +10,7 @@ namespace pd {
 struct State {
   Vec3Array u;  // displacement [m]
   Vec3Array v;  // velocity [m/s]
-  Vec3Array f;  // force density of the conservative terms (bonds + body force) at u [N/m³]
+  Vec3Array f;  // force density at u of every operator term (bonds, contact, indenters, body force; damping acts in the integrator) [N/m³]
   std::vector<double> w;  // strain-energy density W_i at u, from the last force evaluation [J/m³]
   double contact_energy = 0.0;  // potential of contact pairs and indenters at u [J]
   std::vector<std::array<double, 3>> indenter_force;  // force of each indenter on the body at u [N]

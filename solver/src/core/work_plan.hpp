@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "core/case.hpp"
-#include "core/verlet_list.hpp"
+#include "core/neighbour_list.hpp"
 
 namespace pd {
 

@@ -11,7 +11,7 @@
 
 #include "core/model.hpp"
 #include "core/state.hpp"
-#include "core/verlet_list.hpp"
+#include "core/neighbour_list.hpp"
 #include "forces/force_term.hpp"
 
 namespace pd {

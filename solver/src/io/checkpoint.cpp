@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/vtu.hpp"
 
 namespace pd {

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
 #error "the VTU reader and writer copy raw little-endian bytes; port them for a big-endian host"
@@ -37,25 +38,6 @@ VtuArray make_vec3_array(const std::string& name, const std::vector<double>& x, 
 }
 
 // ---------------------------------------------------------------- writing
-
-void write_file_atomically(const std::filesystem::path& path, const std::vector<std::string_view>& pieces) {
-  const std::filesystem::path tmp = path.string() + ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(tmp.string() + ": cannot open for writing");
-    // Piece by piece from where the data lie: a frame's arrays are not first copied into one string.
-    for (const std::string_view piece : pieces) out.write(piece.data(), static_cast<std::streamsize>(piece.size()));
-    out.close();
-    if (!out) throw Error(tmp.string() + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw Error(path.string() + ": cannot rename " + tmp.string() + " into place: " + ec.message());
-}
-
-void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
-  write_file_atomically(path, std::vector<std::string_view>{text});
-}
 
 void write_vtu(const std::filesystem::path& path, const VtuGrid& g) {
   std::ostringstream head;

@@ -67,11 +67,6 @@ VtuGrid read_vtu(const std::filesystem::path& path);
 // The same from the file's bytes (`file` only names it in messages); the fuzz targets call this.
 VtuGrid parse_vtu(const std::string& text, const std::string& file);
 
-// Writes `text` to `path` through a temporary file and a rename.
-void write_file_atomically(const std::filesystem::path& path, const std::string& text);
-// The same for text given in pieces, written one after the other.
-void write_file_atomically(const std::filesystem::path& path, const std::vector<std::string_view>& pieces);
-
 // Typed copy of an array's values.
 template <class T>
 std::vector<T> values_of(const VtuArray& a) {

@@ -30,10 +30,10 @@ std::vector<double> PmbModel::strain_energy_density(const Model& model, const Ve
 
 double PmbModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, double length) const {
   const auto nb = static_cast<std::size_t>(m.material.blocks);
-  const double c = m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
-                                                static_cast<std::size_t>(m.block_index[j])];
+  const double micromodulus = m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
+                                                           static_cast<std::size_t>(m.block_index[j])];
   // thesis eq. 2.5 with the linearised PMB stiffness |C(ξ)| = c/|ξ| (Silling & Askari 2005).
-  return m.nodes.volume[j] * m.bonds.volume_weight(length) * c / length;
+  return m.nodes.volume[j] * m.bonds.volume_weight(length) * micromodulus / length;
 }
 
 namespace {

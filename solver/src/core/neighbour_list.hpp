@@ -1,4 +1,5 @@
-// The contact neighbour list: a Verlet list of node pairs within the contact distance plus a skin,
+// The contact neighbour list (a "Verlet list" in molecular-dynamics terms; named apart from the
+// velocity-Verlet integrator): node pairs within the contact distance plus a skin,
 // found with a cell list over current positions and rebuilt only when some node has moved more
 // than half the skin since the last build (so no pair can have come within the contact distance
 // unseen: each of the two nodes moved ≤ skin/2). Never O(N²).
@@ -36,7 +37,7 @@ inline double contact_distance(double reference_length, bool bonded, double two_
   return bonded ? std::min(0.9 * reference_length, two_rs) : two_rs;
 }
 
-class VerletList {
+class NeighbourList {
  public:
   // Rebuilds the list if this is the first call or some node moved more than skin/2 since the
   // last build (max over nodes of |u − u_build|); returns true if it rebuilt.

@@ -1,5 +1,5 @@
-// Builds and refreshes the contact Verlet list (see verlet_list.hpp).
-#include "core/verlet_list.hpp"
+// Builds and refreshes the contact Verlet list (see neighbour_list.hpp).
+#include "core/neighbour_list.hpp"
 
 #include <omp.h>
 
@@ -12,7 +12,7 @@
 
 namespace pd {
 
-ContactPairs VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
+ContactPairs NeighbourList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
                                 const ContactParameters& p) {
   ContactPairs out;
   Scratch scratch;
@@ -20,7 +20,7 @@ ContactPairs VerletList::search(const Vec3Array& x, const Vec3Array& u, const st
   return out;
 }
 
-void VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
+void NeighbourList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
                         const ContactParameters& p, ContactPairs& out, Scratch& scratch) {
   const std::size_t n = x[0].size();
   out.offsets.assign(n + 1, 0);
@@ -92,7 +92,7 @@ void VerletList::search(const Vec3Array& x, const Vec3Array& u, const std::vecto
   }
 }
 
-bool VerletList::update(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
+bool NeighbourList::update(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
                         const ContactParameters& p) {
   const auto n = static_cast<std::int64_t>(x[0].size());
   bool stale = rebuilds_ == 0 || static_cast<std::int64_t>(u_build_[0].size()) != n;
@@ -122,7 +122,7 @@ bool VerletList::update(const Vec3Array& x, const Vec3Array& u, const std::vecto
   return true;
 }
 
-void VerletList::restore(const Vec3Array& x, const Vec3Array& u_build, const std::vector<std::int32_t>& block,
+void NeighbourList::restore(const Vec3Array& x, const Vec3Array& u_build, const std::vector<std::int32_t>& block,
                          const ContactParameters& p, std::int64_t rebuilds, double seconds) {
   pairs_ = rebuilds > 0 ? search(x, u_build, block, p) : ContactPairs{};
   u_build_ = u_build;
