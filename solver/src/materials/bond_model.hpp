@@ -80,6 +80,11 @@ class BondModel {
   // y += J(u)·x, J = ∂f/∂u the linearised force density at u (a Jacobian–vector product, matrix-free):
   // the Newton and Krylov solves of the implicit integrators use it.
   virtual void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const = 0;
+  // The same Jacobian assembled, for a bond-based law whose force on i depends on u_j − u_i only:
+  // blocks[9k..9k+8] = ∂f_i/∂u_j (row-major 3×3) for bond k of row i at u (zeros for a broken
+  // bond); ∂f_i/∂u_i is minus their sum. Returns false for a law that has no such form (a
+  // state-based one couples i with its neighbours' neighbours): solvers then stay matrix-free.
+  virtual bool bond_tangent_row(const Model& model, const Vec3Array& u, std::size_t i, double* blocks) const = 0;
 };
 
 // What the registry holds per model: its parameters (the reader checks them and --describe prints

@@ -84,6 +84,27 @@ void PmbModel::apply_reference_stiffness(const Model& m, const std::array<double
   }
 }
 
+namespace {
+
+// ∂f_i/∂u_j of one intact bond at the current state (row-major 3×3):
+//   c ν V_j·[(1/|ξ|)·n nᵀ + (s/y)·(I − n nᵀ)],  n = e/y, e = y_j − y_i.
+// A bond crushed to a point (y = 0) has no direction: the kernel gives it no force, and no stiffness here.
+inline void bond_block(double c_vj, double length, double e0, double e1, double e2, double block[9]) {
+  const double len_y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+  if (!(len_y > 0.0)) {
+    for (int q = 0; q < 9; ++q) block[q] = 0.0;
+    return;
+  }
+  const double n[3] = {e0 / len_y, e1 / len_y, e2 / len_y};
+  const double raw_s = (len_y - length) / length;
+  const double s = std::fabs(raw_s) > kStretchZero ? raw_s : 0.0;  // as the kernel (thesis §2.2)
+  const double axial = c_vj / length, lateral = c_vj * s / len_y;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) block[3 * a + b] = (axial - lateral) * n[a] * n[b] + (a == b ? lateral : 0.0);
+}
+
+}  // namespace
+
 void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
   const auto n = static_cast<std::int64_t>(m.nodes.size());
   const auto nb = static_cast<std::size_t>(m.material.blocks);
@@ -99,26 +120,41 @@ void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Ve
       if (m.bonds.broken[ku]) continue;
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
       const double length = bond_length(X, i, j);
-      const double e0 = (X[0][j] + u[0][j]) - yi0, e1 = (X[1][j] + u[1][j]) - yi1, e2 = (X[2][j] + u[2][j]) - yi2;
-      const double len_y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-      if (!(len_y > 0.0)) continue;  // a bond crushed to a point has no direction (the kernel gives it no force)
-      const double n0 = e0 / len_y, n1 = e1 / len_y, n2 = e2 / len_y;
-      const double raw_s = (len_y - length) / length;
-      const double s = std::fabs(raw_s) > kStretchZero ? raw_s : 0.0;  // as the kernel (thesis §2.2)
       const double c_vj = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] *
                           m.nodes.volume[j] * m.bonds.volume_weight(length);
-      // δe = x_j − x_i;  δf_i = c ν V_j [(1/|ξ|) n nᵀ + (s/y)(I − n nᵀ)] δe
+      double b[9];
+      bond_block(c_vj, length, (X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2, b);
+      // δf_i = B (δu_j − δu_i)
       const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
-      const double along = n0 * d0 + n1 * d1 + n2 * d2;
-      const double axial = c_vj * along / length, lateral = c_vj * s / len_y;
-      s0 += axial * n0 + lateral * (d0 - along * n0);
-      s1 += axial * n1 + lateral * (d1 - along * n1);
-      s2 += axial * n2 + lateral * (d2 - along * n2);
+      s0 += b[0] * d0 + b[1] * d1 + b[2] * d2;
+      s1 += b[3] * d0 + b[4] * d1 + b[5] * d2;
+      s2 += b[6] * d0 + b[7] * d1 + b[8] * d2;
     }
     y[0][i] += s0;
     y[1][i] += s1;
     y[2][i] += s2;
   }
+}
+
+bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t i, double* blocks) const {
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
+  const auto& X = m.nodes.x;
+  const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
+  for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    double* b = blocks + 9 * (k - m.bonds.offsets[i]);
+    if (m.bonds.broken[ku]) {
+      for (int q = 0; q < 9; ++q) b[q] = 0.0;
+      continue;
+    }
+    const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
+    const double length = bond_length(X, i, j);
+    const double c_vj = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] *
+                        m.nodes.volume[j] * m.bonds.volume_weight(length);
+    bond_block(c_vj, length, (X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2, b);
+  }
+  return true;
 }
 
 // The registry entry (materials/bond_model.hpp): the parameters PMB reads from a block.
