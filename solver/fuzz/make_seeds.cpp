@@ -70,10 +70,11 @@ pd::Checkpoint checkpoint(std::size_t nodes, bool rich) {
   c.nodes = nodes;
   c.directed_bonds = 2 * nodes;
   c.integrator = rich ? "adaptive" : "verlet";
-  c.step = 10, c.time = 1e-6, c.dt = 1e-7, c.dt_taken = 1e-7;
-  c.last_frame_step = 10, c.next_frame_index = 2, c.next_restart_index = 1;
-  c.broken = 1, c.force_evaluations = 11, c.broken_energy = 1e-9, c.wall_time = 0.25;
-  c.energy_before = 2e-6, c.energy_streak_start = 1e-6, c.growth_streak = 0;
+  pd::LoopState& l = c.loop;
+  l.step = 10, l.t = 1e-6, l.dt = 1e-7, l.dt_taken = 1e-7;
+  l.last_frame_step = 10, l.next_frame_index = 2, l.next_restart_index = 1;
+  l.broken = 1, l.force_evaluations = 11, l.broken_energy = 1e-9, l.wall_time = 0.25;
+  l.growth.energy_before = 2e-6, l.growth.streak_start = 1e-6, l.growth.streak = 0;
   c.integrator_state = SavedReport().save_state();
   if (rich) {
     const double proposal = 1.1e-7;  // AdaptiveStep::save_state appends its proposal

@@ -190,7 +190,7 @@ TEST_P(Restart, SigtermThenRestartIsBitwiseTheUninterruptedRun) {
   ASSERT_TRUE(fs::exists(cut / "out" / "checkpoint.bin"));
   EXPECT_LE(total_steps(cut / "out" / "history.csv"), stop);
   const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
-  EXPECT_EQ(ck.step, stop);
+  EXPECT_EQ(ck.loop.step, stop);
   EXPECT_EQ(ck.integrator, v.integrator);
   EXPECT_EQ(ck.history_bytes, fs::file_size(cut / "out" / "history.csv"));  // whole rows only, all on disk
   EXPECT_NE(slurp(cut / "out" / "run.log").find("interrupted by SIGTERM after step " + std::to_string(stop)),
@@ -216,7 +216,7 @@ TEST_P(Restart, PeriodicCheckpointThenCutOffRunRestartsBitwise) {
   const std::int64_t stop = steps * 2 / 3 + 1;
   ASSERT_EQ(run(cut / "case.json", {}, {}, stop), pd::kOk);
   const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
-  EXPECT_EQ(ck.step, stop / 7 * 7);
+  EXPECT_EQ(ck.loop.step, stop / 7 * 7);
   EXPECT_LT(ck.history_bytes, fs::file_size(cut / "out" / "history.csv"));
   ASSERT_EQ(run(cut / "case.json", {}, cut / "out" / "checkpoint.bin"), pd::kOk);
   expect_same_output(whole / "out", cut / "out");
@@ -236,9 +236,9 @@ TEST(Checkpoint, RestartTimeEveryTimeWritesCheckpoints) {
   write_case(dir, "verlet", false, R"(, "restart_every_time": 1.5e-6)");
   ASSERT_EQ(run(dir / "case.json"), pd::kOk);
   const pd::Checkpoint ck = pd::read_checkpoint(dir / "out" / "checkpoint.bin");
-  EXPECT_GE(ck.time, 3e-6);  // the last: the first step at or after 2 × 1.5e-6
-  EXPECT_LT(ck.time, 3e-6 + 2 * ck.dt);
-  EXPECT_EQ(ck.next_restart_index, 3);
+  EXPECT_GE(ck.loop.t, 3e-6);  // the last: the first step at or after 2 × 1.5e-6
+  EXPECT_LT(ck.loop.t, 3e-6 + 2 * ck.loop.dt);
+  EXPECT_EQ(ck.loop.next_restart_index, 3);
   fs::remove_all(dir);
 }
 

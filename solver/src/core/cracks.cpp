@@ -34,7 +34,7 @@ std::int64_t cut_crossing_bonds(const std::vector<CrackSegment>& cracks, const V
       const double q[2] = {x[0][j], x[1][j]};
       for (const auto& crack : cracks) {
         const double a[2] = {crack.from[0], crack.from[1]}, b[2] = {crack.to[0], crack.to[1]};
-        // Both copies of a bond must break together (forces/pmb.hpp relies on it, and so does
+        // Both copies of a bond must break together (materials/pmb/pmb.hpp relies on it, and so does
         // momentum). The test is symmetric in p, q in exact arithmetic only: orientation(p, q, a)
         // and orientation(q, p, a) round differently, so a crack end nearly in line with a bond
         // could split the copies. Test every bond with its lower-index end first.

@@ -203,4 +203,21 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
   }
 }
 
+// ---- What the run asks (integrator.hpp): its run.log line
+std::vector<std::string> AdaptiveStep::describe(double dt_exact) const {
+  const auto text = [](const char* fmt, double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, fmt, value);
+    return std::string(buffer);
+  };
+  return {"adaptive (thesis §2.2): TOL " + text("%g", settings_.tol) + ", Kd " + std::to_string(settings_.kd) +
+          ", p " + text("%g", settings_.p) + ", phi " + text("%g", settings_.phi) + ", dt_min " + text("%.6g", dt_min_) +
+          " s, dt_max " + text("%.6g", dt_max_) + " s" +
+          (settings_.dt_max ? std::string()
+           : dt_exact > 0.0
+               ? std::string(" (default: eq. 2.5 or 0.9 × the contraction limit, from the exact limit above)")
+               : " (default: eq. 2.5 or 0.9 × the contraction limit, eigenvalue estimate " + text("%.3f", limit_seconds_) +
+                     " s)")};
+}
+
 }  // namespace pd

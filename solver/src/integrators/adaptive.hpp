@@ -64,6 +64,11 @@ class AdaptiveStep : public Integrator {
   // Wall time of the eigenvalue estimate behind the default dt_max [s]; 0 when dt_max was given.
   double limit_seconds() const { return limit_seconds_; }
 
+  // ---- What the run asks (integrator.hpp); the run.log line in adaptive.cpp's last block
+  std::vector<std::string> describe(double dt_exact) const override;
+  bool controls_step() const override { return true; }
+  std::optional<double> initial_dt() const override { return settings_.dt_initial; }
+
  private:
   // One iterate: v_new, u_new from (u^n, v^n, f^n) in state and the implicit force f_imp at t1.
   void update(const State& state, const Vec3Array& f_imp, double t, double t1, double dt);

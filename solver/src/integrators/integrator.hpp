@@ -5,6 +5,7 @@
 #pragma once
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,7 +21,7 @@ struct StepReport {
   int iterations = 1;         // fixed-point iterations K of the accepted step (1 for Verlet)
   int rejected = 0;           // rejected attempts before acceptance (0 for Verlet)
   std::int64_t broken_now = 0;  // bonds broken during the step, each counted once
-  double broken_energy_now = 0.0;  // energy those bonds held when they broke [J] (forces/pmb.hpp)
+  double broken_energy_now = 0.0;  // energy those bonds held when they broke [J] (materials/pmb/pmb.hpp)
   int force_evaluations = 1;  // force evaluations of the step, rejected attempts included
   double next_dt = 0.0;       // the step the integrator proposes next [s]; 0: no proposal (fixed dt)
 };
@@ -58,6 +59,19 @@ class Integrator {
   }
   // Throws std::runtime_error if the bytes are not what save_state() of this integrator writes.
   virtual void load_state(const std::vector<char>& bytes) { load_report(bytes, 0); }
+
+  // ---- What the run (run/) asks of an integrator, so that it never tests a name or a type.
+  // Lines for run.log about the integrator's own settings, after the dt line; dt_exact: what the
+  // caller passed to configure() (0: it had not computed the exact limit). Verlet has none.
+  virtual std::vector<std::string> describe(double /*dt_exact*/) const { return {}; }
+  // An explicit step of the given dt, stable only below the limit: a step above it explains a
+  // blow-up, and an indenter's growing stiffness 2K·h is watched (run/watches.hpp).
+  virtual bool explicit_step() const { return false; }
+  // A controller chooses the step: time.dt gives only the first one.
+  virtual bool controls_step() const { return false; }
+  // The first step from the integrator's own settings (adaptive.dt_initial), once configured.
+  virtual std::optional<double> initial_dt() const { return std::nullopt; }
+  // ---- end of what the run asks
 
  protected:
   static constexpr std::size_t kReportBytes = 3 * sizeof(int) + sizeof(std::int64_t) + 2 * sizeof(double);

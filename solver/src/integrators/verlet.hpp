@@ -12,6 +12,9 @@ class VelocityVerlet : public Integrator {
   // Takes exactly the dt it is given.
   void step(State& state, double& t, double& dt) override;
 
+  // ---- What the run asks (integrator.hpp)
+  bool explicit_step() const override { return true; }
+
  private:
   ForceOperator& op_;
 };

@@ -93,10 +93,11 @@ void fields(IO& io, Checkpoint& c) {
   std::vector<char> name(c.integrator.begin(), c.integrator.end());
   io.array(name);
   c.integrator.assign(name.begin(), name.end());
-  io.scalar(c.step), io.scalar(c.time), io.scalar(c.dt), io.scalar(c.dt_taken);
-  io.scalar(c.last_frame_step), io.scalar(c.next_frame_index), io.scalar(c.next_restart_index);
-  io.scalar(c.broken), io.scalar(c.force_evaluations), io.scalar(c.broken_energy), io.scalar(c.wall_time);
-  io.scalar(c.energy_before), io.scalar(c.energy_streak_start), io.scalar(c.growth_streak);
+  LoopState& l = c.loop;
+  io.scalar(l.step), io.scalar(l.t), io.scalar(l.dt), io.scalar(l.dt_taken);
+  io.scalar(l.last_frame_step), io.scalar(l.next_frame_index), io.scalar(l.next_restart_index);
+  io.scalar(l.broken), io.scalar(l.force_evaluations), io.scalar(l.broken_energy), io.scalar(l.wall_time);
+  io.scalar(l.growth.energy_before), io.scalar(l.growth.streak_start), io.scalar(l.growth.streak);
   io.array(c.integrator_state);
   State& s = c.state;
   io.vec3(s.u), io.vec3(s.v), io.vec3(s.f), io.array(s.w);

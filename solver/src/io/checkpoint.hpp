@@ -14,6 +14,7 @@
 
 #include "core/nodes.hpp"
 #include "core/state.hpp"
+#include "run/loop_state.hpp"
 
 namespace pd {
 
@@ -26,17 +27,8 @@ struct Checkpoint {
   std::uint64_t nodes = 0, directed_bonds = 0;
   std::string integrator;
 
-  // The time loop (run.cpp).
-  std::int64_t step = 0;
-  double time = 0.0;
-  double dt = 0.0;        // the step the loop will try next (Verlet's dt, or the adaptive proposal)
-  double dt_taken = 0.0;  // the last step taken
-  std::int64_t last_frame_step = -1, next_frame_index = 1, next_restart_index = 1;
-  std::int64_t broken = 0, force_evaluations = 0;
-  double broken_energy = 0.0;
-  double wall_time = 0.0;  // seconds of time loop before this checkpoint (history.csv's wall_time goes on)
-  double energy_before = -1.0, energy_streak_start = 0.0;  // the blow-up watch
-  std::int64_t growth_streak = 0;
+  // The time loop (run/loop.cpp), whole; in the file in the order of its fields.
+  LoopState loop;
   std::vector<char> integrator_state;  // Integrator::save_state()
 
   State state;

@@ -1,0 +1,56 @@
+// The extra columns of history.csv, header and values together (run/history_columns.hpp).
+#include "run/history_columns.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/reactions.hpp"
+
+namespace pd {
+
+void HistoryColumns::add(std::vector<std::string> names, Fill fill) {
+  groups_.emplace_back(names.size(), std::move(fill));
+  names_.insert(names_.end(), names.begin(), names.end());
+}
+
+HistoryColumns::HistoryColumns(const Model& model, const Case& c) {
+  const Model* m = &model;
+  if (model.contact.pairs || !model.indenters.empty())
+    add({"contact_energy"}, [](const HistoryInputs& in, std::vector<double>& out) { out.push_back(in.state.contact_energy); });
+  if (model.contact.pairs)
+    add({"contact_rebuilds"}, [m](const HistoryInputs&, std::vector<double>& out) {
+      out.push_back(static_cast<double>(m->contact_list.rebuilds()));
+    });
+  for (std::size_t k = 0; k < model.indenters.size(); ++k) {
+    std::vector<std::string> names;
+    for (const char* axis : {"fx", "fy", "fz"}) names.push_back("indenter_" + model.indenters[k].name + "_" + axis);
+    add(names, [k](const HistoryInputs& in, std::vector<double>& out) {
+      for (std::size_t d = 0; d < 3; ++d)  // the reaction on the indenter: minus its force on the body
+        out.push_back(k < in.state.indenter_force.size() ? -in.state.indenter_force[k][d] : 0.0);
+    });
+  }
+  // Energy of broken bonds (validation.md C4 with breaking): when some block pair can break.
+  const bool breakable = model.material.can_break();
+  if (breakable)
+    add({"broken_bond_energy"}, [](const HistoryInputs& in, std::vector<double>& out) { out.push_back(in.broken_energy); });
+  for (const auto& set : c.output.reactions) {
+    std::vector<std::string> names;
+    for (const char* axis : {"fx", "fy", "fz"}) names.push_back("reaction_" + set + "_" + axis);
+    add(names, [m, set](const HistoryInputs& in, std::vector<double>& out) {
+      for (double component : reaction_force(*m, in.state, set, in.t)) out.push_back(component);
+    });
+  }
+}
+
+void HistoryColumns::fill(HistoryRow& row, const HistoryInputs& in) const {
+  for (const auto& [count, fill] : groups_) {
+    const std::size_t before = row.extra.size();
+    fill(in, row.extra);
+    if (row.extra.size() != before + count)  // a group that fills other than it names: a bug here
+      throw Error("history.csv: a column group gave " + std::to_string(row.extra.size() - before) + " values for " +
+                  std::to_string(count) + " columns");
+  }
+}
+
+}  // namespace pd

@@ -1,0 +1,42 @@
+// The scene's own columns of history.csv (formats.md §4), after wall_time: each column group is
+// declared once with its names and the values it puts in a row, so header and rows cannot drift.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/case.hpp"
+#include "core/model.hpp"
+#include "core/state.hpp"
+#include "io/output.hpp"
+
+namespace pd {
+
+// What a row's extra values are computed from.
+struct HistoryInputs {
+  const State& state;
+  double t;              // [s]
+  double broken_energy;  // Σ energy of bonds at the moment they broke [J]
+};
+
+class HistoryColumns {
+ public:
+  // Contact energy with contact or indenters; Verlet-list builds with contact; each indenter's
+  // reaction; the broken-bond energy when some block pair can break; each output.reactions set.
+  HistoryColumns(const Model& model, const Case& c);
+  HistoryColumns(const HistoryColumns&) = delete;
+  HistoryColumns& operator=(const HistoryColumns&) = delete;
+
+  // The names after wall_time, in order (OutputWriter writes them into the header).
+  const std::vector<std::string>& names() const { return names_; }
+  // Appends the row's values to row.extra, one per name.
+  void fill(HistoryRow& row, const HistoryInputs& in) const;
+
+ private:
+  using Fill = std::function<void(const HistoryInputs&, std::vector<double>&)>;
+  void add(std::vector<std::string> names, Fill fill);
+  std::vector<std::string> names_;
+  std::vector<std::pair<std::size_t, Fill>> groups_;  // (its column count, what fills them)
+};
+
+}  // namespace pd

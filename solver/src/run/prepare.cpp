@@ -1,0 +1,158 @@
+// The prepare phase of a run: case, nodes, model, time step, integrator, run.log header (run/prepare.hpp).
+#include "run/prepare.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/stability.hpp"
+#include "core/work_plan.hpp"
+#include "forces/indenter.hpp"
+#include "io/case_reader.hpp"
+#include "io/node_file.hpp"
+#include "run/schedule.hpp"
+#include "run/text.hpp"
+
+namespace pd {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A material whose constants come out unusable (overflow of c for extreme E, δ or thickness).
+void check_materials(const Prepared& p) {
+  for (std::size_t b = 0; b < p.model.material.block.size(); ++b) {
+    const auto& k = p.model.material.block[b];
+    if (!std::isfinite(k.micromodulus) || !(k.micromodulus > 0.0) || !(k.critical_stretch > 0.0))
+      throw Error(p.c.file.string() + ": blocks[" + std::to_string(b) + "] '" + p.c.blocks[b].name +
+                  "': the material gives micromodulus c = " + format("%.6g", k.micromodulus) +
+                  " and critical stretch s0 = " + format("%.6g", k.critical_stretch) +
+                  " (need finite c > 0 and s0 > 0): check density, youngs_modulus, fracture_energy, horizon and thickness");
+  }
+}
+
+// The time-step policy: time.dt "stable" is eq. 2.5 × safety_factor, "exact" the linear limit
+// 2/ω_max × safety_factor, a number is used as given.
+void choose_dt(Prepared& p) {
+  const Case& c = p.c;
+  p.dt_stable = stable_time_step(p.model);
+  if (c.time.dt_rule == "stable") {
+    if (!std::isfinite(p.dt_stable))
+      throw Error(c.file.string() + ": time.dt: \"stable\" needs bonds, but no node has a partner within the horizon " +
+                  format("%.6g", c.horizon) + " m");
+    p.dt = p.dt_stable * c.time.safety_factor;
+  } else if (c.time.dt_rule == "exact") {
+    // The largest eigenvalue of the linearised operator (core/stability): the true linear limit.
+    if (!std::isfinite(p.exact_limit()))
+      throw Error(c.file.string() + ": time.dt: \"exact\" needs bonds, but no node has a partner within the horizon " +
+                  format("%.6g", c.horizon) + " m");
+    p.dt = p.dt_exact * c.time.safety_factor;
+  } else {
+    p.dt = c.time.dt_value;
+  }
+}
+
+// Nodes without a bond move freely: only loads and contact act on them (preprocess warns too, but
+// the solver may be run alone). The count and the first one, −1 if none.
+std::pair<std::int64_t, std::int64_t> isolated_nodes(const Model& model) {
+  std::int64_t isolated = 0, first = -1;
+  for (std::size_t i = 0; i < model.nodes.size(); ++i)
+    if (model.bonds.offsets[i + 1] == model.bonds.offsets[i] && isolated++ == 0) first = static_cast<std::int64_t>(i);
+  return {isolated, first};
+}
+
+}  // namespace
+
+double Prepared::exact_limit() {
+  if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
+  return dt_exact;
+}
+
+std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
+  auto p = std::make_unique<Prepared>();
+  Case& c = p->c;
+  c = read_case(opt.case_file);
+  if (opt.end_time) c.time.end = *opt.end_time;
+  if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  p->threads = omp_get_max_threads();
+  Nodes nodes = read_node_file(c.nodes_file);
+  for (const auto& name : c.node_sets)
+    if (!nodes.find_set(name))
+      throw Error(c.file.string() + ": node_sets: '" + name + "' has no array 'set_" + name + "' in " +
+                  c.nodes_file.string());
+  const auto build_start = Clock::now();
+  p->model = build_model(c, std::move(nodes));
+  p->build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
+  check_materials(*p);
+
+  choose_dt(*p);
+  p->max_steps = c.time.max_steps;
+  if (opt.max_steps) p->max_steps = std::min(p->max_steps, *opt.max_steps);
+  p->op = std::make_unique<ForceOperator>(p->model);
+  p->integrator = integrator_registry().get(c.time.integrator)(*p->op);
+  p->dt_exact_configured = p->dt_exact;
+  p->integrator->configure(c, p->dt_exact);
+  // A step-size controller starts from its own initial step when given, else from the time.dt rule.
+  if (const auto dt_initial = p->integrator->initial_dt()) p->dt = *dt_initial;
+  p->steps_for_end = steps_to_reach(c.time.end, p->dt);
+  p->steps_expected = std::min(p->steps_for_end, p->max_steps);
+
+  // A fixed explicit step has no room for the indenter's stiffness 2K·h, which grows with depth:
+  // the header says how deep it may go, and the loop warns once if a node gets deeper
+  // (forces/indenter.hpp). A step above eq. 2.5 (dt: exact, or a fixed dt) is judged against the
+  // exact limit, computed here for a fixed dt.
+  p->indenter_watch = !p->model.indenters.empty() && p->integrator->explicit_step();
+  if (p->indenter_watch && p->dt > p->dt_stable) {
+    const double dt_exact = p->exact_limit();
+    if (dt_exact > 0.0 && std::isfinite(dt_exact)) p->omega2_exact = 4.0 / (dt_exact * dt_exact);
+  }
+  return p;
+}
+
+void log_title(RunLog& log, const RunOptions& opt, const Prepared& p) {
+  log.line("pdsolve " PD_VERSION ": case " + (p.c.name.empty() ? opt.case_file.string() : p.c.name) + " (" +
+           opt.case_file.string() + ")");
+}
+
+void log_setup(RunLog& log, const Prepared& p) {
+  const Case& c = p.c;
+  const Model& model = p.model;
+  const std::size_t n = model.nodes.size();
+  log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(model.bonds.directed() / 2) + " (" +
+           format("%.1f", static_cast<double>(model.bonds.directed()) / static_cast<double>(n)) +
+           " per node), built in " + format("%.3f", p.build_seconds) + " s");
+  log.line("analysis " + c.analysis + ", horizon " + format("%.6g", c.horizon) + " m = " +
+           format("%.4g", c.horizon / c.grid_spacing) + " dx");
+  for (std::size_t b = 0; b < model.material.block.size(); ++b)
+    log.line("block " + std::to_string(b + 1) + " '" + c.blocks[b].name + "': c " +
+             format("%.6g", model.material.block[b].micromodulus) + ", s0 " +
+             (std::isinf(model.material.block[b].critical_stretch) ? std::string("none (unbreakable)")
+                                                                   : format("%.6g", model.material.block[b].critical_stretch)));
+  log.line("dt " + format("%.6g", p.dt) + " s (" +
+           (c.time.dt_rule == "stable" ? "stable " + format("%.6g", p.dt_stable) + " s × safety factor " + format("%g", c.time.safety_factor)
+            : c.time.dt_rule == "exact" ? "exact limit " + format("%.6g", p.dt_exact) + " s = " + format("%.4g", p.dt_exact / p.dt_stable) +
+                                              " × eq. 2.5, × safety factor " + format("%g", c.time.safety_factor)
+                                        : "fixed; stable " + format("%.6g", p.dt_stable) + " s") +
+           (p.integrator->controls_step() ? ", the initial step" : "") +
+           "), integrator " + p.integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
+  if (const auto [isolated, first] = isolated_nodes(model); isolated > 0)
+    log.line("warning: " + std::to_string(isolated) + " of " + std::to_string(n) +
+             " nodes have no bond within the horizon (isolated: only loads and contact act on them); the first is " +
+             node_text(model, first));
+  if (c.time.dt_rule == "fixed" && p.dt > p.dt_stable)
+    log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
+  for (const auto& text : work_summary(*p.op, c)) log.line(text);
+  if (p.indenter_watch)
+    for (const auto& ind : model.indenters)
+      log.line("indenter '" + ind.name + "': dt stays stable while no node is deeper than " +
+               format("%.4g", indenter_stable_depth(model, ind, p.dt, p.omega2_exact)) + " m (its stiffness 2K·h with " +
+               (p.omega2_exact > 0.0 ? "the exact limit" : "eq. 2.5") + "; a bound, the step may hold deeper)");
+  for (const auto& text : p.integrator->describe(p.dt_exact_configured)) log.line(text);
+  log.line("end time " + format("%.6g", c.time.end) + " s, steps expected " + std::to_string(p.steps_expected) +
+           (p.steps_for_end > p.max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(p.threads));
+}
+
+}  // namespace pd

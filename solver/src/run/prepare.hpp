@@ -1,0 +1,56 @@
+// Phase 1 of a run: read the case and the node file, build the model, choose the time step,
+// construct the integrator; and the run.log lines that say what was prepared. Every input error is
+// thrown here or in the start phase, before any output file exists.
+#pragma once
+#include <cstdint>
+#include <memory>
+
+#include "core/case.hpp"
+#include "core/model.hpp"
+#include "integrators/integrator.hpp"
+#include "io/output.hpp"
+#include "run.hpp"
+
+namespace pd {
+
+struct Prepared {
+  Case c;
+  int threads = 0;  // OpenMP's, after --threads
+  Model model;
+  double build_seconds = 0.0;  // wall time of build_model
+
+  // The time step (time.dt stable | exact | fixed, × safety_factor; adaptive.dt_initial first).
+  double dt = 0.0;         // the first step [s]
+  double dt_stable = 0.0;  // thesis eq. 2.5, without safety factor [s]
+  double dt_exact = 0.0;   // 2/ω_max (core/stability) once computed, else 0 [s]; see exact_limit()
+  double dt_exact_configured = 0.0;  // what the integrator's configure() was given
+  std::int64_t max_steps = 0, steps_for_end = 0, steps_expected = 0;
+
+  // The operator holds a reference to `model`, the integrator one to the operator: a Prepared never
+  // moves (prepare() returns it by pointer).
+  std::unique_ptr<ForceOperator> op;
+  std::unique_ptr<Integrator> integrator;
+
+  // The indenter-depth watch (run/watches.hpp): for an explicit step with indenters; ω_max² of the
+  // body from the exact limit when the step is above eq. 2.5, else 0 (eq. 2.5 alone).
+  bool indenter_watch = false;
+  double omega2_exact = 0.0;
+
+  // The exact stability limit, computed on first use (Lanczos, about as costly as tens of force
+  // evaluations): for time.dt "exact", an indenter watch above eq. 2.5, or a failed run's message.
+  double exact_limit();
+
+  Prepared() = default;
+  Prepared(const Prepared&) = delete;
+  Prepared& operator=(const Prepared&) = delete;
+};
+
+// Throws pd::Error for bad input (naming the file), before anything is written.
+std::unique_ptr<Prepared> prepare(const RunOptions& options);
+
+// run.log's first line: the version and the case.
+void log_title(RunLog& log, const RunOptions& options, const Prepared& p);
+// The rest of the header: model, materials, time step, warnings, what runs, the integrator, the end.
+void log_setup(RunLog& log, const Prepared& p);
+
+}  // namespace pd

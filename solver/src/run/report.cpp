@@ -1,0 +1,38 @@
+// The closing lines of a run and its exit status (run/report.hpp).
+#include "run/report.hpp"
+
+#include "run/schedule.hpp"
+#include "run/signals.hpp"
+#include "run/text.hpp"
+
+namespace pd {
+
+int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, const LoopEnd& end, const OutputWriter& out,
+           RunLog& log) {
+  const Model& model = p.model;
+  const double wall = end.wall;
+  const double updates = static_cast<double>(model.bonds.directed()) * static_cast<double>(loop.step);
+  log.line(std::string(end.interrupted ? "interrupted" : end.status == kOk ? "done" : "stopped") + ": " +
+           std::to_string(loop.step) + " steps to t = " + format("%.6g", loop.t) + " s in " + format("%.3f", wall) +
+           " s wall (" + format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
+           std::to_string(out.frames_written()) + " frames, " + std::to_string(loop.broken) + " broken bonds, " +
+           std::to_string(loop.force_evaluations) + " force evaluations");
+  log.line("output: frames and history.csv took " + format("%.3f", end.output_seconds) + " s wall, " +
+           format("%.1f", wall > 0 ? 100.0 * end.output_seconds / wall : 0.0) + " % of the time loop");
+  if (model.contact.pairs)
+    log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
+             std::to_string(loop.step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
+             std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
+  if (end.interrupted) {
+    const std::string checkpoint_file = checkpoint_path(p.c).string();
+    log.error("pdsolve: interrupted by " + std::string(signal_name(end.interrupted)) + " after step " +
+              std::to_string(loop.step) + " (t = " + format("%.6g", loop.t) + " s); checkpoint written to " +
+              checkpoint_file + "; continue with: pdsolve " + opt.case_file.string() + " --restart " + checkpoint_file);
+    return kInterruptedBase + end.interrupted;
+  }
+  if (end.status == kOk && loop.step >= p.max_steps && Schedule(p.c.output, p.c.time.end).before_end(loop.t))
+    log.line("note: stopped at max_steps " + std::to_string(p.max_steps) + " before the end time");
+  return end.status;
+}
+
+}  // namespace pd

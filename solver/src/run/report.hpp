@@ -1,0 +1,13 @@
+// Phase 4 of a run: the closing lines of run.log and the exit status.
+#pragma once
+#include "io/output.hpp"
+#include "run.hpp"
+#include "run/loop.hpp"
+
+namespace pd {
+
+// kOk, kRunFailed, or 128 + the signal that interrupted the run.
+int report(const RunOptions& options, const Prepared& p, const LoopState& loop, const LoopEnd& end,
+           const OutputWriter& out, RunLog& log);
+
+}  // namespace pd

@@ -1,0 +1,118 @@
+// The start phase of a run: fresh start or restore, and the checkpoint that restore reads back (run/start.hpp).
+#include "run/start.hpp"
+
+#include "core/conditions.hpp"
+#include "run/measures.hpp"
+#include "run/text.hpp"
+
+namespace pd {
+
+namespace {
+
+// Every refusal of a checkpoint says how to start over instead (the Makefile resumes whenever
+// checkpoint.bin is newer than the case, so a refused one would otherwise block every `make`).
+Error start_over(const RunOptions& opt, const std::exception& e) {
+  return Error(std::string(e.what()) + "; to start the run over instead, delete " + opt.restart.string());
+}
+
+// Replaces the fresh state by the checkpoint's, after checking that it belongs to this case.
+void restore(const RunOptions& opt, Prepared& p, Start& s) {
+  Model& model = p.model;
+  Integrator& integrator = *p.integrator;
+  const std::size_t n = model.nodes.size();
+  Checkpoint ck = read_checkpoint(opt.restart);
+  const std::string where = opt.restart.string() + ": ";
+  if (ck.case_hash != s.case_hash)
+    throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
+                " changed since it was written); restart with the case.json it was written for");
+  if (ck.nodes_hash != s.nodes_hash)
+    throw Error(where + "the checkpoint belongs to another node file (or " + p.c.nodes_file.string() +
+                " changed since it was written)");
+  if (ck.nodes != n || ck.directed_bonds != model.bonds.directed() || ck.broken_flags.size() != model.bonds.directed() ||
+      ck.integrator != integrator.name() ||
+      (model.contact.pairs && ck.contact_rebuilds > 0 && ck.contact_u_build[0].size() != n))
+    throw Error(where + "the checkpoint does not fit this model (" + std::to_string(ck.nodes) + " nodes, " +
+                std::to_string(ck.directed_bonds / 2) + " bonds, integrator " + ck.integrator + "; here " +
+                std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator.name() + ")");
+  if (ck.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
+  // initialize() sizes the integrator's scratch; then everything it set is replaced by the
+  // checkpoint, so the run continues bitwise as if it had never stopped.
+  integrator.initialize(s.state, ck.loop.t);
+  s.state = std::move(ck.state);  // moved: a restarted run holds one copy of the state
+  model.bonds.broken = std::move(ck.broken_flags);
+  if (model.contact.pairs)
+    model.contact_list.restore(model.nodes.x, ck.contact_u_build, model.block_index, model.contact, ck.contact_rebuilds,
+                               ck.contact_seconds);
+  try {
+    integrator.load_state(ck.integrator_state);
+  } catch (const std::exception& e) {
+    throw Error(where + e.what());
+  }
+  s.loop = ck.loop;
+  s.resume = OutputResume{std::move(ck.frame_times), ck.history_bytes};
+}
+
+}  // namespace
+
+Start start_or_restore(const RunOptions& opt, Prepared& p) {
+  Start s;
+  s.state = State(p.model.nodes.size());
+  s.restarting = !opt.restart.empty();
+  s.case_hash = file_hash(opt.case_file);
+  s.nodes_hash = file_hash(p.c.nodes_file);
+  if (s.restarting) {
+    try {
+      restore(opt, p, s);
+    } catch (const Error& e) {
+      throw start_over(opt, e);
+    }
+  } else {
+    apply_initial_conditions(p.c, p.model.nodes, s.state.u, s.state.v);
+    p.integrator->initialize(s.state, 0.0);
+    s.loop.dt = p.dt;
+    s.loop.broken = broken_bond_count(p.model);
+  }
+  if (first_non_finite(s.state) >= 0)
+    throw Error((s.restarting ? opt.restart.string() + ": the checkpoint's state" : p.c.file.string() + ": the initial state") +
+                " is not finite");
+  return s;
+}
+
+std::filesystem::path checkpoint_path(const Case& c) { return (c.output_dir / "checkpoint.bin").lexically_normal(); }
+
+OutputWriter open_output(const RunOptions& opt, const Prepared& p, const Start& s, const HistoryColumns& columns) {
+  if (!s.restarting) return OutputWriter(p.c.output_dir, columns.names());
+  try {
+    return OutputWriter(p.c.output_dir, columns.names(), &s.resume);
+  } catch (const Error& e) {  // history.csv shorter than recorded, a frame missing
+    throw start_over(opt, e);
+  }
+}
+
+std::string restart_line(const RunOptions& opt, const Start& s) {
+  return "restart from " + opt.restart.string() + ": step " + std::to_string(s.loop.step) + ", t = " +
+         format("%.6g", s.loop.t) + " s, " + std::to_string(s.resume.frame_times.size()) +
+         " frames kept (frames after it, history.csv rows after it: dropped)";
+}
+
+Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loop, const OutputWriter& out) {
+  const Model& model = p.model;
+  Checkpoint k;
+  k.case_hash = s.case_hash;
+  k.nodes_hash = s.nodes_hash;
+  k.nodes = model.nodes.size();
+  k.directed_bonds = model.bonds.directed();
+  k.integrator = p.integrator->name();
+  k.loop = loop;
+  k.integrator_state = p.integrator->save_state();
+  k.state = s.state;
+  k.broken_flags = model.bonds.broken;
+  k.contact_rebuilds = model.contact_list.rebuilds();
+  k.contact_seconds = model.contact_list.seconds();
+  k.contact_u_build = model.contact_list.u_build();
+  k.frame_times = out.frame_times();
+  k.history_bytes = out.history_bytes();
+  return k;
+}
+
+}  // namespace pd

@@ -1,0 +1,45 @@
+// Phase 2 of a run: a fresh start at t = 0 (initial conditions), or a restore from checkpoint.bin
+// with every check that it belongs to this case; and its mirror, the checkpoint of a running loop.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/state.hpp"
+#include "io/checkpoint.hpp"
+#include "io/output.hpp"
+#include "run.hpp"
+#include "run/history_columns.hpp"
+#include "run/loop_state.hpp"
+#include "run/prepare.hpp"
+
+namespace pd {
+
+struct Start {
+  bool restarting = false;
+  State state;
+  LoopState loop;
+  OutputResume resume;  // a restart: the frames kept and history.csv's length
+  std::uint64_t case_hash = 0, nodes_hash = 0;  // what a checkpoint written by this run belongs to
+};
+
+// Throws pd::Error for a checkpoint that does not fit (saying how to start over instead) or an
+// initial state that is not finite; writes nothing.
+Start start_or_restore(const RunOptions& options, Prepared& p);
+
+// output_dir/checkpoint.bin.
+std::filesystem::path checkpoint_path(const Case& c);
+
+// The output writer: a fresh one, or on a restart one that keeps the frames and history rows up to
+// the checkpoint (a refusal says how to start over).
+OutputWriter open_output(const RunOptions& options, const Prepared& p, const Start& s, const HistoryColumns& columns);
+
+// run.log's line after the title on a restart.
+std::string restart_line(const RunOptions& options, const Start& s);
+
+// Everything the loop carries from step to step, for checkpoint.bin. loop.wall_time: the time
+// loop's seconds up to now.
+Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loop, const OutputWriter& out);
+
+}  // namespace pd

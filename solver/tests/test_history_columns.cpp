@@ -1,0 +1,59 @@
+// The scene's own history.csv columns (run/history_columns.hpp): names and values come in the
+// same order and number, for each combination of contact, indenters and breaking.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "run/history_columns.hpp"
+
+namespace {
+
+pd::Model scene(bool contact, int indenters, bool breakable) {
+  pd::Model m;
+  m.contact.pairs = contact;
+  for (int k = 0; k < indenters; ++k) {
+    pd::IndenterSettings ind;
+    ind.name = "i" + std::to_string(k);
+    m.indenters.push_back(ind);
+  }
+  m.material.critical_pair = {breakable ? 0.01 : HUGE_VAL};
+  return m;
+}
+
+}  // namespace
+
+TEST(HistoryColumns, APlainBodyHasNoExtraColumns) {
+  const pd::Model m = scene(false, 0, false);
+  const pd::HistoryColumns columns(m, pd::Case{});
+  EXPECT_TRUE(columns.names().empty());
+  pd::HistoryRow row;
+  const pd::State state(0);
+  columns.fill(row, pd::HistoryInputs{state, 0.0, 1.0});
+  EXPECT_TRUE(row.extra.empty());
+}
+
+TEST(HistoryColumns, IndentersAndBreakingGiveTheirColumnsInOrderWithTheirValues) {
+  const pd::Model m = scene(false, 2, true);
+  const pd::HistoryColumns columns(m, pd::Case{});
+  EXPECT_EQ(columns.names(), (std::vector<std::string>{"contact_energy", "indenter_i0_fx", "indenter_i0_fy", "indenter_i0_fz",
+                                                       "indenter_i1_fx", "indenter_i1_fy", "indenter_i1_fz",
+                                                       "broken_bond_energy"}));
+  pd::State state(0);
+  state.contact_energy = 2.0;
+  state.indenter_force = {{1.0, 2.0, 3.0}};  // the second indenter's force not yet computed: 0
+  pd::HistoryRow row;
+  columns.fill(row, pd::HistoryInputs{state, 0.0, 5.0});
+  EXPECT_EQ(row.extra, (std::vector<double>{2.0, -1.0, -2.0, -3.0, 0.0, 0.0, 0.0, 5.0}));  // reactions: minus the force
+  EXPECT_EQ(row.extra.size(), columns.names().size());
+}
+
+TEST(HistoryColumns, ContactAddsItsEnergyAndTheListBuilds) {
+  const pd::Model m = scene(true, 0, false);
+  const pd::HistoryColumns columns(m, pd::Case{});
+  EXPECT_EQ(columns.names(), (std::vector<std::string>{"contact_energy", "contact_rebuilds"}));
+  pd::State state(0);
+  state.contact_energy = 0.25;
+  pd::HistoryRow row;
+  columns.fill(row, pd::HistoryInputs{state, 0.0, 0.0});
+  EXPECT_EQ(row.extra, (std::vector<double>{0.25, 0.0}));
+}
