@@ -15,7 +15,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from .atomic import atomic_path
+from pipeline.atomic import atomic_path
 from .errors import PostprocessError
 from .series import Frame
 
