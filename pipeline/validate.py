@@ -60,6 +60,12 @@ class _Checker:
         if key.minimum is not None and value < key.minimum:
             self.error(keypath, f"must be at least {key.minimum:g}{self.unit(key)}, got {value:g}")
             return None
+        if key.below is not None and not value < key.below:
+            self.error(keypath, f"must be less than {key.below:g}{self.unit(key)}, got {value:g}")
+            return None
+        if key.maximum is not None and value > key.maximum:
+            self.error(keypath, f"must be at most {key.maximum:g}{self.unit(key)}, got {value:g}")
+            return None
         return value
 
     @staticmethod
