@@ -137,7 +137,7 @@ $(BENCH_DEPS): pipeline/install-deps.sh
 	sh pipeline/install-deps.sh lammps openmpi-bin
 	@mkdir -p $(@D) && touch $@
 bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
-	$(PY) solver/bench/speed.py --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
+	$(PY) -m bench.speed --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
 
 # Error against run time and force evaluations (issue 3): Verlet at several safety factors and at the
 # exact limit, the adaptive step over a sweep of TOL, on a wave and on a fracture problem, against a

@@ -15,26 +15,12 @@ import difflib
 import json
 import os
 import sys
-import tempfile
 import warnings
 
+from .atomic import write_atomically
 from .case import CaseError, load_case
 from .resolve import resolve
 from .stability import check_discretized_case
-
-
-def write_atomically(path: str, text: str):
-    directory = os.path.dirname(os.path.abspath(path))
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".tmp-", suffix=os.path.basename(path))
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def cmd_check(args):

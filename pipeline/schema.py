@@ -28,6 +28,8 @@ class Key:
     choices: tuple = ()
     minimum: float | None = None          # inclusive
     above: float | None = None            # exclusive lower bound
+    maximum: float | None = None          # inclusive
+    below: float | None = None            # exclusive upper bound
     fields: dict[str, "Key"] = field(default_factory=dict)
     table: bool = True                    # components: allow a time table
 
@@ -173,14 +175,14 @@ CASE = {
         "the adaptive step of thesis §2.2 (time.integrator: adaptive): fixed-point iterations with "
         "error ω_K (eq. 2.6) and step factor Φ_K (eq. 2.8)",
         tol=Key("number", "TOL of eq. 2.7: a step is accepted once the last correction is this fraction "
-                "of the step's motion", default=1e-3, above=0.0),
+                "of the step's motion", default=1e-3, above=0.0, below=1.0),
         kd=Key("integer", "K_d: the iterations the step size is aimed at; a step not converged after "
-               "K_d iterations is redone with a smaller Δt", default=20, minimum=1),
+               "K_d iterations is redone with a smaller Δt", default=20, minimum=1, maximum=1000),
         p=Key("number", "exponent p of eq. 2.8 (the correction shrinks like Δt^p per iteration; "
               "2 for the linear problem, thesis 3)", default=3.0, above=0.0),
         phi=Key("number", "φ: weight of the end-of-step force and velocity; 1 the thesis form "
                 "(first order, dissipative), 0.5 the trapezoidal rule (second order)", default=1.0,
-                minimum=0.5),
+                minimum=0.5, maximum=1.0),
         dt_initial=Key("number", "the first step (default: from time.dt)", default=None, unit="s",
                        above=0.0),
         dt_min=Key("number", "smallest step; not converging there stops the run (default: 1e-6 × "

@@ -3,7 +3,8 @@
 Hand-edited case files mix units (g/cm³ for kg/m³, MPa or GPa for Pa, mm for m). Each mistake
 moves the stable time step of thesis eq. 2.5 by orders of magnitude, so the run either never
 ends (10¹² steps) or is over in a single step. Computing that step here, from the node cloud and
-the materials exactly as the solver will, turns such a mistake into an error before any work,
+the materials as the solver will (partial volumes and contact springs included; tested equal to
+`pdsolve --stable-dt`), turns such a mistake into an error before any work,
 naming the file, the line and the key. Messages that could be false alarms are warnings.
 """
 from __future__ import annotations
@@ -27,6 +28,11 @@ BOND_SLACK = 1.0 + 1e-12
 # since foams and gels are real.
 LOW_DENSITY = 50.0
 LOW_MODULUS = 1.0e5
+# partial_volume rule → (family extension beyond δ in units of dx, shell weight ν on the outer
+# shell), as solver/src/core/partial_volume.cpp registers them (validation.md F3).
+PARTIAL_VOLUME = {"none": (0.0, False), "lammps": (0.0, True), "hhb": (0.5, True)}
+# Contact distance 2r_s = 1.35·dx (solver/src/core/work_plan.cpp plan_contact; validation.md F4).
+CONTACT_DISTANCE = 1.35
 
 
 def micromodulus(analysis: str, youngs_modulus: float, horizon: float, thickness: float | None) -> float:
@@ -40,21 +46,43 @@ def micromodulus(analysis: str, youngs_modulus: float, horizon: float, thickness
     raise ValueError(f"unknown analysis {analysis!r}")
 
 
+def contact_stiffness_factor(resolved: dict, block: np.ndarray) -> float | None:
+    """c_s/c when the solver will compute contact pairs for this case and cloud, else None
+    (solver/src/core/work_plan.cpp plan_contact: on; or auto with several blocks or self_contact)."""
+    contact = resolved["contact"]
+    on = contact["enabled"] == "on" or (contact["enabled"] == "auto" and
+                                        (len(np.unique(block)) > 1 or contact["self_contact"]))
+    return float(contact["stiffness_factor"]) if on else None
+
+
 def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, density: np.ndarray,
-                     c_pair: np.ndarray, horizon: float, tree: cKDTree | None = None) -> tuple[float, int]:
-    """min over nodes of √(2ρ_i / Σ_j V_j c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the node
-    where it is reached; over an evenly spread subset of SAMPLE nodes for large clouds. block is
-    1-based; density[b-1] and c_pair[a-1, b-1] (the solver's arithmetic mean of the two blocks' c).
-    (inf, -1) when no sampled node has a bond."""
+                     c_pair: np.ndarray, horizon: float, tree: cKDTree | None = None, *,
+                     dx: float | None = None, partial_volume: str = "none", contact: float | None = None,
+                     sample: int | None = SAMPLE) -> tuple[float, int]:
+    """min over nodes of √(2ρ_i / Σ_j V_j ν_ij c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the
+    node where it is reached, as solver/src/core/model.cpp stable_time_step computes it: ν of the
+    `partial_volume` rule (needs the grid spacing dx unless "none"), and with contact (c_s/c given
+    as `contact`, see contact_stiffness_factor) a spring V_j c_s c_ij/δ for every bond with
+    |ξ| ≤ 1.35·dx. Over an evenly spread subset of `sample` nodes for larger clouds (None: all).
+    block is 1-based; density[b-1] and c_pair[a-1, b-1] (the solver's arithmetic mean of the two
+    blocks' c). (inf, -1) when no sampled node has a bond. tests/pipeline/test_stability_solver.py
+    holds it equal to `pdsolve --stable-dt` on every shipped case."""
     n = len(points)
     tree = tree if tree is not None else cKDTree(points)
-    sample = np.arange(n) if n <= SAMPLE else np.unique(np.linspace(0, n - 1, SAMPLE).astype(np.int64))
-    pairs = cKDTree(points[sample]).sparse_distance_matrix(tree, horizon * BOND_SLACK, output_type="coo_matrix")
+    extension, shell = PARTIAL_VOLUME[partial_volume]
+    cutoff = horizon + extension * dx if extension else horizon
+    sample = np.arange(n) if sample is None or n <= sample else np.unique(np.linspace(0, n - 1, sample).astype(np.int64))
+    pairs = cKDTree(points[sample]).sparse_distance_matrix(tree, cutoff * BOND_SLACK, output_type="coo_matrix")
     rows, cols, dist = pairs.row, pairs.col, pairs.data
     keep = dist > 0  # the node itself (coincident nodes are rejected earlier)
     rows, cols, dist = rows[keep], cols[keep], dist[keep]
     i = sample[rows]
-    stiffness = volume[cols] * c_pair[block[i] - 1, block[cols] - 1] / dist
+    c = c_pair[block[i] - 1, block[cols] - 1]
+    # ν = clamp((δ + dx/2 − |ξ|)/dx, 0, 1) on the outer shell (core/bonds.hpp VolumeWeight)
+    nu = np.clip((horizon + 0.5 * dx - dist) * (1.0 / dx), 0.0, 1.0) if shell else 1.0
+    stiffness = volume[cols] * nu * c / dist
+    if contact is not None:
+        stiffness = stiffness + np.where(dist <= CONTACT_DISTANCE * dx, volume[cols] * contact * c / horizon, 0.0)
     total = np.bincount(rows, weights=stiffness, minlength=len(sample))
     bonded = total > 0
     if not np.any(bonded):
@@ -63,6 +91,23 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
     dt[bonded] = np.sqrt(2.0 * density[block[sample[bonded]] - 1] / total[bonded])
     k = int(np.argmin(dt))
     return float(dt[k]), int(sample[k])
+
+
+def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | None = None, *,
+                          sample: int | None = SAMPLE) -> tuple[float, int]:
+    """stable_time_step for a validated case, its case.json dictionary and its node cloud: the
+    step the solver's run.log reports before the safety factor (`pdsolve --stable-dt`)."""
+    names = list(case["materials"])
+    horizon = float(resolved["horizon"])
+    c = np.array([micromodulus(case["analysis"], case["materials"][n]["youngs_modulus"], horizon,
+                               case["thickness"]) for n in names])
+    c_pair = 0.5 * (c[:, None] + c[None, :])
+    density = np.array([case["materials"][n]["density"] for n in names], dtype=np.float64)
+    block = np.asarray(cloud.block, dtype=np.int64)
+    return stable_time_step(np.asarray(cloud.points), np.asarray(cloud.volume), block, density, c_pair,
+                            horizon, tree, dx=float(resolved["grid_spacing"]),
+                            partial_volume=resolved["partial_volume"],
+                            contact=contact_stiffness_factor(resolved, block), sample=sample)
 
 
 def _where(case: dict, *keypath) -> str:
@@ -105,7 +150,7 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
             warnings.append(f"{_where(case, 'materials', name, 'youngs_modulus')}: {m['youngs_modulus']:g} Pa "
                             f"is softer than rubber; was it given in MPa or GPa? (SI: Pa, e.g. 2.1e11 for steel)")
 
-    points, volume = np.asarray(cloud.points), np.asarray(cloud.volume)
+    points = np.asarray(cloud.points)
     block = np.asarray(cloud.block, dtype=np.int64)
     tree = cKDTree(points)
     # Isolated nodes: no partner within the horizon, so no force ever acts on them.
@@ -120,11 +165,7 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
                         f"within the horizon {horizon:.6g} m), e.g. node {first} at {_fmt(points[first])}; "
                         f"no force acts on them: refine the mesh there or enlarge the horizon")
 
-    c = np.array([micromodulus(case["analysis"], case["materials"][n]["youngs_modulus"], horizon,
-                               case["thickness"]) for n in names])
-    c_pair = 0.5 * (c[:, None] + c[None, :])
-    density = np.array([case["materials"][n]["density"] for n in names], dtype=np.float64)
-    dt_stable, node = stable_time_step(points, volume, block, density, c_pair, horizon, tree)
+    dt_stable, node = case_stable_time_step(case, resolved, cloud, tree)
     if node < 0:  # no sampled node has a bond; the isolated-node warning says so
         return warnings
     time = case["time"]

@@ -1,10 +1,12 @@
 """Gmsh views of the results, written by our own code:
 
 - results.msh: MSH 2.2 ASCII. $Nodes (reference positions), $Elements with one 1-node point element
-  (type 15) per node so that Gmsh draws point data, and one $NodeData block per frame for each of
-  the views `displacement` (3 components) and `damage` (1 component), tagged with the frame's time
-  and index, so that Gmsh animates them (Gmsh merges blocks of the same name into the time steps of
-  one view). Tools → Options → View → "Displacement" display of the first view warps the body.
+  (type 15) per node so that Gmsh draws point data, and one $NodeData block per frame for every
+  point array the frame has (displacement, velocity, damage, block, … in the frame's order: a
+  scalar view for 1 component, a vector view for 3, a tensor view for 9, a 2-component array padded
+  with a zero z, any other count one scalar view `name[k]` per component), tagged with the frame's
+  time and index, so that Gmsh animates them (Gmsh merges blocks of the same name into the time
+  steps of one view). Tools → Options → View → "Displacement" display of `displacement` warps the body.
 - damage_final.pos: Gmsh's parsed format, one scalar point SP(x,y,z){φ} per node (and one line
   SL per broken bond in a second view): Gmsh prints these as vector (PDF/SVG/EPS) images.
 Both are written under a temporary name and renamed into place.
@@ -15,7 +17,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from .atomic import atomic_path
+from pipeline.atomic import atomic_path
 from .errors import PostprocessError
 from .series import Frame
 
@@ -46,6 +48,20 @@ def _node_data(stream, name: str, time: float, index: int, values: np.ndarray, p
     stream.write(f'$NodeData\n1\n"{name}"\n1\n{float(time)!r}\n3\n{index}\n{values.shape[1]}\n{len(values)}\n')
     _write_rows(stream, tags, values, precision)
     stream.write("$EndNodeData\n")
+
+
+def gmsh_views(point_data: dict, n: int) -> Iterator[tuple[str, np.ndarray]]:
+    """(view name, (n, 1 | 3 | 9) float64 values) for every point array, in the frame's order."""
+    for name, values in point_data.items():
+        values = np.asarray(values, dtype=np.float64).reshape(n, -1)
+        k = values.shape[1]
+        if k in (1, 3, 9):
+            yield name, values
+        elif k == 2:  # a vector of a 2D frame: Gmsh's vectors have 3 components
+            yield name, np.column_stack([values, np.zeros(n)])
+        else:
+            for c in range(k):
+                yield f"{name}[{c}]", values[:, c:c + 1]
 
 
 def write_results_msh(path: str, frames: Iterable[tuple[int, float, Frame]], *,
@@ -85,8 +101,8 @@ def write_results_msh(path: str, frames: Iterable[tuple[int, float, Frame]], *,
         while True:
             if len(frame.points) != n:
                 raise PostprocessError(f"{frame.path}: {len(frame.points)} points, the first frame has {n}")
-            _node_data(stream, "displacement", time, index, frame.displacement, precision)
-            _node_data(stream, "damage", time, index, frame.damage.reshape(n, 1), precision)
+            for name, values in gmsh_views(frame.point_data, n):
+                _node_data(stream, name, time, index, values, precision)
             count += 1
             try:
                 index, time, frame = next(frames)

@@ -7,7 +7,7 @@ matplotlib.use("Agg")  # before pyplot: never look for a display
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-from .atomic import atomic_path  # noqa: E402
+from pipeline.atomic import atomic_path  # noqa: E402
 
 DPI = 150
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import tempfile
+
+from pipeline.atomic import atomic_path
 
 from .errors import PreprocessError
 
@@ -23,14 +24,10 @@ def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[
     exe = shutil.which(GMSH)
     if exe is None:
         raise PreprocessError(f"{geo_path}: the gmsh command is not installed (Debian package gmsh)")
-    directory = os.path.dirname(os.path.abspath(out_msh_path))
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".tmp-", suffix=".msh")
-    os.close(fd)
-    cmd = [exe, f"-{dimension}", geo_path, "-o", tmp, "-format", "msh4", "-nopopup"]
-    for name, value in parameters.items():
-        cmd += ["-setnumber", str(name), repr(float(value))]
-    try:
+    with atomic_path(out_msh_path) as tmp:
+        cmd = [exe, f"-{dimension}", geo_path, "-o", tmp, "-format", "msh4", "-nopopup"]
+        for name, value in parameters.items():
+            cmd += ["-setnumber", str(name), repr(float(value))]
         result = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True)
         output = (result.stdout + "\n" + result.stderr).splitlines()
         errors = []
@@ -44,7 +41,3 @@ def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[
                                   + "\n  ".join(shown) + more)
         if os.path.getsize(tmp) == 0:
             raise PreprocessError(f"{geo_path}: gmsh wrote an empty mesh")
-        os.replace(tmp, out_msh_path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)

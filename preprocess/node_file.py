@@ -5,12 +5,12 @@ reader, which checks the header, every array's type, size and byte count, and th
 """
 from __future__ import annotations
 
-import os
-import tempfile
 import xml.etree.ElementTree as ET
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+
+from pipeline.atomic import atomic_path
 
 from .cloud import NodeCloud
 from .errors import PreprocessError
@@ -75,20 +75,11 @@ def write_node_file(path: str, cloud: NodeCloud) -> None:
         '  <AppendedData encoding="raw">\n'
         '   _'
     )
-    directory = os.path.dirname(os.path.abspath(path))
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".tmp-", suffix=os.path.basename(path))
-    try:
-        with os.fdopen(fd, "wb") as stream:
-            stream.write(header.encode("ascii"))
-            for blob in blobs:
-                stream.write(blob)
-            stream.write(b"\n  </AppendedData>\n</VTKFile>\n")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp, open(tmp, "wb") as stream:
+        stream.write(header.encode("ascii"))
+        for blob in blobs:
+            stream.write(blob)
+        stream.write(b"\n  </AppendedData>\n</VTKFile>\n")
 
 
 def read_node_file(path: str) -> NodeCloud:

@@ -1,4 +1,4 @@
-// pd_speed: one measurement of `make bench` (solver/bench/speed.py runs it per size and thread
+// pd_speed: one measurement of `make bench` (bench/speed.py runs it per size and thread
 // count): a 3D PMB brick on a simple cubic lattice, δ = 3.0002·dx (122 bonds per interior node),
 // free faces, the top layers given an initial velocity, advanced by the velocity-Verlet integrator
 // pdsolve uses (bond breaking on). Prints one CSV row (header with --header).

@@ -3,8 +3,15 @@
 #include <iostream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "build_info.hpp"
 #include "core/error.hpp"
+#include "core/model.hpp"
+#include "core/stability.hpp"
+#include "io/case_reader.hpp"
+#include "io/describe.hpp"
+#include "io/node_file.hpp"
 #include "run.hpp"
 
 #ifdef _OPENMP
@@ -17,6 +24,8 @@ namespace {
 const char* const kUsage =
     "usage: pdsolve CASE.json [--restart CHECKPOINT] [--threads N] [--end-time T] [--max-steps N] [--quiet]\n"
     "               [--help] [--version]\n"
+    "       pdsolve --stable-dt CASE.json [--exact] [--threads N]\n"
+    "       pdsolve --describe\n"
     "\n"
     "Bond-based PMB peridynamics solver. Reads the resolved case CASE.json and its node file\n"
     "(pipeline/formats.md), writes frames/*.vtu, frames.pvd, history.csv and run.log to the\n"
@@ -31,6 +40,14 @@ const char* const kUsage =
     "  --quiet         print nothing on stdout and no progress line (run.log is still written)\n"
     "  --help          this text\n"
     "  --version       the solver version and how it was built (compiler, flags, OpenMP, sanitizers)\n"
+    "  --stable-dt     print, as JSON, the stable step of thesis eq. 2.5 that a run of CASE.json would\n"
+    "                  compute (before time.safety_factor; null if no node has a bond):\n"
+    "                  {\"stable\": s, \"safety_factor\": f}. Writes nothing.\n"
+    "  --exact         with --stable-dt: also \"exact\": 2/omega_max, the Lanczos limit of time.dt \"exact\"\n"
+    "  --describe      print, as JSON, every case.json key this solver reads: {\"keys\": {\"time.dt\":\n"
+    "                  {\"type\", \"default\" | \"required\", \"choices\", \"minimum\", \"maximum\", \"above\",\n"
+    "                  \"below\", \"unit\", \"note\"}, ...}, \"registries\": {name: [keys]}}\n"
+    "                  (pipeline/formats.md §6)\n"
     "\n"
     "SIGINT (Ctrl-C) or SIGTERM: the run finishes its step, writes output_dir/checkpoint.bin and\n"
     "stops (a second signal kills it at once); so does output.restart_every_time / _steps, without\n"
@@ -97,6 +114,19 @@ long long parse_integer(const std::string& option, const std::string& text) {
   return value;
 }
 
+// --stable-dt: eq. 2.5 on the model built exactly as run() builds it (read_case, read_node_file,
+// build_model), so that pipeline/stability.py can be tested against the solver's own number.
+int print_stable_dt(const std::filesystem::path& case_file, bool exact) {
+  const pd::Case c = pd::read_case(case_file);
+  const pd::Model model = pd::build_model(c, pd::read_node_file(c.nodes_file));
+  nlohmann::json out = {{"case", case_file.string()},
+                        {"stable", pd::stable_time_step(model)},  // +inf (no bond) dumps as null
+                        {"safety_factor", c.time.safety_factor}};
+  if (exact) out["exact"] = pd::exact_time_step(model);
+  std::cout << out.dump(1) << "\n";
+  return pd::kOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -108,6 +138,7 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
   mallopt(M_TOP_PAD, 16 << 20);
   pd::RunOptions options;
+  bool stable_dt = false, exact = false;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
     auto value = [&]() -> std::string {
@@ -128,6 +159,13 @@ int main(int argc, char** argv) {
       options.max_steps = parse_integer(arg, value());
     } else if (arg == "--restart") {
       options.restart = value();
+    } else if (arg == "--describe") {
+      std::cout << pd::describe_case().dump(1) << "\n";
+      return pd::kOk;
+    } else if (arg == "--stable-dt") {
+      stable_dt = true;
+    } else if (arg == "--exact") {
+      exact = true;
     } else if (arg == "--quiet") {
       options.quiet = true;
     } else if (!arg.empty() && arg[0] == '-') {
@@ -139,7 +177,14 @@ int main(int argc, char** argv) {
     }
   }
   if (options.case_file.empty()) usage_error("no case file given");
+  if (exact && !stable_dt) usage_error("--exact goes with --stable-dt");
   try {
+    if (stable_dt) {
+#ifdef _OPENMP
+      if (options.threads > 0) omp_set_num_threads(options.threads);
+#endif
+      return print_stable_dt(options.case_file, exact);
+    }
     return pd::run(options);
   } catch (const pd::Error& e) {
     std::cerr << "pdsolve: error: " << e.what() << "\n";

@@ -183,8 +183,10 @@ def test_bad_adaptive_values_name_line_and_range(tmp_path):
     assert "plate.yaml:13: adaptive.kd: must be at least 1, got 0" in message
     text = MINIMAL + "adaptive:\n  phi: 1.5\n  tol: 2.0\n  dt_min: 1.0e-6\n  dt_max: 1.0e-7\n"
     message = error_of(tmp_path, text)
-    assert "plate.yaml:12: adaptive.phi: must be between 0.5 and 1, got 1.5" in message
-    assert "plate.yaml:13: adaptive.tol: must be below 1" in message
+    assert "plate.yaml:12: adaptive.phi: must be at most 1, got 1.5" in message  # schema maximum
+    assert "plate.yaml:13: adaptive.tol: must be less than 1, got 2" in message  # schema below
+    # the cross-checks run once every value is in its range
+    message = error_of(tmp_path, MINIMAL + "adaptive:\n  phi: 1.0\n  tol: 0.5\n  dt_min: 1.0e-6\n  dt_max: 1.0e-7\n")
     assert "plate.yaml:14: adaptive.dt_min: dt_min 1e-06 s is larger than dt_max 1e-07 s" in message
 
 

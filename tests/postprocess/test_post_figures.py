@@ -7,7 +7,7 @@ import pytest
 
 import synthetic_output as synth
 from postprocess import cli, maps
-from postprocess.atomic import atomic_path
+from pipeline.atomic import atomic_path
 from postprocess.energy_plot import energy_balance
 from postprocess.history import read_history
 

@@ -1,9 +1,10 @@
-"""Gmsh export: results.msh opens in gmsh's own API with 2 views × N time steps and exact values."""
+"""Gmsh export: results.msh opens in gmsh's own API with a view per point array × N time steps, exact values."""
 import meshio
 import numpy as np
 
 from postprocess import cli
-from postprocess.gmsh_export import read_msh_node_data
+from postprocess.gmsh_export import read_msh_node_data, write_results_msh
+from postprocess.series import Frame, read_frame
 
 
 def export(run):
@@ -11,16 +12,27 @@ def export(run):
     return run.out / "gmsh"
 
 
-def test_gmsh_opens_results_with_two_views_and_one_time_step_per_frame(run2d, gmsh_session):
+ARRAYS = ("displacement", "velocity", "damage", "block")  # every point array of the synthetic frames
+
+
+def frame_arrays(run, k):
+    """The point arrays of frame k as the synthetic output wrote them, (n, components) each."""
+    frame = read_frame(str(run.out / "frames" / f"frame_{k:06d}.vtu"))
+    assert tuple(frame.point_data) == ARRAYS
+    return {name: np.asarray(v, dtype=np.float64).reshape(len(run.points), -1) for name, v in frame.point_data.items()}
+
+
+def test_gmsh_opens_results_with_a_view_per_point_array_and_one_time_step_per_frame(run2d, gmsh_session):
     gmsh = gmsh_session
     gmsh_dir = export(run2d)
     assert sorted(p.name for p in gmsh_dir.iterdir()) == ["damage_final.pos", "results.msh"]
     gmsh.open(str(gmsh_dir / "results.msh"))
     n_frames, n_nodes = len(run2d.times), len(run2d.points)
     tags = list(gmsh.view.getTags())
-    assert len(tags) == 2
     names = [gmsh.option.getString(f"View[{gmsh.view.getIndex(t)}].Name") for t in tags]
-    assert names == ["displacement", "damage"]
+    assert names == list(ARRAYS)
+    expected = [frame_arrays(run2d, k) for k in range(n_frames)]
+    assert np.array_equal(expected[-1]["displacement"], run2d.displacements[-1])
     for tag, name in zip(tags, names):
         assert gmsh.option.getNumber(f"View[{gmsh.view.getIndex(tag)}].NbTimeStep") == n_frames
         for k in range(n_frames):
@@ -28,13 +40,8 @@ def test_gmsh_opens_results_with_two_views_and_one_time_step_per_frame(run2d, gm
             assert kind == "NodeData"
             assert time == run2d.times[k]
             assert list(node_tags) == list(range(1, n_nodes + 1))
-            values = np.array(data)
-            if name == "displacement":
-                assert components == 3
-                assert np.array_equal(values, run2d.displacements[k])  # exact: shortest round-trip repr
-            else:
-                assert components == 1
-                assert np.array_equal(values[:, 0], run2d.damages[k])
+            assert components == expected[k][name].shape[1]
+            assert np.array_equal(np.array(data), expected[k][name])  # exact: shortest round-trip repr
     # nodes at the reference positions, one point element each, tagged with the block
     node_tags, coords, _ = gmsh.model.mesh.getNodes()
     assert np.array_equal(np.asarray(coords).reshape(-1, 3)[np.argsort(node_tags)], run2d.points)
@@ -46,18 +53,50 @@ def test_gmsh_opens_results_with_two_views_and_one_time_step_per_frame(run2d, gm
 def test_our_parser_and_meshio_read_the_values_back(run2d):
     path = export(run2d) / "results.msh"
     views = read_msh_node_data(str(path))
-    assert sorted(views) == ["damage", "displacement"]
-    for name, expected in (("displacement", run2d.displacements), ("damage", run2d.damages)):
+    assert sorted(views) == sorted(ARRAYS)
+    for name in ARRAYS:
         blocks = views[name]
         assert [b[0] for b in blocks] == run2d.times.tolist()        # time of each block
         assert [b[1] for b in blocks] == list(range(len(run2d.times)))  # its time-step index
-        for (_, _, tags, values), want in zip(blocks, expected):
+        for k, (_, _, tags, values) in enumerate(blocks):
             assert np.array_equal(tags, np.arange(1, len(run2d.points) + 1))
-            assert np.array_equal(values.reshape(np.shape(want)), want)
+            assert np.array_equal(values, frame_arrays(run2d, k)[name])
     mesh = meshio.read(str(path))  # an independent reader of the mesh part (it keeps the last data block)
     assert np.array_equal(mesh.points, run2d.points)
     assert [c.type for c in mesh.cells] == ["vertex"] and len(mesh.cells[0].data) == len(run2d.points)
     assert np.array_equal(mesh.point_data["displacement"], run2d.displacements[-1])
+
+
+def test_arrays_of_any_width_become_views_gmsh_can_hold(tmp_path, gmsh_session):
+    """1, 3, 9 components as they are; 2 padded with z = 0; any other count one scalar per component."""
+    gmsh = gmsh_session
+    rng = np.random.default_rng(7)
+    n = 5
+    points = np.column_stack([np.arange(n) * 1e-3, np.zeros(n), np.zeros(n)])
+    data = {"damage": rng.random(n), "velocity": rng.random((n, 3)), "stress": rng.random((n, 9)),
+            "flat": rng.random((n, 2)), "strain6": rng.random((n, 6)), "block": np.arange(1, n + 1, dtype=np.int32)}
+    frames = [(k, 0.5 * k, Frame(path=f"f{k}.vtu", points=points, point_data={name: v * (k + 1) for name, v in data.items()},
+                                 broken_bonds=np.zeros((0, 2), np.int64)))
+              for k in range(2)]
+    path = tmp_path / "results.msh"
+    assert write_results_msh(str(path), frames) == 2
+    views = read_msh_node_data(str(path))
+    want = {"damage": data["damage"][:, None], "velocity": data["velocity"], "stress": data["stress"],
+            "flat": np.column_stack([data["flat"], np.zeros(n)]), "block": data["block"][:, None].astype(float)}
+    want.update({f"strain6[{c}]": data["strain6"][:, c:c + 1] for c in range(6)})
+    assert list(views) == ["damage", "velocity", "stress", "flat"] + [f"strain6[{c}]" for c in range(6)] + ["block"]
+    for name, values in want.items():
+        assert [b[0] for b in views[name]] == [0.0, 0.5]
+        for k, (_, _, _, got) in enumerate(views[name]):
+            assert np.array_equal(got, values * (k + 1))
+    gmsh.open(str(path))
+    tags = list(gmsh.view.getTags())
+    names = [gmsh.option.getString(f"View[{gmsh.view.getIndex(t)}].Name") for t in tags]
+    assert names == list(views)
+    for tag, name in zip(tags, names):
+        _, _, got, _, components = gmsh.view.getModelData(tag, 1)
+        assert components == want[name].shape[1]
+        assert np.array_equal(np.array(got), want[name] * 2)
 
 
 def test_damage_pos_holds_the_last_frame_as_points_and_broken_bonds_as_lines(run2d, gmsh_session):
@@ -83,6 +122,6 @@ def test_3d_export_round_trips(run3d, gmsh_session):
     gmsh = gmsh_session
     gmsh.open(str(export(run3d) / "results.msh"))
     tags = list(gmsh.view.getTags())
-    assert [gmsh.option.getNumber(f"View[{gmsh.view.getIndex(t)}].NbTimeStep") for t in tags] == [4, 4]
+    assert [gmsh.option.getNumber(f"View[{gmsh.view.getIndex(t)}].NbTimeStep") for t in tags] == [4] * len(ARRAYS)
     _, _, data, time, _ = gmsh.view.getModelData(tags[0], 3)
     assert time == run3d.times[3] and np.array_equal(np.array(data), run3d.displacements[3])

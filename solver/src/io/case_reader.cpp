@@ -168,7 +168,7 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
 BoundaryCondition read_boundary(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "boundary_conditions[" + std::to_string(k) + "]";
   ck.object(j, where);
-  ck.known_keys(j, where, {"set", "kind", "component", "times", "values"});
+  ck.known_keys(j, where, case_keys().at("boundary_conditions[]"));
   BoundaryCondition bc;
   bc.set = ck.string(ck.required(j, "set", where + ".set"), where + ".set");
   bc.kind = ck.string(ck.required(j, "kind", where + ".kind"), where + ".kind");
@@ -190,7 +190,7 @@ BoundaryCondition read_boundary(const Checker& ck, const json& j, std::size_t k)
 InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "initial_conditions[" + std::to_string(k) + "]";
   ck.object(j, where);
-  ck.known_keys(j, where, {"set", "kind", "component", "value", "gradient"});
+  ck.known_keys(j, where, case_keys().at("initial_conditions[]"));
   InitialCondition ic;
   ic.set = ck.string(ck.required(j, "set", where + ".set"), where + ".set");
   ic.kind = ck.string(ck.required(j, "kind", where + ".kind"), where + ".kind");
@@ -208,7 +208,7 @@ InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
 
 ContactSettings read_contact(const Checker& ck, const json& j) {
   ck.object(j, "contact");
-  ck.known_keys(j, "contact", {"enabled", "self_contact", "skin", "stiffness_factor"});
+  ck.known_keys(j, "contact", case_keys().at("contact"));
   ContactSettings s;
   if (const json* e = ck.optional(j, "enabled")) {
     s.enabled = ck.string(*e, "contact.enabled");
@@ -243,7 +243,7 @@ std::array<double, 3> read_direction(const Checker& ck, const json& j, const std
 CrackSegment read_crack(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "cracks[" + std::to_string(k) + "]";
   ck.object(j, where);
-  ck.known_keys(j, where, {"from", "to"});
+  ck.known_keys(j, where, case_keys().at("cracks[]"));
   CrackSegment crack;
   crack.from = read_vector(ck, ck.required(j, "from", where + ".from"), where + ".from");
   crack.to = read_vector(ck, ck.required(j, "to", where + ".to"), where + ".to");
@@ -255,7 +255,7 @@ CrackSegment read_crack(const Checker& ck, const json& j, std::size_t k) {
 IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) {
   const std::string where = "indenters[" + std::to_string(k) + "]";
   ck.object(j, where);
-  ck.known_keys(j, where, {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"});
+  ck.known_keys(j, where, case_keys().at("indenters[]"));
   IndenterSettings ind;
   ind.name = ck.string(ck.required(j, "name", where + ".name"), where + ".name");
   const bool name_ok = !ind.name.empty() && !std::isdigit(static_cast<unsigned char>(ind.name[0])) &&
@@ -273,7 +273,7 @@ IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) 
   } else {
     ind.radius = ck.positive(ck.required(j, "radius", where + ".radius"), where + ".radius");
     if (ind.shape == "cylinder") {
-      ind.axis = {0.0, 0.0, 1.0};
+      ind.axis = kDefaultCylinderAxis;
       if (const json* a = ck.optional(j, "axis"); a && !a->is_null()) ind.axis = read_direction(ck, *a, where + ".axis");
     }
   }
@@ -283,7 +283,7 @@ IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) 
 // The adaptive section (integrators/adaptive.hpp): every value in the range the scheme needs.
 AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
   ck.object(j, "adaptive");
-  ck.known_keys(j, "adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"});
+  ck.known_keys(j, "adaptive", case_keys().at("adaptive"));
   AdaptiveSettings a;
   if (const json* v = ck.optional(j, "tol")) {
     a.tol = ck.positive(*v, "adaptive.tol");
@@ -310,6 +310,25 @@ AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
 
 }  // namespace
 
+const std::map<std::string, std::vector<std::string>>& case_keys() {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
+            "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
+            "initial_conditions", "damping", "time", "adaptive", "output", "figures", "partial_volume", "contact",
+            "indenters", "cracks"}},
+      {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
+      {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
+      {"contact", {"enabled", "self_contact", "skin", "stiffness_factor"}},
+      {"cracks[]", {"from", "to"}},
+      {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
+      {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
+      {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
+      {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
+                  "restart_every_steps"}},
+  };
+  return keys;
+}
+
 Case parse_case(const std::string& text, const std::filesystem::path& path) {
   const std::string file = path.string();
   json root;
@@ -320,10 +339,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   }
   const Checker ck(file);
   if (!root.is_object()) throw Error(file + ": the top level must be a JSON object");
-  ck.known_keys(root, "", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension",
-                           "analysis", "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets",
-                           "node_sets", "boundary_conditions", "initial_conditions", "damping", "time",
-                           "adaptive", "output", "figures", "partial_volume", "contact", "indenters", "cracks"});
+  ck.known_keys(root, "", case_keys().at(""));
   Case c;
   c.file = path;
   const std::int64_t version = ck.integer(ck.required(root, "format_version", "format_version"), "format_version", 0, 1 << 30);
@@ -337,7 +353,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   const std::string nodes_file = ck.string(ck.required(root, "nodes_file", "nodes_file"), "nodes_file");
   if (nodes_file.empty()) ck.fail("nodes_file", "must not be empty");
   c.nodes_file = dir / nodes_file;
-  std::string output_dir = ".";
+  std::string output_dir = kDefaultOutputDir;
   if (const json* j = ck.optional(root, "output_dir")) output_dir = ck.string(*j, "output_dir");
   c.output_dir = dir / output_dir;
 
@@ -391,7 +407,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
     }
 
   const json& time = ck.object(ck.required(root, "time", "time"), "time");
-  ck.known_keys(time, "time", {"end", "integrator", "dt", "safety_factor", "max_steps"});
+  ck.known_keys(time, "time", case_keys().at("time"));
   c.time.end = ck.positive(ck.required(time, "end", "time.end"), "time.end");
   if (const json* j = ck.optional(time, "integrator")) {
     c.time.integrator = ck.string(*j, "time.integrator");
@@ -417,8 +433,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 
   const json& output = ck.object(ck.required(root, "output", "output"), "output");
-  ck.known_keys(output, "output",
-                {"every_time", "every_steps", "history_every", "reactions", "restart_every_time", "restart_every_steps"});
+  ck.known_keys(output, "output", case_keys().at("output"));
   if (const json* j = ck.optional(output, "every_time"); j && !j->is_null())
     c.output.every_time = ck.positive(*j, "output.every_time");
   if (const json* j = ck.optional(output, "every_steps"); j && !j->is_null())

@@ -2,7 +2,7 @@
 side³ simple cubic lattice as pd_speed (dx = 1 mm, δ = 3.0002·dx, free faces, the top three layers
 moving down at 0.1 m/s, the same glass-like material), serial and with 2 MPI ranks.
 
-    /usr/bin/python3 solver/bench/lammps_brick.py [--side 40] [--steps 40] [--ranks 1 2]
+    /usr/bin/python3 -m bench.lammps_brick [--side 40] [--steps 40] [--ranks 1 2]
 
 Needs Debian's `lammps` package (lmp, built with PERI) and `mpirun` (openmpi-bin); `make bench`
 installs both. The rate is counted as pd_speed counts it: directed bonds × steps / LAMMPS's own
@@ -22,9 +22,7 @@ import tempfile
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from pipeline.stability import micromodulus, stable_time_step  # noqa: E402  (the solver's formulas)
+from pipeline.stability import micromodulus, stable_time_step  # the solver's formulas (tested equal)
 
 # The material of pd_speed (solver/bench/speed.cpp): E = 72 GPa, ν = 1/4, ρ = 2440 kg/m³, G0 = 4 J/m².
 DX = 1e-3
@@ -53,7 +51,7 @@ TIME_STEP = 0.8 * lattice_stable_time_step()
 def lammps_input(side, steps):
     """A LAMMPS input for the side³ brick (lattice units of dx, nodes at 0 … side−1)."""
     hi = side - 0.5
-    return f"""# written by solver/bench/lammps_brick.py
+    return f"""# written by bench/lammps_brick.py
 units si
 boundary s s s
 atom_style peri

@@ -5,12 +5,12 @@ so that peak memory is per run, three times each (the fastest counts), writes ou
 directed bond updates per second, time per step against N (with its growth exponent, which must
 be ≈ 1), bytes of bond storage per directed bond and peak memory, and set-up time per node.
 Then LAMMPS's PERI package on the 40³ brick, serial and with 2 MPI ranks, against our 1 and 2 threads
-(solver/bench/lammps_brick.py, out/bench/lammps.csv), what the node numbering costs (x-fastest,
+(bench/lammps_brick.py, out/bench/lammps.csv), what the node numbering costs (x-fastest,
 shuffled, Morton-sorted), and the cost of output at each case's own interval: the share of the time
 loop pdsolve reports spending on frames and history rows, on out/<case>/case.json as the case sets
 it (skipped for cases not built).
 
-    /usr/bin/python3 solver/bench/speed.py [--build build/solver] [--sides 40 46 100] [--quick]
+    /usr/bin/python3 -m bench.speed [--build build/solver] [--sides 40 46 100] [--quick]
 
 Wall-clock numbers depend on what else the machine runs; the load average is printed with them.
 """
@@ -39,8 +39,6 @@ def node_order_study(exe, header, side, steps, workdir):
     discretization makes it), shuffled (as an unsorted cloud could be), and Morton-sorted after
     shuffling (what the pre-processor writes: preprocess/ordering.py)."""
     import numpy as np
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    sys.path.insert(0, root)
     from preprocess.cloud import NodeCloud
     from preprocess.node_file import write_node_file
     from preprocess.ordering import morton_order, reorder
@@ -67,12 +65,11 @@ def node_order_study(exe, header, side, steps, workdir):
 
 
 def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=2):
-    """LAMMPS's PERI package on the same brick (solver/bench/lammps_brick.py), serial and with 2 MPI
+    """LAMMPS's PERI package on the same brick (bench/lammps_brick.py), serial and with 2 MPI
     ranks, against pd_speed with 1 and 2 threads: the two codes alternate, `repeats` runs each, and
     the best run of each counts (a busy neighbour slows a run, nothing speeds it up). Rates are
     counted with our directed bond count on that lattice."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import lammps_brick
+    from . import lammps_brick
     missing = lammps_brick.available()
     if missing:
         print(f"LAMMPS comparison skipped: {missing} not found (apt-get install lammps openmpi-bin; make bench does)")
