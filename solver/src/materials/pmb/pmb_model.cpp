@@ -164,7 +164,7 @@ void register_material_pmb(MaterialRegistry& registry) {
           "(1/4 in 3D and plane strain, 1/3 in plane stress)";
   d.parameters = {
       {"youngs_modulus", "Pa", "Young's modulus E", true},
-      {"fracture_energy", "J/m^2", "critical energy release rate G0; absent or null: the block never breaks", false},
+      {"fracture_energy", "J/m²", "null: unbreakable", false},
   };
   d.constants = &pmb_constants;
   d.make = [](const Model&) -> std::shared_ptr<const BondModel> { return std::make_shared<PmbModel>(); };
