@@ -105,6 +105,7 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "indenters": indenters,
         "time": time,
         "adaptive": dict(case["adaptive"]),
+        "quasi_static": dict(case["quasi_static"]),
         "output": dict(case["output"]),
         "figures": figures,
     }

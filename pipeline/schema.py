@@ -160,9 +160,11 @@ CASE = {
     "time": section(
         "time integration",
         end=Key("number", "simulated end time", default=REQUIRED, unit="s", above=0.0),
-        integrator=Key("choice", "time integrator: verlet (velocity Verlet, thesis eq. 2.4) or adaptive "
-                       "(the mixed explicit–implicit step of thesis §2.2, settings in adaptive:)",
-                       default="verlet", choices=("verlet", "adaptive")),
+        integrator=Key("choice", "time integrator: verlet (velocity Verlet, thesis eq. 2.4), adaptive "
+                       "(the mixed explicit–implicit step of thesis §2.2, settings in adaptive:) or "
+                       "quasi_static (time is a load parameter: equilibrium by Newton at every load step, "
+                       "settings in quasi_static:)",
+                       default="verlet", choices=("verlet", "adaptive", "quasi_static")),
         dt=Key("number_or_choice", "time step: 'stable' (thesis eq. 2.5, minimised over nodes, times "
                "safety_factor), 'exact' (2/ω_max, ω_max² the largest eigenvalue of the linearised PMB "
                "operator M⁻¹K, times safety_factor: about 1.7× 'stable' in 2D, 2× in 3D), or a number; "
@@ -190,6 +192,30 @@ CASE = {
         dt_max=Key("number", "largest step (default: the smaller of eq. 2.5 and 0.9 × Δt_exact/(2φ), "
                    "where the fixed-point iteration still contracts)", default=None,
                    unit="s", above=0.0),
+    ),
+    "quasi_static": section(
+        "the quasi-static solver (time.integrator: quasi_static): each load step is brought to "
+        "equilibrium by Newton's method with a sparse Cholesky factorisation of the tangent "
+        "(CHOLMOD), bonds over their critical stretch break and the load step is solved again until "
+        "none does; the step size follows eq. 2.8 from the Newton corrections",
+        tol=Key("number", "TOL on the last Newton correction relative to the step's motion "
+                "(eq. 2.6 for Newton)", default=1e-6, above=0.0, below=1.0),
+        residual_tol=Key("number", "equilibrium: the out-of-balance force over free components, "
+                         "relative to the load (reactions and body forces)", default=1e-8, above=0.0,
+                         below=1.0),
+        kd=Key("integer", "K_d: the Newton iterations a load step is aimed at (eq. 2.8)", default=5,
+               minimum=1, maximum=1000),
+        p=Key("number", "exponent p of eq. 2.8", default=2.0, above=0.0),
+        max_iterations=Key("integer", "Newton iterations before the load step is cut", default=30,
+                           minimum=1, maximum=100000),
+        max_breaking_rounds=Key("integer", "re-solves at one load while bonds keep breaking; more "
+                                "means unstable crack growth, and the run stops", default=100,
+                                minimum=1, maximum=100000000),
+        dt_initial=Key("number", "the first load step (default: end/100)", default=None, unit="s",
+                       above=0.0),
+        dt_min=Key("number", "smallest load step (default: 1e-9 × end)", default=None, unit="s",
+                   above=0.0),
+        dt_max=Key("number", "largest load step (default: end/10)", default=None, unit="s", above=0.0),
     ),
     "output": section(
         "what the solver writes and how often",

@@ -44,6 +44,18 @@ struct AdaptiveSettings {
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: derived from eq. 2.5
 };
 
+// quasi_static: time is a load parameter; each load step is solved for equilibrium by Newton
+// (integrators/quasi_static.hpp), its size set by eq. 2.8 from the iterations it took.
+struct QuasiStaticSettings {
+  double tol = 1e-6;           // TOL on ω_K = ‖Δu_K‖/‖u_K − u_n‖ (eq. 2.6 for Newton's corrections)
+  double residual_tol = 1e-8;  // equilibrium: ‖V f‖ over free components ≤ this × the load (reactions, body forces)
+  int kd = 5;                  // K_d: the Newton iterations the load step is aimed at
+  double p = 2.0;              // exponent of eq. 2.8
+  int max_iterations = 30;     // Newton iterations before the load step is cut
+  int max_breaking_rounds = 100;  // re-solves at one load while bonds keep breaking, then unstable
+  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-9, end/10
+};
+
 struct OutputSettings {
   std::optional<double> every_time;        // s
   std::optional<std::int64_t> every_steps;
@@ -101,6 +113,7 @@ struct Case {
   std::vector<IndenterSettings> indenters;
   TimeSettings time;
   AdaptiveSettings adaptive;
+  QuasiStaticSettings quasi_static;
   OutputSettings output;
 };
 

@@ -36,6 +36,7 @@ class BodyForceOnSets : public ForceTerm {
   void add_force(State& s, double t) const override { BodyForceTerm(model_).AddMult(t, s.f); }
   void add_power(const State& s, double t, double& p) const override { p += BodyForceTerm(model_).power(t, s.v); }
   void add_jacobian_product(const State&, double, const Vec3Array&, Vec3Array&) const override {}
+  bool add_tangent_diagonal(const State&, double, std::size_t, double*) const override { return true; }
   std::vector<std::string> work_plan() const override { return {}; }
 
  private:

@@ -119,6 +119,7 @@ class ContactTerm : public ForceTerm {
   void add_jacobian_product(const State& s, double, const Vec3Array& x, Vec3Array& y) const override {
     ShortRangeForce(model_).AddJacobianProduct(s.u, x, y);
   }
+  bool add_tangent_diagonal(const State&, double, std::size_t, double*) const override { return false; }
   std::vector<std::string> work_plan() const override {
     char buffer[256];
     std::snprintf(buffer, sizeof buffer, ", contact distance 2r_s %.4g m, skin %.4g m, c_s = %.4g·c",

@@ -23,6 +23,10 @@ class ForceTerm {
   virtual void add_power(const State& s, double t, double& p) const = 0;
   // y += ∂f/∂u·x at (s.u, t): the term's part of the linearised force (implicit solves).
   virtual void add_jacobian_product(const State& s, double t, const Vec3Array& x, Vec3Array& y) const = 0;
+  // block += ∂f_i/∂u_i (row-major 3×3) at node i for a term that acts on each node alone
+  // (indenters, body force); false for a term that couples nodes (contact): the assembled tangent
+  // does not hold it, and solvers then stay matrix-free.
+  virtual bool add_tangent_diagonal(const State& s, double t, std::size_t i, double block[9]) const = 0;
   // Lines of the work plan (run.log) for this term.
   virtual std::vector<std::string> work_plan() const = 0;
 };

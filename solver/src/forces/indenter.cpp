@@ -217,6 +217,26 @@ void IndenterForce::AddJacobianProduct(double t, const Vec3Array& u, const Vec3A
   }
 }
 
+void IndenterForce::AddTangentDiagonal(double t, const Vec3Array& u, std::size_t q, double block[9]) const {
+  const Model& m = model_;
+  const double yq[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
+  for (const IndenterSettings& ind : m.indenters) {
+    const std::array<double, 3> c = indenter_position(ind, t);
+    double n[3];
+    const double h = indenter_shape_registry().get(ind.shape)(ind, c.data(), yq, n);
+    if (!(h > 0.0)) continue;
+    // The matrix of AddJacobianProduct: −2K h n nᵀ + K h²/r·P (P = I − n nᵀ [− a aᵀ for a cylinder]).
+    const bool curved = ind.shape != "plane", cylinder = ind.shape == "cylinder";
+    const double turn = curved ? ind.stiffness * h * h / (ind.radius - h) : 0.0;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        double projection = (a == b ? 1.0 : 0.0) - n[a] * n[b];
+        if (cylinder) projection -= ind.axis[static_cast<std::size_t>(a)] * ind.axis[static_cast<std::size_t>(b)];
+        block[3 * a + b] += -2.0 * ind.stiffness * h * n[a] * n[b] + turn * projection;
+      }
+  }
+}
+
 namespace {
 
 // The indenters as a term of the operator (forces/force_term.hpp).
@@ -234,6 +254,10 @@ class IndenterTerm : public ForceTerm {
   }
   void add_jacobian_product(const State& s, double t, const Vec3Array& x, Vec3Array& y) const override {
     IndenterForce(model_).AddJacobianProduct(t, s.u, x, y);
+  }
+  bool add_tangent_diagonal(const State& s, double t, std::size_t i, double block[9]) const override {
+    IndenterForce(model_).AddTangentDiagonal(t, s.u, i, block);
+    return true;
   }
   std::vector<std::string> work_plan() const override {
     std::vector<std::string> lines;

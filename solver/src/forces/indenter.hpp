@@ -59,6 +59,8 @@ class IndenterForce {
   // y += ∂f/∂u·x at (u, t): the stiffness of the push, 2K·h along n, and for a curved surface the
   // turn of n with the node, K h²/r across it.
   void AddJacobianProduct(double t, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const;
+  // block += the same as node q's 3×3 matrix (an indenter couples no nodes).
+  void AddTangentDiagonal(double t, const Vec3Array& u, std::size_t q, double block[9]) const;
 
  private:
   const Model& model_;

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <string>
 
+#include "control/zohdi.hpp"
 #include "core/error.hpp"
 
 namespace pd {
@@ -155,7 +156,7 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
       // Nothing moves (a body at rest): the step is exact, ω_K = 0.
       const double omega = m > 0.0 ? c / m : 0.0;
       // Eq. 2.8 with ω_0 = 1 (see adaptive.hpp); ω_K = 0 proposes an unbounded step, capped below.
-      phi_k = omega > 0.0 ? std::pow(tol, 1.0 / (p * kd)) / std::pow(omega, 1.0 / (p * k)) : HUGE_VAL;
+      phi_k = zohdi_step_factor(tol, omega, k, kd, p);
       if (omega <= tol) {  // eq. 2.7: Z_K ≤ 1
         accepted = true;
         break;

@@ -2,6 +2,7 @@
 #include "integrators/integrator.hpp"
 
 #include "integrators/adaptive.hpp"
+#include "integrators/quasi_static.hpp"
 #include "integrators/verlet.hpp"
 
 namespace pd {
@@ -10,6 +11,7 @@ const Registry<IntegratorFactory>& integrator_registry() {
   static const Registry<IntegratorFactory> registry = [] {
     Registry<IntegratorFactory> r("integrator");
     r.add("verlet", [](ForceOperator& op) -> std::unique_ptr<Integrator> { return std::make_unique<VelocityVerlet>(op); });
+    r.add("quasi_static", [](ForceOperator& op) -> std::unique_ptr<Integrator> { return std::make_unique<QuasiStatic>(op); });
     r.add("adaptive", [](ForceOperator& op) -> std::unique_ptr<Integrator> { return std::make_unique<AdaptiveStep>(op); });
     return r;
   }();

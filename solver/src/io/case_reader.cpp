@@ -280,6 +280,29 @@ IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) 
   return ind;
 }
 
+// The quasi_static section (integrators/quasi_static.hpp).
+QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
+  ck.object(j, "quasi_static");
+  ck.known_keys(j, "quasi_static", case_keys().at("quasi_static"));
+  QuasiStaticSettings q;
+  for (auto [name, slot] : {std::pair<const char*, double*>{"tol", &q.tol}, {"residual_tol", &q.residual_tol}})
+    if (const json* v = ck.optional(j, name)) {
+      *slot = ck.positive(*v, std::string("quasi_static.") + name);
+      if (!(*slot < 1.0)) ck.fail(std::string("quasi_static.") + name, "must be below 1 (a relative error), got " + show(*v));
+    }
+  if (const json* v = ck.optional(j, "kd")) q.kd = static_cast<int>(ck.integer(*v, "quasi_static.kd", 1, 1000));
+  if (const json* v = ck.optional(j, "p")) q.p = ck.positive(*v, "quasi_static.p");
+  if (const json* v = ck.optional(j, "max_iterations"))
+    q.max_iterations = static_cast<int>(ck.integer(*v, "quasi_static.max_iterations", 1, 100000));
+  if (const json* v = ck.optional(j, "max_breaking_rounds"))
+    q.max_breaking_rounds = static_cast<int>(ck.integer(*v, "quasi_static.max_breaking_rounds", 1, 100000000));
+  for (auto [name, slot] : {std::pair<const char*, std::optional<double>*>{"dt_initial", &q.dt_initial},
+                            {"dt_min", &q.dt_min}, {"dt_max", &q.dt_max}})
+    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("quasi_static.") + name);
+  if (q.dt_min && q.dt_max && *q.dt_min > *q.dt_max) ck.fail("quasi_static.dt_min", "is larger than quasi_static.dt_max");
+  return q;
+}
+
 // The adaptive section (integrators/adaptive.hpp): every value in the range the scheme needs.
 AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
   ck.object(j, "adaptive");
@@ -314,7 +337,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "output", "figures", "partial_volume", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "output", "figures", "partial_volume", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -322,6 +345,8 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"cracks[]", {"from", "to"}},
       {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
+      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "dt_initial", "dt_min",
+                        "dt_max"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
                   "restart_every_steps"}},
@@ -430,6 +455,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
     c.time.max_steps = ck.integer(*j, "time.max_steps", 1, std::numeric_limits<std::int64_t>::max());
 
   if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) c.adaptive = read_adaptive(ck, *j);
+  if (const json* j = ck.optional(root, "quasi_static"); j && !j->is_null()) c.quasi_static = read_quasi_static(ck, *j);
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 
   const json& output = ck.object(ck.required(root, "output", "output"), "output");

@@ -122,6 +122,18 @@ json describe_case() {
   keys["adaptive.dt_initial"] = defaulted("number", value_or_null(a.dt_initial), {{"above", 0.0}, {"unit", "s"}});
   keys["adaptive.dt_min"] = defaulted("number", value_or_null(a.dt_min), {{"above", 0.0}, {"unit", "s"}});
   keys["adaptive.dt_max"] = defaulted("number", value_or_null(a.dt_max), {{"above", 0.0}, {"unit", "s"}});
+  const QuasiStaticSettings q{};
+  keys["quasi_static"] = defaulted("object", json::object());
+  keys["quasi_static.tol"] = defaulted("number", q.tol, {{"above", 0.0}, {"below", 1.0}});
+  keys["quasi_static.residual_tol"] = defaulted("number", q.residual_tol, {{"above", 0.0}, {"below", 1.0}});
+  keys["quasi_static.kd"] = defaulted("integer", q.kd, {{"minimum", 1}, {"maximum", 1000}});
+  keys["quasi_static.p"] = defaulted("number", q.p, positive);
+  keys["quasi_static.max_iterations"] = defaulted("integer", q.max_iterations, {{"minimum", 1}, {"maximum", 100000}});
+  keys["quasi_static.max_breaking_rounds"] =
+      defaulted("integer", q.max_breaking_rounds, {{"minimum", 1}, {"maximum", 100000000}});
+  keys["quasi_static.dt_initial"] = defaulted("number", value_or_null(q.dt_initial), {{"above", 0.0}, {"unit", "s"}});
+  keys["quasi_static.dt_min"] = defaulted("number", value_or_null(q.dt_min), {{"above", 0.0}, {"unit", "s"}});
+  keys["quasi_static.dt_max"] = defaulted("number", value_or_null(q.dt_max), {{"above", 0.0}, {"unit", "s"}});
   keys["output"] = required("object", {{"note", "exactly one of every_time and every_steps"}});
   keys["output.every_time"] = defaulted("number", value_or_null(o.every_time), {{"above", 0.0}, {"unit", "s"}});
   keys["output.every_steps"] = defaulted("integer", value_or_null(o.every_steps), {{"minimum", 1}});

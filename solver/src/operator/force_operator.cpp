@@ -44,6 +44,78 @@ void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x,
   for (const auto& term : terms_) term->add_jacobian_product(s, t, x, y);
 }
 
+SparseMatrix ForceOperator::assemble_stiffness(const State& s, double t, const FreeDofs& dofs) const {
+  const Model& m = model_;
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+  SparseMatrix K;
+  K.rows = -1;
+  {  // an assembled form exists only if the law and every active term have one
+    std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
+    double diagonal[9] = {};
+    if (n > 0 && !m.bond_model->bond_tangent_row(m, s.u, 0, probe.data())) return K;
+    for (const auto& term : terms_)
+      if (n > 0 && !term->add_tangent_diagonal(s, t, 0, diagonal)) return K;
+  }
+  const auto& off = m.bonds.offsets;
+  const auto dof = [&](std::size_t node, int d) { return dofs.index[3 * node + static_cast<std::size_t>(d)]; };
+  // Pass 1: the pattern. Row (i, d) has a column for every free component of i and of its bonded
+  // nodes (broken bonds too: the pattern never changes).
+  std::vector<std::int64_t> free_of(static_cast<std::size_t>(n), 0);
+  for (std::int64_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) free_of[static_cast<std::size_t>(i)] += dof(static_cast<std::size_t>(i), d) >= 0;
+  K.rows = static_cast<std::int64_t>(dofs.size());
+  K.row_start.assign(dofs.size() + 1, 0);
+  for (std::size_t r = 0; r < dofs.size(); ++r) {
+    const auto i = static_cast<std::size_t>(dofs.node[r]);
+    std::int64_t count = free_of[i];
+    for (std::int64_t k = off[i]; k < off[i + 1]; ++k) count += free_of[static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)])];
+    K.row_start[r + 1] = K.row_start[r] + count;
+  }
+  K.column.resize(static_cast<std::size_t>(K.row_start.back()));
+  K.value.resize(K.column.size());
+  // Pass 2: the values, node by node (each node fills only its own rows).
+#pragma omp parallel
+  {
+    std::vector<double> blocks;
+#pragma omp for schedule(dynamic, 256)
+    for (std::int64_t i64 = 0; i64 < n; ++i64) {
+      const auto i = static_cast<std::size_t>(i64);
+      if (free_of[i] == 0) continue;
+      const std::int64_t bonds = off[i + 1] - off[i];
+      blocks.assign(static_cast<std::size_t>(9 * bonds), 0.0);
+      m.bond_model->bond_tangent_row(m, s.u, i, blocks.data());
+      double diagonal[9] = {};
+      for (std::int64_t b = 0; b < bonds; ++b)
+        for (int q = 0; q < 9; ++q) diagonal[q] -= blocks[static_cast<std::size_t>(9 * b + q)];
+      for (const auto& term : terms_) term->add_tangent_diagonal(s, t, i, diagonal);
+      const double volume = m.nodes.volume[i];
+      for (int d = 0; d < 3; ++d) {
+        const std::int64_t r = dof(i, d);
+        if (r < 0) continue;
+        std::int64_t at = K.row_start[static_cast<std::size_t>(r)];
+        // Columns in node order: the bonded nodes below i, i itself, those above (rows ascend).
+        bool self_done = false;
+        auto put_node = [&](std::size_t j, const double* block) {
+          for (int e = 0; e < 3; ++e) {
+            const std::int64_t col = dof(j, e);
+            if (col < 0) continue;
+            K.column[static_cast<std::size_t>(at)] = col;
+            K.value[static_cast<std::size_t>(at)] = -volume * block[3 * d + e];
+            ++at;
+          }
+        };
+        for (std::int64_t b = 0; b < bonds; ++b) {
+          const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(off[i] + b)]);
+          if (!self_done && j > i) put_node(i, diagonal), self_done = true;
+          put_node(j, &blocks[static_cast<std::size_t>(9 * b)]);
+        }
+        if (!self_done) put_node(i, diagonal);
+      }
+    }
+  }
+  return K;
+}
+
 void ForceOperator::impose_prescribed_motion(State& s, double t) const {
   for (const auto& p : model_.conditions.prescribed) {
     auto& u = s.u[static_cast<std::size_t>(p.component)];

@@ -12,6 +12,7 @@
 #include "core/model.hpp"
 #include "core/state.hpp"
 #include "forces/force_term.hpp"
+#include "linalg/sparse_matrix.hpp"
 
 namespace pd {
 
@@ -39,6 +40,13 @@ class ForceOperator {
   // y = ∂f/∂u·x at (s.u, t): the linearised force density (matrix-free). Prescribed components are
   // not treated specially: a solver constrains them itself.
   void apply_jacobian(const State& s, double t, const Vec3Array& x, Vec3Array& y) const;
+
+  // K = −V_i ∂f_i/∂u_j over the free dofs at (s.u, t): the assembled tangent stiffness (symmetric;
+  // positive semi-definite for bonds in tension), rows of nodes with all their bonds, broken ones
+  // included as zeros so that the pattern stays that of the first assembly (a factorisation's
+  // ordering is reused). Empty (rows = −1) when the material or an active term has no assembled
+  // form (a state-based law, contact): a solver then stays matrix-free.
+  SparseMatrix assemble_stiffness(const State& s, double t, const FreeDofs& dofs) const;
 
   // Prescribed motion. impose: u and v of every prescribed component at t.
   void impose_prescribed_motion(State& s, double t) const;

@@ -1,0 +1,219 @@
+// One quasi-static load step: prescribed motion at the new load, Newton to equilibrium, breaking
+// and re-solving, the eq. 2.8 proposal (see quasi_static.hpp).
+#include "integrators/quasi_static.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "control/zohdi.hpp"
+#include "core/error.hpp"
+
+namespace pd {
+
+namespace {
+
+std::string number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+
+}  // namespace
+
+void QuasiStatic::configure(const Case& c, double) {
+  settings_ = c.quasi_static;
+  end_ = c.time.end;
+  dt_max_ = settings_.dt_max.value_or(end_ / 10.0);
+  dt_min_ = settings_.dt_min.value_or(std::min(1e-9 * end_, dt_max_));
+  dt_initial_ = std::min(settings_.dt_initial.value_or(end_ / 100.0), dt_max_);
+  if (dt_min_ > dt_max_)
+    throw Error(c.file.string() + ": quasi_static.dt_min = " + number(dt_min_) + " s is above dt_max = " +
+                number(dt_max_) + " s");
+  if (op_.damping() != 0.0)
+    throw Error(c.file.string() + ": damping: quasi_static solves for equilibrium, where damping does nothing; "
+                "set damping: 0 (or use time.integrator: verlet)");
+}
+
+void QuasiStatic::initialize(State& state, double t) {
+  if (dt_max_ <= 0.0) {  // not configured (tests that build it bare): the defaults
+    Case defaults;
+    defaults.time.end = 1.0;
+    configure(defaults);
+  }
+  op_.impose_prescribed_motion(state, t);
+  op_.evaluate(state, t);
+  op_.update_work(state, t, 0.0);
+  dofs_ = FreeDofs::of(state.size(), op_.model().nodes.dimension, op_.fixed());
+  trial_ = State(state.size());
+  report_ = StepReport{};
+}
+
+double QuasiStatic::residual_norm(const State& s) const {
+  const auto& volume = op_.model().nodes.volume;
+  double sum = 0.0;  // serial, dof order: the same for any thread count
+  for (std::size_t k = 0; k < dofs_.size(); ++k) {
+    const auto i = static_cast<std::size_t>(dofs_.node[k]);
+    const double r = volume[i] * s.f[dofs_.component[k]][i];
+    sum += r * r;
+  }
+  return std::sqrt(sum);
+}
+
+double QuasiStatic::load_scale(const State& s, double t) const {
+  // The load the residual is measured against: the reactions at prescribed components plus the
+  // body forces, as force vectors [N].
+  const Model& m = op_.model();
+  double sum = 0.0;
+  for (const auto& p : m.conditions.prescribed)
+    for (std::int32_t i32 : p.nodes) {
+      const auto i = static_cast<std::size_t>(i32);
+      const double r = m.nodes.volume[i] * s.f[static_cast<std::size_t>(p.component)][i];
+      sum += r * r;
+    }
+  for (const auto& b : m.conditions.body_forces) {
+    const double value = b.table.value(t);
+    for (std::int32_t i32 : b.nodes) {
+      const double r = m.nodes.volume[static_cast<std::size_t>(i32)] * value;
+      sum += r * r;
+    }
+  }
+  return std::sqrt(sum);
+}
+
+bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
+  double previous = HUGE_VAL;
+  for (int k = 1; k <= settings_.max_iterations; ++k) {
+    op_.evaluate(s, t1);
+    ++report_.force_evaluations;
+    const double residual = residual_norm(s);
+    if (!std::isfinite(residual)) return false;
+    const double load = load_scale(s, t1);
+    // Equilibrium (and a correction below TOL, checked after the solve below).
+    if (k > 1 && residual <= settings_.residual_tol * load && omega <= settings_.tol) return true;
+    if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
+    // Reuse the factorisation while it keeps the residual falling fast; else assemble anew.
+    if (!have_factor_ || residual > 0.25 * previous) {
+      const SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_);
+      if (K.rows < 0)
+        throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
+                         "have; use time.integrator: verlet");
+      if (!factor_.factorize(K)) {
+        have_factor_ = false;
+        if (!std::isfinite(previous)) {  // at the first iteration: the body is not held
+          throw StepFailed("the tangent stiffness is singular or indefinite (" + factor_.failure() +
+                           "): the body can move freely or a part of it has come loose; quasi_static needs "
+                           "displacement conditions that hold every body in every direction, or use "
+                           "time.integrator: verlet");
+        }
+        return false;
+      }
+      have_factor_ = true;
+      ++factorisations_;
+    }
+    previous = residual;
+    // K Δu = V f at the free components.
+    const auto& volume = op_.model().nodes.volume;
+    rhs_.resize(dofs_.size());
+    for (std::size_t q = 0; q < dofs_.size(); ++q) {
+      const auto i = static_cast<std::size_t>(dofs_.node[q]);
+      rhs_[q] = volume[i] * s.f[dofs_.component[q]][i];
+    }
+    factor_.solve(rhs_, correction_);
+    // Backtracking: the full step unless it raises the residual (then ½, ¼, … up to 1/32).
+    double alpha = 1.0, step_norm = 0.0, motion = 0.0;
+    trial_ = s;
+    for (int halving = 0;; ++halving) {
+      for (std::size_t q = 0; q < dofs_.size(); ++q) {
+        const auto i = static_cast<std::size_t>(dofs_.node[q]);
+        trial_.u[dofs_.component[q]][i] = s.u[dofs_.component[q]][i] + alpha * correction_[q];
+      }
+      if (halving == 5) break;
+      op_.evaluate(trial_, t1);
+      ++report_.force_evaluations;
+      if (residual_norm(trial_) < residual) break;
+      alpha *= 0.5;
+    }
+    for (std::size_t q = 0; q < dofs_.size(); ++q) {
+      const auto i = static_cast<std::size_t>(dofs_.node[q]);
+      const double du = alpha * correction_[q], from_start = trial_.u[dofs_.component[q]][i] - u_start[dofs_.component[q]][i];
+      step_norm += du * du;
+      motion += from_start * from_start;
+    }
+    std::swap(s.u, trial_.u);
+    omega = motion > 0.0 ? std::sqrt(step_norm / motion) : 0.0;  // eq. 2.6 for Newton
+    iterations = k;
+    if (!std::isfinite(omega)) return false;
+  }
+  op_.evaluate(s, t1);
+  ++report_.force_evaluations;
+  return residual_norm(s) <= settings_.residual_tol * load_scale(s, t1) && omega <= settings_.tol;
+}
+
+void QuasiStatic::step(State& state, double& t, double& dt) {
+  report_ = StepReport{};
+  report_.force_evaluations = 0;
+  double h = std::min(dt, dt_max_);
+  for (;;) {
+    const double t1 = t + h;
+    State s = state;
+    op_.advance_prescribed_motion(state.u, s.u, s.v, t, t1, h, false);
+    int iterations = 0, total = 0, rounds = 0;
+    double omega = 0.0;
+    bool converged = true;
+    BreakReport broke_total;
+    for (;;) {
+      converged = solve_equilibrium(s, t1, state.u, iterations, omega);
+      total += iterations;
+      if (!converged) break;
+      const BreakReport broke = op_.model().bond_model->break_bonds(op_.model(), s.u, true);
+      if (broke.broken == 0) break;
+      broke_total.broken += broke.broken;
+      broke_total.energy += broke.energy;
+      have_factor_ = false;  // the tangent lost bonds
+      if (++rounds >= settings_.max_breaking_rounds)
+        throw StepFailed("bonds kept breaking at t = " + number(t1) + " s through " + std::to_string(rounds) +
+                         " re-solves at the same load (" + std::to_string(broke_total.broken) +
+                         " bonds): the crack grows unstably, which a quasi-static solve cannot follow; use "
+                         "time.integrator: verlet (or raise quasi_static.max_breaking_rounds)");
+    }
+    if (converged) {
+      // Accepted: the mean velocity over the load step, the force and the work at t1.
+      for (std::size_t d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < s.size(); ++i)
+          if (!op_.fixed()[d][i]) s.v[d][i] = (s.u[d][i] - state.u[d][i]) / h;
+      op_.evaluate(s, t1);
+      ++report_.force_evaluations;
+      op_.update_work(s, t1, h);
+      state = std::move(s);
+      report_.iterations = std::max(total, 1);
+      report_.broken_now = broke_total.broken;
+      report_.broken_energy_now = broke_total.energy;
+      t = t1;
+      dt = h;
+      double next = std::min(zohdi_step_factor(settings_.tol, omega, std::max(iterations, 1), settings_.kd, settings_.p), 2.0) * h;
+      if (broke_total.broken > 0) next = std::min(next, h);  // a crack grows: no longer steps
+      report_.next_dt = std::max(std::min(next, dt_max_), dt_min_);
+      return;
+    }
+    // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved.
+    have_factor_ = false;
+    if (h <= dt_min_ * (1.0 + 1e-12))
+      throw StepFailed("the quasi-static load step did not reach equilibrium at dt_min = " + number(dt_min_) +
+                       " s (t = " + number(t) + " s, " + std::to_string(report_.rejected + 1) +
+                       " attempts, last correction ω = " + number(omega) + "); the load may exceed what the "
+                       "body can carry (unstable fracture or buckling): use time.integrator: verlet, or raise "
+                       "quasi_static.max_iterations");
+    ++report_.rejected;
+    h = std::max(0.5 * h, dt_min_);
+  }
+}
+
+std::vector<std::string> QuasiStatic::describe(double) const {
+  return {"quasi_static: Newton with line search to residual " + number(settings_.residual_tol) +
+          " × the load and correction TOL " + number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
+          number(settings_.p) + "; tangent factorised by CHOLMOD; load steps dt_initial " + number(dt_initial_.value_or(0.0)) + " s, dt_min " + number(dt_min_) +
+          " s, dt_max " + number(dt_max_) + " s"};
+}
+
+}  // namespace pd

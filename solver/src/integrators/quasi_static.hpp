@@ -1,0 +1,62 @@
+// Quasi-static loading (time.integrator: quasi_static): time is a load parameter, the boundary-
+// condition tables are the load path, and every load step t → t + Δt is brought to equilibrium,
+// V_i f_i(u) = 0 at every free component, by Newton's method:
+//   K(u_K) Δu = V f(u_K),  u_{K+1} = u_K + α Δu,   K = −V ∂f/∂u the assembled tangent
+// (operator/force_operator.hpp), factorised by CHOLMOD (linalg/cholesky.hpp); α < 1 only when the
+// full step does not lower the residual (backtracking line search). A factorisation is reused for
+// later iterations and load steps while it keeps the residual falling by 4× per iteration (below
+// the first bond failure PMB is nearly linear, so one factorisation serves many steps); otherwise
+// the tangent is assembled and factorised again.
+//
+// Converged when ‖V f‖ ≤ residual_tol × the load (‖reactions‖ + ‖body forces‖) and
+// ω_K = ‖Δu‖/‖u_K − u_n‖ ≤ tol (eq. 2.6 for Newton's corrections). Then bonds over their critical
+// stretch break (thesis §2.2 rule) and the same load is solved again, until none breaks
+// (max_breaking_rounds: more is unstable crack growth, and the step fails). The next step is
+// Φ_K·Δt with Φ_K of eq. 2.8 (control/zohdi.hpp) from the last correction, not larger after a step
+// in which bonds broke; a step that does not converge is redone from t with Δt/2. Velocities are
+// the mean over the load step, (u_{n+1} − u_n)/Δt, so the work ledger integrates the reactions.
+#pragma once
+#include <memory>
+
+#include "integrators/integrator.hpp"
+#include "linalg/cholesky.hpp"
+#include "linalg/sparse_matrix.hpp"
+
+namespace pd {
+
+class QuasiStatic : public Integrator {
+ public:
+  explicit QuasiStatic(ForceOperator& op) : op_(op) {}
+  std::string name() const override { return "quasi_static"; }
+  void configure(const Case& c, double dt_exact = 0.0) override;
+  void initialize(State& state, double t) override;
+  void step(State& state, double& t, double& dt) override;
+
+  std::vector<std::string> describe(double dt_exact) const override;
+  bool controls_step() const override { return true; }
+  std::optional<double> initial_dt() const override { return dt_initial_; }
+
+  // Work of the whole run, for run.log and the tests.
+  int factorisations() const { return factorisations_; }
+  const QuasiStaticSettings& settings() const { return settings_; }
+
+ private:
+  // Newton at load t1 from state.u (prescribed components already at t1). True when converged;
+  // iterations, the last ω_K and the evaluations are added to the report.
+  bool solve_equilibrium(State& trial, double t1, const Vec3Array& u_start, int& iterations, double& omega);
+  double load_scale(const State& s, double t) const;
+  double residual_norm(const State& s) const;  // ‖V f‖ over free dofs
+
+  ForceOperator& op_;
+  QuasiStaticSettings settings_;
+  double end_ = 0.0, dt_min_ = 0.0, dt_max_ = 0.0;
+  std::optional<double> dt_initial_;
+  FreeDofs dofs_;
+  SparseCholesky factor_;
+  bool have_factor_ = false;
+  int factorisations_ = 0;
+  State trial_;
+  std::vector<double> rhs_, correction_;
+};
+
+}  // namespace pd

@@ -1,0 +1,86 @@
+// CHOLMOD behind SparseCholesky (see cholesky.hpp).
+#include "linalg/cholesky.hpp"
+
+#include <cholmod.h>
+
+#include <cstring>
+
+#include "core/error.hpp"
+
+namespace pd {
+
+struct SparseCholesky::Impl {
+  cholmod_common common;
+  cholmod_factor* factor = nullptr;
+  std::vector<std::int64_t> row_start, column;  // the pattern the factor was analysed for
+  Impl() {
+    cholmod_l_start(&common);
+    common.supernodal = CHOLMOD_SUPERNODAL;
+    common.print = 0;
+  }
+  ~Impl() {
+    if (factor) cholmod_l_free_factor(&factor, &common);
+    cholmod_l_finish(&common);
+  }
+};
+
+SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::~SparseCholesky() = default;
+
+bool SparseCholesky::factorize(const SparseMatrix& K) {
+  cholmod_common* cm = &impl_->common;
+  failure_.clear();
+  // A CSR matrix stored whole is its own CSC transpose: hand CHOLMOD the arrays as they are and
+  // let it read the upper triangle (stype = 1).
+  cholmod_sparse A;
+  std::memset(&A, 0, sizeof A);
+  A.nrow = A.ncol = static_cast<std::size_t>(K.rows);
+  A.nzmax = K.nonzeros();
+  A.p = const_cast<std::int64_t*>(K.row_start.data());
+  A.i = const_cast<std::int64_t*>(K.column.data());
+  A.x = const_cast<double*>(K.value.data());
+  A.stype = 1;
+  A.itype = CHOLMOD_LONG;
+  A.xtype = CHOLMOD_REAL;
+  A.dtype = CHOLMOD_DOUBLE;
+  A.sorted = 1;
+  A.packed = 1;
+  const bool same_pattern = impl_->factor && impl_->row_start == K.row_start && impl_->column == K.column;
+  if (!same_pattern) {
+    if (impl_->factor) cholmod_l_free_factor(&impl_->factor, cm);
+    impl_->factor = cholmod_l_analyze(&A, cm);
+    if (!impl_->factor) throw Error("CHOLMOD could not analyse the tangent matrix (status " + std::to_string(cm->status) + ")");
+    impl_->row_start = K.row_start;
+    impl_->column = K.column;
+    ++analyses_;
+  }
+  cholmod_l_factorize(&A, impl_->factor, cm);
+  if (cm->status == CHOLMOD_NOT_POSDEF || impl_->factor->minor < impl_->factor->n) {
+    failure_ = "the tangent is not positive definite at unknown " + std::to_string(impl_->factor->minor) + " of " +
+               std::to_string(impl_->factor->n);
+    return false;
+  }
+  if (cm->status < CHOLMOD_OK) throw Error("CHOLMOD failed to factorise the tangent (status " + std::to_string(cm->status) + ")");
+  factor_nonzeros_ = cm->lnz;
+  return true;
+}
+
+void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const {
+  cholmod_common* cm = &impl_->common;
+  cholmod_dense B;
+  std::memset(&B, 0, sizeof B);
+  B.nrow = b.size();
+  B.ncol = 1;
+  B.nzmax = b.size();
+  B.d = b.size();
+  B.x = const_cast<double*>(b.data());
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* X = cholmod_l_solve(CHOLMOD_A, impl_->factor, &B, cm);
+  if (!X) throw Error("CHOLMOD could not solve with the factorised tangent (status " + std::to_string(cm->status) + ")");
+  const auto* values = static_cast<const double*>(X->x);
+  x.assign(values, values + b.size());
+  cholmod_l_free_dense(&X, cm);
+}
+
+}  // namespace pd

@@ -1,0 +1,39 @@
+// Sparse Cholesky factorisation K = L Lᵀ of a symmetric positive definite matrix by CHOLMOD
+// (SuiteSparse, Debian's libsuitesparse-dev): supernodal, fill-reducing ordering (AMD, or METIS
+// nested dissection where CHOLMOD finds it better), the symbolic analysis kept and reused while
+// the sparsity pattern stays the same. The only code that calls CHOLMOD.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "linalg/sparse_matrix.hpp"
+
+namespace pd {
+
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  // Factorises K (its upper triangle is read). False when K is not positive definite (then
+  // failure() says at which column): a singular or indefinite tangent, e.g. a body free to move.
+  bool factorize(const SparseMatrix& K);
+  // x = K⁻¹ b with the last successful factorisation.
+  void solve(const std::vector<double>& b, std::vector<double>& x) const;
+
+  const std::string& failure() const { return failure_; }
+  int analyses() const { return analyses_; }            // symbolic analyses so far (orderings)
+  double factor_nonzeros() const { return factor_nonzeros_; }  // entries of L
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string failure_;
+  int analyses_ = 0;
+  double factor_nonzeros_ = 0.0;
+};
+
+}  // namespace pd
