@@ -45,6 +45,16 @@ void QuasiStatic::initialize(State& state, double t) {
   op_.evaluate(state, t);
   op_.update_work(state, t, 0.0);
   dofs_ = FreeDofs::of(state.size(), op_.model().nodes.dimension, op_.fixed());
+  // Equilibrium fixes u only up to the rigid motions nothing holds: a direction in which no node
+  // is prescribed is one (rotations are caught by the factorisation, singular then).
+  static const char* const axis[3] = {"x", "y", "z"};
+  for (int d = 0; d < op_.model().nodes.dimension; ++d) {
+    const auto& held = op_.fixed()[static_cast<std::size_t>(d)];
+    if (std::none_of(held.begin(), held.end(), [](std::uint8_t f) { return f != 0; }))
+      throw Error(std::string("time.integrator: quasi_static: the body can move freely in ") + axis[d] +
+                  " (no node has a displacement or velocity condition in " + axis[d] +
+                  "): quasi_static needs one, or use time.integrator: verlet");
+  }
   trial_ = State(state.size());
   report_ = StepReport{};
 }
@@ -89,8 +99,11 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     const double residual = residual_norm(s);
     if (!std::isfinite(residual)) return false;
     const double load = load_scale(s, t1);
-    // Equilibrium (and a correction below TOL, checked after the solve below).
-    if (k > 1 && residual <= settings_.residual_tol * load && omega <= settings_.tol) return true;
+    // Equilibrium: the residual below its tolerance and the last correction below TOL. Or the
+    // correction below TOL and the residual no longer falling: it is at the round-off floor of the
+    // stretches (about 1e-16/strain of the load), and no further iteration changes u.
+    if (k > 1 && omega <= settings_.tol && (residual <= settings_.residual_tol * load || residual >= 0.5 * previous))
+      return true;
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew.
     if (!have_factor_ || residual > 0.25 * previous) {

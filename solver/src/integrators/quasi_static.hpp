@@ -8,8 +8,9 @@
 // the first bond failure PMB is nearly linear, so one factorisation serves many steps); otherwise
 // the tangent is assembled and factorised again.
 //
-// Converged when ‖V f‖ ≤ residual_tol × the load (‖reactions‖ + ‖body forces‖) and
-// ω_K = ‖Δu‖/‖u_K − u_n‖ ≤ tol (eq. 2.6 for Newton's corrections). Then bonds over their critical
+// Converged when ω_K = ‖Δu‖/‖u_K − u_n‖ ≤ tol (eq. 2.6 for Newton's corrections) and either
+// ‖V f‖ ≤ residual_tol × the load (‖reactions‖ + ‖body forces‖) or the residual has stopped falling
+// (the round-off floor of the stretches, ~1e-16/strain of the load, above residual_tol at small strain). Then bonds over their critical
 // stretch break (thesis §2.2 rule) and the same load is solved again, until none breaks
 // (max_breaking_rounds: more is unstable crack growth, and the step fails). The next step is
 // Φ_K·Δt with Φ_K of eq. 2.8 (control/zohdi.hpp) from the last correction, not larger after a step

@@ -61,6 +61,13 @@ bool SparseCholesky::factorize(const SparseMatrix& K) {
     return false;
   }
   if (cm->status < CHOLMOD_OK) throw Error("CHOLMOD failed to factorise the tangent (status " + std::to_string(cm->status) + ")");
+  // A singular matrix (a free rigid motion) factorises in floating point with pivots at round-off
+  // level instead of failing: CHOLMOD's estimate of the reciprocal condition number tells.
+  const double rcond = cholmod_l_rcond(impl_->factor, cm);
+  if (!(rcond > kSingularRcond)) {
+    failure_ = "the tangent is singular to working precision (reciprocal condition estimate " + std::to_string(rcond) + ")";
+    return false;
+  }
   factor_nonzeros_ = cm->lnz;
   return true;
 }

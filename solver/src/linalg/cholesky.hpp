@@ -13,6 +13,10 @@ namespace pd {
 
 class SparseCholesky {
  public:
+  // Below this reciprocal condition estimate the matrix counts as singular (a rigid motion left
+  // free gives ~1e-16; a well-held body of 10⁶ nodes stays far above).
+  static constexpr double kSingularRcond = 1e-14;
+
   SparseCholesky();
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
