@@ -50,9 +50,12 @@ def check_set_names(case: dict, existing: list[str]):
 def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file: str) -> dict:
     """The dictionary written to case.json, in SI units with every default explicit."""
     check_set_names(case, node_sets)
+    # Every material key the case gives goes to the solver, which checks it against the model's
+    # declared parameters (solver/src/materials/<model>/): a new model needs no edit here. An
+    # optional key left out (None, e.g. no fracture_energy: unbreakable) is left out of case.json.
     blocks = [
         {"id": i + 1, "name": name, "model": m["model"], "density": m["density"],
-         "youngs_modulus": m["youngs_modulus"], "fracture_energy": m["fracture_energy"]}
+         **{key: value for key, value in m.items() if key not in ("model", "density") and value is not None}}
         for i, (name, m) in enumerate(case["materials"].items())
     ]
     boundary = []
