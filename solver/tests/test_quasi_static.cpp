@@ -198,3 +198,32 @@ TEST(SparseCholesky, SolvesAHeldChainAndRefusesAFreeOne) {
   EXPECT_FALSE(chol.factorize(chain(200, false)));  // free to translate: singular
   EXPECT_NE(chol.failure().find("not positive definite"), std::string::npos) << chol.failure();
 }
+
+TEST(QuasiStatic, DefiniteTangentLeavesOutOnlyTheCompressedBondsLateralStiffness) {
+  // A bar squeezed by 1 % along x: its y and z bonds stretch (no Poisson effect in the lattice
+  // without it) and its x bonds are in compression, whose lateral stiffness c s/y is negative.
+  pd::Model m = bar(0.0);
+  const pd::ForceOperator op(m);
+  pd::State s(m.nodes.size());
+  for (std::size_t i = 0; i < s.size(); ++i) s.u[0][i] = -1e-2 * m.nodes.x[0][i];
+  const pd::FreeDofs dofs = pd::FreeDofs::of(s.size(), 3, m.conditions.fixed);
+  const pd::SparseMatrix exact = op.assemble_stiffness(s, 0.0, dofs), definite = op.assemble_stiffness(s, 0.0, dofs, true);
+  ASSERT_EQ(exact.column, definite.column);  // the same pattern: one symbolic analysis serves both
+  double smallest = HUGE_VAL, differs = 0.0;
+  for (unsigned salt = 0; salt < 20; ++salt) {
+    const pd::Vec3Array v = pdtest::pseudo_random(s.size(), 100 + salt);
+    std::vector<double> x, kx;
+    dofs.gather(v, x);
+    definite.multiply(x, kx);
+    double xkx = 0.0, xx = 0.0;
+    for (std::size_t k = 0; k < x.size(); ++k) xkx += x[k] * kx[k], xx += x[k] * x[k];
+    smallest = std::min(smallest, xkx / xx);
+  }
+  for (std::size_t k = 0; k < exact.value.size(); ++k) differs = std::max(differs, std::fabs(exact.value[k] - definite.value[k]));
+  EXPECT_GT(smallest, 0.0);  // positive on every probe
+  EXPECT_GT(differs, 0.0);   // and not the exact tangent under compression
+  // In tension (every bond stretched or at rest) the two are the same.
+  for (std::size_t i = 0; i < s.size(); ++i) s.u[0][i] = 1e-3 * m.nodes.x[0][i], s.u[1][i] = 1e-3 * m.nodes.x[1][i],
+                                             s.u[2][i] = 1e-3 * m.nodes.x[2][i];
+  EXPECT_EQ(op.assemble_stiffness(s, 0.0, dofs).value, op.assemble_stiffness(s, 0.0, dofs, true).value);
+}

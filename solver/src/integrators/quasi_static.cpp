@@ -91,6 +91,16 @@ double QuasiStatic::load_scale(const State& s, double t) const {
   return std::sqrt(sum);
 }
 
+void QuasiStatic::shift_diagonal(SparseMatrix& K) const {
+  double largest = 0.0;
+  for (std::int64_t r = 0; r < K.rows; ++r)
+    for (std::int64_t q = K.row_start[static_cast<std::size_t>(r)]; q < K.row_start[static_cast<std::size_t>(r) + 1]; ++q)
+      if (K.column[static_cast<std::size_t>(q)] == r) largest = std::max(largest, std::fabs(K.value[static_cast<std::size_t>(q)]));
+  for (std::int64_t r = 0; r < K.rows; ++r)
+    for (std::int64_t q = K.row_start[static_cast<std::size_t>(r)]; q < K.row_start[static_cast<std::size_t>(r) + 1]; ++q)
+      if (K.column[static_cast<std::size_t>(q)] == r) K.value[static_cast<std::size_t>(q)] += kDiagonalShift * largest;
+}
+
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
   double previous = HUGE_VAL;
   for (int k = 1; k <= settings_.max_iterations; ++k) {
@@ -107,13 +117,27 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew.
     if (!have_factor_ || residual > 0.25 * previous) {
-      const SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_);
+      SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_);
       if (K.rows < 0)
         throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
                          "have; use time.integrator: verlet");
-      if (!factor_.factorize(K)) {
+      // Once bonds have broken, a node or a fragment may hang by nothing: its rows are zero and K
+      // is singular although the residual does not drive it. A shift of the diagonal by
+      // kDiagonalShift × its largest entry lets it be factorised; the residual, not K, decides
+      // convergence, so the equilibrium found is unchanged (a modified Newton iteration).
+      if (broken_since_start_) shift_diagonal(K);
+      bool factorised = factor_.factorize(K);
+      if (!factorised && broken_since_start_) {
+        // Indefinite after damage (compressed bonds lose their stiffness across their line, a node
+        // may hang by collinear bonds): the definite variant, shifted, still leads Newton to the
+        // same equilibrium.
+        K = op_.assemble_stiffness(s, t1, dofs_, true);
+        shift_diagonal(K);
+        factorised = factor_.factorize(K);
+      }
+      if (!factorised) {
         have_factor_ = false;
-        if (!std::isfinite(previous)) {  // at the first iteration: the body is not held
+        if (!std::isfinite(previous) && !broken_since_start_) {  // nothing broken: the body is not held
           throw StepFailed("the tangent stiffness is singular or indefinite (" + factor_.failure() +
                            "): the body can move freely or a part of it has come loose; quasi_static needs "
                            "displacement conditions that hold every body in every direction, or use "
@@ -166,6 +190,12 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
 void QuasiStatic::step(State& state, double& t, double& dt) {
   report_ = StepReport{};
   report_.force_evaluations = 0;
+  // From the bonds themselves, not a flag carried along: a restarted run (or a pre-cracked body)
+  // shifts its tangent exactly as the uninterrupted run does.
+  if (!broken_since_start_) {
+    const auto& broken = op_.model().bonds.broken;
+    broken_since_start_ = std::any_of(broken.begin(), broken.end(), [](std::uint8_t b) { return b != 0; });
+  }
   double h = std::min(dt, dt_max_);
   for (;;) {
     const double t1 = t + h;
@@ -184,6 +214,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       broke_total.broken += broke.broken;
       broke_total.energy += broke.energy;
       have_factor_ = false;  // the tangent lost bonds
+      broken_since_start_ = true;
       if (++rounds >= settings_.max_breaking_rounds)
         throw StepFailed("bonds kept breaking at t = " + number(t1) + " s through " + std::to_string(rounds) +
                          " re-solves at the same load (" + std::to_string(broke_total.broken) +
@@ -209,7 +240,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       report_.next_dt = std::max(std::min(next, dt_max_), dt_min_);
       return;
     }
-    // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved.
+    // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved. The
+    // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     have_factor_ = false;
     if (h <= dt_min_ * (1.0 + 1e-12))
       throw StepFailed("the quasi-static load step did not reach equilibrium at dt_min = " + number(dt_min_) +

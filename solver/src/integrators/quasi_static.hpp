@@ -47,6 +47,9 @@ class QuasiStatic : public Integrator {
   bool solve_equilibrium(State& trial, double t1, const Vec3Array& u_start, int& iterations, double& omega);
   double load_scale(const State& s, double t) const;
   double residual_norm(const State& s) const;  // ‖V f‖ over free dofs
+  void shift_diagonal(SparseMatrix& K) const;
+  static constexpr double kDiagonalShift = 1e-8;
+  bool broken_since_start_ = false;  // a bond has broken in this run (then K is shifted, see .cpp)
 
   ForceOperator& op_;
   QuasiStaticSettings settings_;

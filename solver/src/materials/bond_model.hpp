@@ -84,7 +84,11 @@ class BondModel {
   // blocks[9k..9k+8] = ∂f_i/∂u_j (row-major 3×3) for bond k of row i at u (zeros for a broken
   // bond); ∂f_i/∂u_i is minus their sum. Returns false for a law that has no such form (a
   // state-based one couples i with its neighbours' neighbours): solvers then stay matrix-free.
-  virtual bool bond_tangent_row(const Model& model, const Vec3Array& u, std::size_t i, double* blocks) const = 0;
+  // definite: leave out the (negative) stiffness of compressed bonds across their line, so that
+  // the assembled matrix is positive semi-definite — a Newton iteration with it still converges
+  // to the same equilibrium, only no longer quadratically (the residual decides, not the matrix).
+  virtual bool bond_tangent_row(const Model& model, const Vec3Array& u, std::size_t i, double* blocks,
+                                bool definite = false) const = 0;
 };
 
 // What the registry holds per model: its parameters (the reader checks them and --describe prints

@@ -44,7 +44,7 @@ void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x,
   for (const auto& term : terms_) term->add_jacobian_product(s, t, x, y);
 }
 
-SparseMatrix ForceOperator::assemble_stiffness(const State& s, double t, const FreeDofs& dofs) const {
+SparseMatrix ForceOperator::assemble_stiffness(const State& s, double t, const FreeDofs& dofs, bool definite) const {
   const Model& m = model_;
   const auto n = static_cast<std::int64_t>(m.nodes.size());
   SparseMatrix K;
@@ -83,7 +83,7 @@ SparseMatrix ForceOperator::assemble_stiffness(const State& s, double t, const F
       if (free_of[i] == 0) continue;
       const std::int64_t bonds = off[i + 1] - off[i];
       blocks.assign(static_cast<std::size_t>(9 * bonds), 0.0);
-      m.bond_model->bond_tangent_row(m, s.u, i, blocks.data());
+      m.bond_model->bond_tangent_row(m, s.u, i, blocks.data(), definite);
       double diagonal[9] = {};
       for (std::int64_t b = 0; b < bonds; ++b)
         for (int q = 0; q < 9; ++q) diagonal[q] -= blocks[static_cast<std::size_t>(9 * b + q)];

@@ -46,7 +46,8 @@ class ForceOperator {
   // included as zeros so that the pattern stays that of the first assembly (a factorisation's
   // ordering is reused). Empty (rows = −1) when the material or an active term has no assembled
   // form (a state-based law, contact): a solver then stays matrix-free.
-  SparseMatrix assemble_stiffness(const State& s, double t, const FreeDofs& dofs) const;
+  // definite: the material's positive semi-definite variant (materials/bond_model.hpp).
+  SparseMatrix assemble_stiffness(const State& s, double t, const FreeDofs& dofs, bool definite = false) const;
 
   // Prescribed motion. impose: u and v of every prescribed component at t.
   void impose_prescribed_motion(State& s, double t) const;

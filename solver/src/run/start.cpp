@@ -20,36 +20,36 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
   Integrator& integrator = *p.integrator;
   const std::size_t n = model.nodes.size();
-  Checkpoint ck = read_checkpoint(opt.restart);
+  Checkpoint checkpoint = read_checkpoint(opt.restart);
   const std::string where = opt.restart.string() + ": ";
-  if (ck.case_hash != s.case_hash)
+  if (checkpoint.case_hash != s.case_hash)
     throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
                 " changed since it was written); restart with the case.json it was written for");
-  if (ck.nodes_hash != s.nodes_hash)
+  if (checkpoint.nodes_hash != s.nodes_hash)
     throw Error(where + "the checkpoint belongs to another node file (or " + p.c.nodes_file.string() +
                 " changed since it was written)");
-  if (ck.nodes != n || ck.directed_bonds != model.bonds.directed() || ck.broken_flags.size() != model.bonds.directed() ||
-      ck.integrator != integrator.name() ||
-      (model.contact.pairs && ck.contact_rebuilds > 0 && ck.contact_u_build[0].size() != n))
-    throw Error(where + "the checkpoint does not fit this model (" + std::to_string(ck.nodes) + " nodes, " +
-                std::to_string(ck.directed_bonds / 2) + " bonds, integrator " + ck.integrator + "; here " +
+  if (checkpoint.nodes != n || checkpoint.directed_bonds != model.bonds.directed() || checkpoint.broken_flags.size() != model.bonds.directed() ||
+      checkpoint.integrator != integrator.name() ||
+      (model.contact.pairs && checkpoint.contact_rebuilds > 0 && checkpoint.contact_u_build[0].size() != n))
+    throw Error(where + "the checkpoint does not fit this model (" + std::to_string(checkpoint.nodes) + " nodes, " +
+                std::to_string(checkpoint.directed_bonds / 2) + " bonds, integrator " + checkpoint.integrator + "; here " +
                 std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator.name() + ")");
-  if (ck.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
+  if (checkpoint.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
   // initialize() sizes the integrator's scratch; then everything it set is replaced by the
   // checkpoint, so the run continues bitwise as if it had never stopped.
-  integrator.initialize(s.state, ck.loop.t);
-  s.state = std::move(ck.state);  // moved: a restarted run holds one copy of the state
-  model.bonds.broken = std::move(ck.broken_flags);
+  integrator.initialize(s.state, checkpoint.loop.t);
+  s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
+  model.bonds.broken = std::move(checkpoint.broken_flags);
   if (model.contact.pairs)
-    model.contact_list.restore(model.nodes.x, ck.contact_u_build, model.block_index, model.contact, ck.contact_rebuilds,
-                               ck.contact_seconds);
+    model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
+                               checkpoint.contact_seconds);
   try {
-    integrator.load_state(ck.integrator_state);
+    integrator.load_state(checkpoint.integrator_state);
   } catch (const std::exception& e) {
     throw Error(where + e.what());
   }
-  s.loop = ck.loop;
-  s.resume = OutputResume{std::move(ck.frame_times), ck.history_bytes};
+  s.loop = checkpoint.loop;
+  s.resume = OutputResume{std::move(checkpoint.frame_times), checkpoint.history_bytes};
 }
 
 }  // namespace

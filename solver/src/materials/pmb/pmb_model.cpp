@@ -1,4 +1,5 @@
 // PmbModel: PMB behind the BondModel interface, its linearisation, and its registry entry.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -89,7 +90,8 @@ namespace {
 // ∂f_i/∂u_j of one intact bond at the current state (row-major 3×3):
 //   c ν V_j·[(1/|ξ|)·n nᵀ + (s/y)·(I − n nᵀ)],  n = e/y, e = y_j − y_i.
 // A bond crushed to a point (y = 0) has no direction: the kernel gives it no force, and no stiffness here.
-inline void bond_block(double c_vj, double length, double e0, double e1, double e2, double block[9]) {
+inline void bond_block(double c_vj, double length, double e0, double e1, double e2, double block[9],
+                       bool definite = false) {
   const double len_y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
   if (!(len_y > 0.0)) {
     for (int q = 0; q < 9; ++q) block[q] = 0.0;
@@ -98,7 +100,7 @@ inline void bond_block(double c_vj, double length, double e0, double e1, double 
   const double n[3] = {e0 / len_y, e1 / len_y, e2 / len_y};
   const double raw_s = (len_y - length) / length;
   const double s = std::fabs(raw_s) > kStretchZero ? raw_s : 0.0;  // as the kernel (thesis §2.2)
-  const double axial = c_vj / length, lateral = c_vj * s / len_y;
+  const double axial = c_vj / length, lateral = c_vj * (definite ? std::max(s, 0.0) : s) / len_y;
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) block[3 * a + b] = (axial - lateral) * n[a] * n[b] + (a == b ? lateral : 0.0);
 }
@@ -136,7 +138,8 @@ void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Ve
   }
 }
 
-bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t i, double* blocks) const {
+bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t i, double* blocks,
+                                bool definite) const {
   const auto nb = static_cast<std::size_t>(m.material.blocks);
   const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
   const auto& X = m.nodes.x;
@@ -152,7 +155,8 @@ bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t 
     const double length = bond_length(X, i, j);
     const double c_vj = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] *
                         m.nodes.volume[j] * m.bonds.volume_weight(length);
-    bond_block(c_vj, length, (X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2, b);
+    bond_block(c_vj, length, (X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2, b,
+               definite);
   }
   return true;
 }
