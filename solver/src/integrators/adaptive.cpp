@@ -10,18 +10,9 @@
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
+#include "integrators/messages.hpp"
 
 namespace pd {
-
-namespace {
-
-std::string number(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", value);
-  return buffer;
-}
-
-}  // namespace
 
 void AdaptiveStep::configure(const Case& c, double dt_exact_known) {
   settings_ = c.adaptive;
@@ -46,8 +37,8 @@ void AdaptiveStep::configure(const Case& c, double dt_exact_known) {
   // The reader checks dt_min ≤ dt_max when both are given; a default Δt_max can still fall below a
   // given dt_min, and then the first rejected attempt would end the run.
   if (dt_min_ > dt_max_)
-    throw Error(c.file.string() + ": adaptive.dt_min = " + number(dt_min_) + " s is above the default dt_max = " +
-                number(dt_max_) + " s (eq. 2.5 and the contraction limit of the fixed-point iteration); lower "
+    throw Error(c.file.string() + ": adaptive.dt_min = " + message_number(dt_min_) + " s is above the default dt_max = " +
+                message_number(dt_max_) + " s (eq. 2.5 and the contraction limit of the fixed-point iteration); lower "
                 "adaptive.dt_min or give adaptive.dt_max");
 }
 
@@ -192,10 +183,10 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
     // Rejected (Z > 1 at K_d, or diverging): redo from t with a smaller step.
     if (h <= dt_min_ * (1.0 + 1e-12)) {
       report_.iterations = std::min(k, kd);
-      throw StepFailed("the adaptive step did not converge at dt_min = " + number(dt_min_) + " s (t = " + number(t) +
+      throw StepFailed("the adaptive step did not converge at dt_min = " + message_number(dt_min_) + " s (t = " + message_number(t) +
                        " s, " + std::to_string(report_.rejected + 1) + " attempts" +
                        (diverged ? ", the fixed-point iteration diverged" : "") +
-                       "); the motion is too violent for TOL = " + number(tol) +
+                       "); the motion is too violent for TOL = " + message_number(tol) +
                        " at this dt_min: raise adaptive.tol, lower adaptive.dt_min, or look for a load or "
                        "contact that makes the state jump");
     }

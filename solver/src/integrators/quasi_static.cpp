@@ -8,18 +8,9 @@
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
+#include "integrators/messages.hpp"
 
 namespace pd {
-
-namespace {
-
-std::string number(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", value);
-  return buffer;
-}
-
-}  // namespace
 
 void QuasiStatic::configure(const Case& c, double) {
   settings_ = c.quasi_static;
@@ -28,8 +19,8 @@ void QuasiStatic::configure(const Case& c, double) {
   dt_min_ = settings_.dt_min.value_or(std::min(1e-9 * end_, dt_max_));
   dt_initial_ = std::min(settings_.dt_initial.value_or(end_ / 100.0), dt_max_);
   if (dt_min_ > dt_max_)
-    throw Error(c.file.string() + ": quasi_static.dt_min = " + number(dt_min_) + " s is above dt_max = " +
-                number(dt_max_) + " s");
+    throw Error(c.file.string() + ": quasi_static.dt_min = " + message_number(dt_min_) + " s is above dt_max = " +
+                message_number(dt_max_) + " s");
   if (op_.damping() != 0.0)
     throw Error(c.file.string() + ": damping: quasi_static solves for equilibrium, where damping does nothing; "
                 "set damping: 0 (or use time.integrator: verlet)");
@@ -216,7 +207,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       have_factor_ = false;  // the tangent lost bonds
       broken_since_start_ = true;
       if (++rounds >= settings_.max_breaking_rounds)
-        throw StepFailed("bonds kept breaking at t = " + number(t1) + " s through " + std::to_string(rounds) +
+        throw StepFailed("bonds kept breaking at t = " + message_number(t1) + " s through " + std::to_string(rounds) +
                          " re-solves at the same load (" + std::to_string(broke_total.broken) +
                          " bonds): the crack grows unstably, which a quasi-static solve cannot follow; use "
                          "time.integrator: verlet (or raise quasi_static.max_breaking_rounds)");
@@ -244,9 +235,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     have_factor_ = false;
     if (h <= dt_min_ * (1.0 + 1e-12))
-      throw StepFailed("the quasi-static load step did not reach equilibrium at dt_min = " + number(dt_min_) +
-                       " s (t = " + number(t) + " s, " + std::to_string(report_.rejected + 1) +
-                       " attempts, last correction ω = " + number(omega) + "); the load may exceed what the "
+      throw StepFailed("the quasi-static load step did not reach equilibrium at dt_min = " + message_number(dt_min_) +
+                       " s (t = " + message_number(t) + " s, " + std::to_string(report_.rejected + 1) +
+                       " attempts, last correction ω = " + message_number(omega) + "); the load may exceed what the "
                        "body can carry (unstable fracture or buckling): use time.integrator: verlet, or raise "
                        "quasi_static.max_iterations");
     ++report_.rejected;
@@ -255,10 +246,10 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
 }
 
 std::vector<std::string> QuasiStatic::describe(double) const {
-  return {"quasi_static: Newton with line search to residual " + number(settings_.residual_tol) +
-          " × the load and correction TOL " + number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
-          number(settings_.p) + "; tangent factorised by CHOLMOD; load steps dt_initial " + number(dt_initial_.value_or(0.0)) + " s, dt_min " + number(dt_min_) +
-          " s, dt_max " + number(dt_max_) + " s"};
+  return {"quasi_static: Newton with line search to residual " + message_number(settings_.residual_tol) +
+          " × the load and correction TOL " + message_number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
+          message_number(settings_.p) + "; tangent factorised by CHOLMOD; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
+          " s, dt_max " + message_number(dt_max_) + " s"};
 }
 
 }  // namespace pd

@@ -1,0 +1,14 @@
+// How integrators print numbers in their messages and run.log lines: six significant digits.
+#pragma once
+#include <cstdio>
+#include <string>
+
+namespace pd {
+
+inline std::string message_number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+
+}  // namespace pd
