@@ -213,7 +213,8 @@ CASE = {
                                 minimum=1, maximum=100000000),
         dt_initial=Key("number", "the first load step (default: end/100)", default=None, unit="s",
                        above=0.0),
-        dt_min=Key("number", "smallest load step (default: 1e-9 × end)", default=None, unit="s",
+        dt_min=Key("number", "smallest load step (default: 1e-6 × end: some ten halvings below "
+                   "end/100)", default=None, unit="s",
                    above=0.0),
         dt_max=Key("number", "largest load step (default: end/10)", default=None, unit="s", above=0.0),
     ),

@@ -53,7 +53,7 @@ struct QuasiStaticSettings {
   double p = 2.0;              // exponent of eq. 2.8
   int max_iterations = 30;     // Newton iterations before the load step is cut
   int max_breaking_rounds = 100;  // re-solves at one load while bonds keep breaking, then unstable
-  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-9, end/10
+  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-6, end/10
 };
 
 struct OutputSettings {

@@ -16,7 +16,7 @@ void QuasiStatic::configure(const Case& c, double) {
   settings_ = c.quasi_static;
   end_ = c.time.end;
   dt_max_ = settings_.dt_max.value_or(end_ / 10.0);
-  dt_min_ = settings_.dt_min.value_or(std::min(1e-9 * end_, dt_max_));
+  dt_min_ = settings_.dt_min.value_or(std::min(1e-6 * end_, dt_max_));
   dt_initial_ = std::min(settings_.dt_initial.value_or(end_ / 100.0), dt_max_);
   if (dt_min_ > dt_max_)
     throw Error(c.file.string() + ": quasi_static.dt_min = " + message_number(dt_min_) + " s is above dt_max = " +
