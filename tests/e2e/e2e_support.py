@@ -19,3 +19,18 @@ def new_case_folder(tmp_path_factory, work_name: str, case_name: str):
     case_dir = work / "cases" / case_name
     case_dir.mkdir(parents=True)
     return work, case_dir
+
+
+def run_stages(yaml_path, geo_path, out):
+    """The Makefile's stages on one case, in order: mesh, preprocess, solve, postprocess; each must
+    exit 0 (the failure names the stage and shows its output)."""
+    import subprocess
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    for args in (
+        (PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(geo_path), str(out / "mesh.msh")),
+        (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
+        (SOLVER, str(out / "case.json"), "--quiet"),
+        (PY, "-m", "postprocess", str(out)),
+    ):
+        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"

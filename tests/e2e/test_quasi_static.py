@@ -6,13 +6,12 @@ displacement."""
 import csv
 import os
 import shutil
-import subprocess
 
 import numpy as np
 import pytest
 import yaml
 
-from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
+from e2e_support import ROOT, new_case_folder, run_stages  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -27,15 +26,7 @@ def quasi_static_run(tmp_path_factory):
     yaml_path = case_dir / "quasi_static.yaml"
     yaml_path.write_text(yaml.safe_dump(case))
     out = work / "out" / "traction-quasi_static"
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    for args in (
-        (PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(case_dir / "traction.geo"), str(out / "mesh.msh")),
-        (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
-        (SOLVER, str(out / "case.json"), "--quiet"),
-        (PY, "-m", "postprocess", str(out)),
-    ):
-        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
-        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+    run_stages(yaml_path, case_dir / "traction.geo", out)
     return out
 
 
