@@ -48,9 +48,7 @@ void AdaptiveStep::initialize(State& state, double t) {
     defaults.time.end = 1.0;
     configure(defaults);
   }
-  op_.impose_prescribed_motion(state, t);
-  op_.evaluate(state, t);
-  op_.update_work(state, t, 0.0);
+  op_.start(state, t);
   const std::size_t n = state.size();
   trial_ = State(n);
   u_new_ = make_vec3(n);

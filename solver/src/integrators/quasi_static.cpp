@@ -27,14 +27,7 @@ void QuasiStatic::configure(const Case& c, double) {
 }
 
 void QuasiStatic::initialize(State& state, double t) {
-  if (dt_max_ <= 0.0) {  // not configured (tests that build it bare): the defaults
-    Case defaults;
-    defaults.time.end = 1.0;
-    configure(defaults);
-  }
-  op_.impose_prescribed_motion(state, t);
-  op_.evaluate(state, t);
-  op_.update_work(state, t, 0.0);
+  op_.start(state, t);
   dofs_ = FreeDofs::of(state.size(), op_.model().nodes.dimension, op_.fixed());
   // Equilibrium fixes u only up to the rigid motions nothing holds: a direction in which no node
   // is prescribed is one (rotations are caught by the factorisation, singular then).

@@ -6,9 +6,7 @@
 namespace pd {
 
 void VelocityVerlet::initialize(State& state, double t) {
-  op_.impose_prescribed_motion(state, t);
-  op_.evaluate(state, t);
-  op_.update_work(state, t, 0.0);
+  op_.start(state, t);
   report_ = StepReport{};
 }
 

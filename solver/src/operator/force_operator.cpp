@@ -116,6 +116,12 @@ SparseMatrix ForceOperator::assemble_stiffness(const State& s, double t, const F
   return K;
 }
 
+void ForceOperator::start(State& s, double t) const {
+  impose_prescribed_motion(s, t);
+  evaluate(s, t);
+  update_work(s, t, 0.0);
+}
+
 void ForceOperator::impose_prescribed_motion(State& s, double t) const {
   for (const auto& p : model_.conditions.prescribed) {
     auto& u = s.u[static_cast<std::size_t>(p.component)];

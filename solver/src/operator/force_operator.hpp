@@ -49,6 +49,10 @@ class ForceOperator {
   // definite: the material's positive semi-definite variant (materials/bond_model.hpp).
   SparseMatrix assemble_stiffness(const State& s, double t, const FreeDofs& dofs, bool definite = false) const;
 
+  // What every integrator does first: the prescribed motion at t, then the force and the powers
+  // there (the work ledger starts from them).
+  void start(State& s, double t) const;
+
   // Prescribed motion. impose: u and v of every prescribed component at t.
   void impose_prescribed_motion(State& s, double t) const;
   // Prescribed components over a step t → t1 = t + dt: u_to = their u at t1 (a displacement table)
