@@ -163,8 +163,10 @@ CASE = {
         integrator=Key("choice", "time integrator: verlet (velocity Verlet, thesis eq. 2.4), adaptive "
                        "(the mixed explicit–implicit step of thesis §2.2, settings in adaptive:) or "
                        "quasi_static (time is a load parameter: equilibrium by Newton at every load step, "
-                       "settings in quasi_static:)",
-                       default="verlet", choices=("verlet", "adaptive", "quasi_static")),
+                       "settings in quasi_static:) or mixed (quasi-static load steps while the body is in "
+                       "equilibrium, Verlet at time.dt while a crack runs, switching both ways by itself; "
+                       "settings in mixed: and quasi_static:)",
+                       default="verlet", choices=("verlet", "adaptive", "quasi_static", "mixed")),
         dt=Key("number_or_choice", "time step: 'stable' (thesis eq. 2.5, minimised over nodes, times "
                "safety_factor), 'exact' (2/ω_max, ω_max² the largest eigenvalue of the linearised PMB "
                "operator M⁻¹K, times safety_factor: about 1.7× 'stable' in 2D, 2× in 3D), or a number; "
@@ -217,6 +219,22 @@ CASE = {
                    "end/100)", default=None, unit="s",
                    above=0.0),
         dt_max=Key("number", "largest load step (default: end/10)", default=None, unit="s", above=0.0),
+    ),
+    "mixed": section(
+        "the mixed scheme (time.integrator: mixed): quasi-static load steps (the quasi_static "
+        "section) while the body is in equilibrium, explicit Verlet steps of time.dt while it is not; "
+        "time is physical, so the boundary conditions are loading rates; history.csv's mode column is "
+        "1 for a quasi-static step, 0 for an explicit one, and run.log says every switch",
+        unstable_rounds=Key("integer", "to explicit when a load step needs more re-solves than this "
+                            "while bonds keep breaking (unstable crack growth), or does not converge "
+                            "down to quasi_static.dt_min (default there: 10 explicit steps)",
+                            default=3, minimum=1, maximum=100000000),
+        kinetic_fraction=Key("number", "back to quasi-static when the kinetic energy has stayed below "
+                             "this fraction of the strain energy ...", default=0.05, above=0.0,
+                             below=1.0),
+        arrest_steps=Key("integer", "... for this many explicit steps in a row without a bond breaking "
+                         "(the crack arrested); the kinetic energy left is given up, as damping work",
+                         default=200, minimum=1, maximum=1000000000),
     ),
     "output": section(
         "what the solver writes and how often",

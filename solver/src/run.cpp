@@ -20,7 +20,7 @@ int run(const RunOptions& opt) {
   Start s = start_or_restore(opt, p);
 
   // Output starts here.
-  const HistoryColumns columns(p.model, p.c);
+  const HistoryColumns columns(p.model, p.c, p.integrator.get());
   OutputWriter out = open_output(opt, p, s, columns);
   // A checkpoint of an earlier run would not match the frames this run writes.
   if (!s.restarting) std::filesystem::remove(checkpoint_path(p.c));

@@ -183,7 +183,7 @@ TEST(CaseFile, RejectsBadValuesNamingTheKey) {
   expect_case_error("\"dt_min\": null, \"dt_max\": null", "\"dt_min\": 1.0, \"dt_max\": 0.5", {"adaptive.dt_min: is larger than adaptive.dt_max"});
   expect_case_error("\"p\": 3.0", "\"p\": 3.0, \"pp\": 1", {"adaptive.pp: unknown key (did you mean 'p'?)"});
   expect_case_error("\"dt\": \"stable\"", "\"dt\": -1e-6", {"time.dt: must be > 0"});
-  expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: adaptive, quasi_static, verlet"});
+  expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: adaptive, mixed, quasi_static, verlet"});
   expect_case_error("\"analysis\": \"plane_stress\"", "\"analysis\": \"planar\"", {"analysis: unknown analysis 'planar'; known: 3d, plane_strain, plane_stress"});
   expect_case_error("\"analysis\": \"plane_stress\"", "\"analysis\": \"3d\"", {"analysis: '3d' does not fit dimension 2"});
   expect_case_error("\"density\": 1200.0", "\"density\": \"heavy\"", {"blocks[0].density: must be a number"});

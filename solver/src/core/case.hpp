@@ -56,6 +56,14 @@ struct QuasiStaticSettings {
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-6, end/10
 };
 
+// mixed: quasi-static load steps while the body is in equilibrium, Verlet while a crack runs
+// (integrators/mixed.hpp); the quasi_static section sets the load steps, time.dt the explicit ones.
+struct MixedSettings {
+  int unstable_rounds = 3;         // re-solves at one load while bonds break, then explicit
+  double kinetic_fraction = 0.05;  // back to quasi-static once kinetic < this × strain energy ...
+  std::int64_t arrest_steps = 200;  // ... for this many explicit steps without a bond breaking
+};
+
 struct OutputSettings {
   std::optional<double> every_time;        // s
   std::optional<std::int64_t> every_steps;
@@ -114,6 +122,7 @@ struct Case {
   TimeSettings time;
   AdaptiveSettings adaptive;
   QuasiStaticSettings quasi_static;
+  MixedSettings mixed;
   OutputSettings output;
 };
 

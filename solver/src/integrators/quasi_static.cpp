@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
@@ -85,6 +86,67 @@ void QuasiStatic::shift_diagonal(SparseMatrix& K) const {
       if (K.column[static_cast<std::size_t>(q)] == r) K.value[static_cast<std::size_t>(q)] += kDiagonalShift * largest;
 }
 
+bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool shifted) {
+  SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, definite);
+  if (K.rows < 0)
+    throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
+                     "have; use time.integrator: verlet");
+  if (shifted) shift_diagonal(K);
+  have_factor_ = factor_.factorize(K);
+  if (!have_factor_) return false;
+  ++factorisations_;
+  factor_u_ = s.u;
+  factor_t_ = t1;
+  factor_definite_ = definite;
+  factor_shifted_ = shifted;
+  return true;
+}
+
+void QuasiStatic::limit(int max_breaking_rounds, double dt_min) {
+  settings_.max_breaking_rounds = max_breaking_rounds;
+  dt_min_ = std::min(dt_min, dt_max_);
+}
+
+std::vector<char> QuasiStatic::save_state() const {
+  std::vector<char> bytes = Integrator::save_state();
+  auto put = [&bytes](const auto& value) {
+    const auto* p = reinterpret_cast<const char*>(&value);
+    bytes.insert(bytes.end(), p, p + sizeof value);
+  };
+  const std::uint8_t have = have_factor_ ? 1 : 0, definite = factor_definite_ ? 1 : 0, shifted = factor_shifted_ ? 1 : 0;
+  put(have), put(definite), put(shifted), put(factor_t_), put(factorisations_);
+  if (have_factor_)
+    for (const auto& component : factor_u_)
+      bytes.insert(bytes.end(), reinterpret_cast<const char*>(component.data()),
+                   reinterpret_cast<const char*>(component.data() + component.size()));
+  return bytes;
+}
+
+void QuasiStatic::load_state(const std::vector<char>& bytes) {
+  constexpr std::size_t fixed_part = 3 + sizeof(double) + sizeof(int);
+  if (bytes.size() < kReportBytes + fixed_part) throw std::runtime_error("integrator state of the wrong size");
+  const std::size_t n = op_.size();
+  const bool have = bytes[kReportBytes] != 0;
+  const std::size_t extra = fixed_part + (have ? 3 * n * sizeof(double) : 0);
+  load_report(std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes)), 0);
+  if (bytes.size() != kReportBytes + extra) throw std::runtime_error("integrator state of the wrong size");
+  const char* at = bytes.data() + kReportBytes + 1;
+  const bool definite = *at++ != 0, shifted = *at++ != 0;
+  double t = 0.0;
+  int factorisations = 0;
+  std::memcpy(&t, at, sizeof t), at += sizeof t;
+  std::memcpy(&factorisations, at, sizeof factorisations), at += sizeof factorisations;
+  have_factor_ = false;
+  if (have) {
+    State s(n);
+    for (auto& component : s.u) std::memcpy(component.data(), at, n * sizeof(double)), at += n * sizeof(double);
+    // Needs the bonds of the checkpoint (restored before load_state, run/start.cpp).
+    if (!factorize_at(s, t, definite, shifted))
+      throw std::runtime_error("the saved tangent could not be factorised again");
+  }
+  factorisations_ = factorisations;
+}
+
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
   double previous = HUGE_VAL;
   for (int k = 1; k <= settings_.max_iterations; ++k) {
@@ -101,23 +163,16 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew.
     if (!have_factor_ || residual > 0.25 * previous) {
-      SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_);
-      if (K.rows < 0)
-        throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
-                         "have; use time.integrator: verlet");
       // Once bonds have broken, a node or a fragment may hang by nothing: its rows are zero and K
       // is singular although the residual does not drive it. A shift of the diagonal by
       // kDiagonalShift × its largest entry lets it be factorised; the residual, not K, decides
       // convergence, so the equilibrium found is unchanged (a modified Newton iteration).
-      if (broken_since_start_) shift_diagonal(K);
-      bool factorised = factor_.factorize(K);
+      bool factorised = factorize_at(s, t1, false, broken_since_start_);
       if (!factorised && broken_since_start_) {
         // Indefinite after damage (compressed bonds lose their stiffness across their line, a node
         // may hang by collinear bonds): the definite variant, shifted, still leads Newton to the
         // same equilibrium.
-        K = op_.assemble_stiffness(s, t1, dofs_, true);
-        shift_diagonal(K);
-        factorised = factor_.factorize(K);
+        factorised = factorize_at(s, t1, true, true);
       }
       if (!factorised) {
         have_factor_ = false;
@@ -129,8 +184,6 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
         }
         return false;
       }
-      have_factor_ = true;
-      ++factorisations_;
     }
     previous = residual;
     // K Δu = V f at the free components.
@@ -173,6 +226,7 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
 
 void QuasiStatic::step(State& state, double& t, double& dt) {
   report_ = StepReport{};
+  failure_reason_.clear();
   report_.force_evaluations = 0;
   // From the bonds themselves, not a flag carried along: a restarted run (or a pre-cracked body)
   // shifts its tangent exactly as the uninterrupted run does.
@@ -199,11 +253,14 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       broke_total.energy += broke.energy;
       have_factor_ = false;  // the tangent lost bonds
       broken_since_start_ = true;
-      if (++rounds >= settings_.max_breaking_rounds)
+      if (++rounds >= settings_.max_breaking_rounds) {
+        failure_reason_ = "bonds kept breaking through " + std::to_string(rounds) + " re-solves at one load (" +
+                          std::to_string(broke_total.broken) + " bonds): unstable crack growth";
         throw StepFailed("bonds kept breaking at t = " + message_number(t1) + " s through " + std::to_string(rounds) +
                          " re-solves at the same load (" + std::to_string(broke_total.broken) +
                          " bonds): the crack grows unstably, which a quasi-static solve cannot follow; use "
                          "time.integrator: verlet (or raise quasi_static.max_breaking_rounds)");
+      }
     }
     if (converged) {
       // Accepted: the mean velocity over the load step, the force and the work at t1.
@@ -227,12 +284,15 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved. The
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     have_factor_ = false;
-    if (h <= dt_min_ * (1.0 + 1e-12))
+    if (h <= dt_min_ * (1.0 + 1e-12)) {
+      failure_reason_ = "no equilibrium at the smallest load step " + message_number(dt_min_) + " s (last correction ω = " +
+                        message_number(omega) + ")";
       throw StepFailed("the quasi-static load step did not reach equilibrium at dt_min = " + message_number(dt_min_) +
                        " s (t = " + message_number(t) + " s, " + std::to_string(report_.rejected + 1) +
                        " attempts, last correction ω = " + message_number(omega) + "); the load may exceed what the "
                        "body can carry (unstable fracture or buckling): use time.integrator: verlet, or raise "
                        "quasi_static.max_iterations");
+    }
     ++report_.rejected;
     h = std::max(0.5 * h, dt_min_);
   }

@@ -37,9 +37,25 @@ class QuasiStatic : public Integrator {
   bool controls_step() const override { return true; }
   std::optional<double> initial_dt() const override { return dt_initial_; }
 
+  // The factorisation in use, if any, is saved as where it was assembled (u, t and how), and
+  // load_state() assembles and factorises it again there: CHOLMOD gives the same factor for the
+  // same matrix, so a restarted run reuses it exactly as the uninterrupted run does (bitwise).
+  std::vector<char> save_state() const override;
+  void load_state(const std::vector<char>& bytes) override;
+
   // Work of the whole run, for run.log and the tests.
   int factorisations() const { return factorisations_; }
   const QuasiStaticSettings& settings() const { return settings_; }
+
+  // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
+  // A step needing more than max_breaking_rounds re-solves, or not converging at dt_min, fails.
+  void limit(int max_breaking_rounds, double dt_min);
+  // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
+  void forget_factorisation() { have_factor_ = false; }
+  // Why the last step() threw StepFailed, in a few words for run.log.
+  const std::string& failure_reason() const { return failure_reason_; }
+  double dt_min() const { return dt_min_; }
+  double dt_max() const { return dt_max_; }
 
  private:
   // Newton at load t1 from state.u (prescribed components already at t1). True when converged;
@@ -59,6 +75,13 @@ class QuasiStatic : public Integrator {
   SparseCholesky factor_;
   bool have_factor_ = false;
   int factorisations_ = 0;
+  // Where the factorisation in use was assembled (for save_state): u, t, and whether the definite
+  // variant and the diagonal shift were used.
+  Vec3Array factor_u_;
+  double factor_t_ = 0.0;
+  bool factor_definite_ = false, factor_shifted_ = false;
+  bool factorize_at(const State& s, double t1, bool definite, bool shifted);
+  std::string failure_reason_;
   State trial_;
   std::vector<double> rhs_, correction_;
 };

@@ -303,6 +303,21 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
   return q;
 }
 
+// The mixed section (integrators/mixed.hpp).
+MixedSettings read_mixed(const Checker& ck, const json& j) {
+  ck.object(j, "mixed");
+  ck.known_keys(j, "mixed", case_keys().at("mixed"));
+  MixedSettings m;
+  if (const json* v = ck.optional(j, "unstable_rounds"))
+    m.unstable_rounds = static_cast<int>(ck.integer(*v, "mixed.unstable_rounds", 1, 100000000));
+  if (const json* v = ck.optional(j, "kinetic_fraction")) {
+    m.kinetic_fraction = ck.positive(*v, "mixed.kinetic_fraction");
+    if (!(m.kinetic_fraction < 1.0)) ck.fail("mixed.kinetic_fraction", "must be below 1 (a fraction of the strain energy), got " + show(*v));
+  }
+  if (const json* v = ck.optional(j, "arrest_steps")) m.arrest_steps = ck.integer(*v, "mixed.arrest_steps", 1, 1000000000);
+  return m;
+}
+
 // The adaptive section (integrators/adaptive.hpp): every value in the range the scheme needs.
 AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
   ck.object(j, "adaptive");
@@ -337,7 +352,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "output", "figures", "partial_volume", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "mixed", "output", "figures", "partial_volume", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -347,6 +362,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
       {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "dt_initial", "dt_min",
                         "dt_max"}},
+      {"mixed", {"unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
                   "restart_every_steps"}},
@@ -456,6 +472,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
 
   if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) c.adaptive = read_adaptive(ck, *j);
   if (const json* j = ck.optional(root, "quasi_static"); j && !j->is_null()) c.quasi_static = read_quasi_static(ck, *j);
+  if (const json* j = ck.optional(root, "mixed"); j && !j->is_null()) c.mixed = read_mixed(ck, *j);
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 
   const json& output = ck.object(ck.required(root, "output", "output"), "output");

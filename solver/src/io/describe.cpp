@@ -134,6 +134,11 @@ json describe_case() {
   keys["quasi_static.dt_initial"] = defaulted("number", value_or_null(q.dt_initial), {{"above", 0.0}, {"unit", "s"}});
   keys["quasi_static.dt_min"] = defaulted("number", value_or_null(q.dt_min), {{"above", 0.0}, {"unit", "s"}});
   keys["quasi_static.dt_max"] = defaulted("number", value_or_null(q.dt_max), {{"above", 0.0}, {"unit", "s"}});
+  const MixedSettings mx{};
+  keys["mixed"] = defaulted("object", json::object());
+  keys["mixed.unstable_rounds"] = defaulted("integer", mx.unstable_rounds, {{"minimum", 1}, {"maximum", 100000000}});
+  keys["mixed.kinetic_fraction"] = defaulted("number", mx.kinetic_fraction, {{"above", 0.0}, {"below", 1.0}});
+  keys["mixed.arrest_steps"] = defaulted("integer", mx.arrest_steps, {{"minimum", 1}, {"maximum", 1000000000}});
   keys["output"] = required("object", {{"note", "exactly one of every_time and every_steps"}});
   keys["output.every_time"] = defaulted("number", value_or_null(o.every_time), {{"above", 0.0}, {"unit", "s"}});
   keys["output.every_steps"] = defaulted("integer", value_or_null(o.every_steps), {{"minimum", 1}});

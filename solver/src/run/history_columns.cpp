@@ -14,7 +14,7 @@ void HistoryColumns::add(std::vector<std::string> names, Fill fill) {
   names_.insert(names_.end(), names.begin(), names.end());
 }
 
-HistoryColumns::HistoryColumns(const Model& model, const Case& c) {
+HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrator* integrator) {
   const Model* m = &model;
   if (model.contact.pairs || !model.indenters.empty())
     add({"contact_energy"}, [](const HistoryInputs& in, std::vector<double>& out) { out.push_back(in.state.contact_energy); });
@@ -41,6 +41,10 @@ HistoryColumns::HistoryColumns(const Model& model, const Case& c) {
       for (double component : reaction_force(*m, in.state, set, in.t)) out.push_back(component);
     });
   }
+  if (integrator && integrator->step_mode())
+    add({"mode"}, [integrator](const HistoryInputs&, std::vector<double>& out) {
+      out.push_back(static_cast<double>(integrator->step_mode().value_or(0)));
+    });
 }
 
 void HistoryColumns::fill(HistoryRow& row, const HistoryInputs& in) const {

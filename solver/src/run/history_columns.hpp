@@ -8,6 +8,7 @@
 #include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/state.hpp"
+#include "integrators/integrator.hpp"
 #include "io/output.hpp"
 
 namespace pd {
@@ -22,8 +23,9 @@ struct HistoryInputs {
 class HistoryColumns {
  public:
   // Contact energy with contact or indenters; Verlet-list builds with contact; each indenter's
-  // reaction; the broken-bond energy when some block pair can break; each output.reactions set.
-  HistoryColumns(const Model& model, const Case& c);
+  // reaction; the broken-bond energy when some block pair can break; each output.reactions set;
+  // the kind of each step (`mode`) when the integrator has several (integrators/mixed.hpp).
+  HistoryColumns(const Model& model, const Case& c, const Integrator* integrator = nullptr);
   HistoryColumns(const HistoryColumns&) = delete;
   HistoryColumns& operator=(const HistoryColumns&) = delete;
 

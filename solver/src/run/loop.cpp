@@ -152,6 +152,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     loop.dt_taken = h;
     ++loop.step;
     const StepReport& report = integrator.last_step();
+    for (const std::string& text : integrator.take_log_lines()) log.line(text);
     loop.broken += report.broken_now;
     loop.broken_energy += report.broken_energy_now;
     loop.force_evaluations += report.force_evaluations;

@@ -1,0 +1,78 @@
+// The mixed scheme (time.integrator: mixed): quasi-static load steps (integrators/quasi_static.hpp)
+// while the body is in equilibrium, velocity Verlet (integrators/verlet.hpp) while it is not, and
+// the switch made by the run itself, in both directions (issue 13; Peridigm switches one way only,
+// PeriLab by hand):
+//
+// - quasi-static → explicit, when a load step fails: bonds keep breaking through more than
+//   mixed.unstable_rounds re-solves at one load (the crack grows unstably: the released energy
+//   becomes motion, which equilibrium cannot describe), or Newton does not converge down to the
+//   smallest load step. The bonds that broke in the failed attempt are restored and Verlet goes on
+//   from the last equilibrium, with its velocities (the loading rate) and the same time: time is
+//   physical here, so the boundary-condition tables must be loading rates.
+// - explicit → quasi-static, when the crack has arrested: bonds have broken in the explicit phase
+//   (a phase in which none breaks has not yet reached the crack: it stays explicit until it
+//   does, so that a failed load step is not tried again at once), then no bond has broken and the kinetic energy
+//   has stayed below mixed.kinetic_fraction × the strain energy for mixed.arrest_steps steps in a
+//   row. The next load step solves equilibrium from the current state; the kinetic energy left is
+//   given up (added to the damping work, so that the energy balance still closes, and said in
+//   run.log).
+//
+// The explicit step is time.dt's (stable × safety_factor, exact × safety_factor, or a number), the
+// quasi-static steps those of the quasi_static section; quasi_static.dt_min defaults to 10 explicit
+// steps (a load step that must be cut below that is cheaper done explicitly). history.csv's `mode`
+// column is the kind of each step: 1 quasi-static, 0 explicit.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+#include "integrators/quasi_static.hpp"
+#include "integrators/verlet.hpp"
+
+namespace pd {
+
+class Mixed : public Integrator {
+ public:
+  enum Mode : int { kExplicit = 0, kQuasiStatic = 1 };
+
+  explicit Mixed(ForceOperator& op) : op_(op), static_(op), explicit_(op) {}
+  std::string name() const override { return "mixed"; }
+  void configure(const Case& c, double dt_exact = 0.0) override;
+  void initialize(State& state, double t) override;
+  void step(State& state, double& t, double& dt) override;
+
+  // The base state, the mode and its watch, then the quasi-static integrator's own state.
+  std::vector<char> save_state() const override;
+  void load_state(const std::vector<char>& bytes) override;
+
+  std::vector<std::string> describe(double dt_exact) const override;
+  bool controls_step() const override { return true; }
+  std::optional<double> initial_dt() const override { return static_.initial_dt(); }
+  std::optional<int> step_mode() const override { return step_mode_; }
+  std::vector<std::string> take_log_lines() override { return std::move(log_lines_); }
+
+  Mode mode() const { return mode_; }  // the mode of the next step
+  double explicit_dt() const { return dt_explicit_; }
+  int switches() const { return switches_; }
+  int factorisations_in_use() const { return static_.factorisations(); }
+
+ private:
+  void to_explicit(State& state, double t, const std::string& reason);
+  void to_quasi_static(State& state, double t, double kinetic, double strain);
+
+  ForceOperator& op_;
+  QuasiStatic static_;
+  VelocityVerlet explicit_;
+  MixedSettings settings_;
+  double dt_explicit_ = 0.0;
+  Mode mode_ = kQuasiStatic;
+  int step_mode_ = kQuasiStatic;
+  std::int64_t calm_steps_ = 0;  // explicit steps in a row with no breaking and low kinetic energy
+  bool cracked_ = false;         // a bond has broken in this explicit phase
+  double static_dt_ = 0.0;       // the load step proposed when the quasi-static mode was left [s]
+  int switches_ = 0;
+  std::vector<std::uint8_t> broken_before_;  // the bonds' state before a quasi-static attempt
+  std::vector<std::string> log_lines_;
+};
+
+}  // namespace pd

@@ -1,0 +1,123 @@
+// The mixed integrator (integrators/mixed.hpp): a breakable bar pulled slowly is loaded by
+// quasi-static load steps until it snaps, then followed by explicit steps, the switch said in a log
+// line and in the step mode; a run saved and restored mid-way continues bitwise in both modes, the
+// factorisation rebuilt from where it was assembled (quasi_static's save_state).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "integrators/mixed.hpp"
+#include "lattice.hpp"
+
+namespace {
+
+constexpr double kDx = 1e-3;
+constexpr int kNx = 12, kNy = 4, kNz = 4;
+constexpr double kEnd = 1e-3;  // s: the right end is pulled to 4e-3 of the bar's length by then
+
+// A 12×4×4 bar, δ = 3.015dx, E = 1 GPa, G0 = 3.6 J/m² (s0 ≈ 1e-3): the left two layers clamped,
+// the right two pulled along x at 0.044 m/s.
+pd::Model breakable_bar() {
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  pd::Nodes nodes = pdtest::cubic_lattice(kNx, kNy, kNz, kDx, 3);
+  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)}, right{"right", left.member};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    left.member[i] = nodes.x[0][i] < 1.5 * kDx;
+    right.member[i] = nodes.x[0][i] > (kNx - 2.5) * kDx;
+  }
+  nodes.sets = {left, right};
+  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
+  c.boundary_conditions.push_back({"right", "displacement", 0, {0.0, kEnd}, {0.0, 4e-3 * (kNx - 1) * kDx}});
+  for (int d = 1; d < 3; ++d) c.boundary_conditions.push_back({"right", "displacement", d, {0.0}, {0.0}});
+  return pd::build_model(c, std::move(nodes));
+}
+
+pd::Case mixed_case() {
+  pd::Case c;
+  c.time.end = kEnd;
+  c.time.integrator = "mixed";
+  c.quasi_static.dt_max = kEnd / 40;
+  c.quasi_static.dt_initial = kEnd / 40;
+  c.mixed.arrest_steps = 50;
+  return c;
+}
+
+// One run of the bar: the model, its operator, the integrator and the state, stepped by hand.
+struct BarRun {
+  pd::Model model = breakable_bar();
+  pd::ForceOperator op{model};
+  pd::Mixed mixed{op};
+  pd::State state{model.nodes.size()};
+  double t = 0.0, dt = 0.0;
+  std::vector<std::string> log;
+  BarRun() {
+    mixed.configure(mixed_case());
+    mixed.initialize(state, 0.0);
+    dt = *mixed.initial_dt();
+  }
+  void step() {
+    double h = std::min(dt, kEnd - t);
+    mixed.step(state, t, h);
+    dt = mixed.last_step().next_dt;
+    for (auto& line : mixed.take_log_lines()) log.push_back(line);
+  }
+};
+
+bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
+  for (std::size_t d = 0; d < 3; ++d)
+    if (std::memcmp(a[d].data(), b[d].data(), a[d].size() * sizeof(double)) != 0) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(Mixed, QuasiStaticUntilTheBarSnapsThenExplicit) {
+  BarRun run;
+  std::vector<int> modes;
+  while (run.t < kEnd * (1 - 1e-12)) {
+    run.step();
+    modes.push_back(*run.mixed.step_mode());
+    ASSERT_LT(modes.size(), 100000u);
+  }
+  ASSERT_GE(modes.size(), 3u);
+  EXPECT_EQ(modes.front(), pd::Mixed::kQuasiStatic);
+  // Breaking starts near s0 = 1e-3 of 4e-3 at the end: the snap comes in the first half.
+  const auto first_explicit = std::find(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kExplicit));
+  ASSERT_NE(first_explicit, modes.end()) << "the bar never went explicit";
+  EXPECT_GE(first_explicit - modes.begin(), 3);  // a few load steps first
+  std::int64_t broken = 0;
+  for (auto b : run.model.bonds.broken) broken += b;
+  EXPECT_GT(broken, 0);
+  ASSERT_FALSE(run.log.empty());
+  EXPECT_NE(run.log.front().find("quasi-static → explicit"), std::string::npos) << run.log.front();
+  EXPECT_NE(run.log.front().find("unstable crack growth"), std::string::npos) << run.log.front();
+  for (std::size_t d = 0; d < 3; ++d)
+    for (double u : run.state.u[d]) ASSERT_TRUE(std::isfinite(u));
+  EXPECT_DOUBLE_EQ(run.mixed.explicit_dt(), run.op.stable_time_step() * 0.8);
+}
+
+TEST(Mixed, SavedAndRestoredMidRunContinuesBitwiseInBothModes) {
+  // Save after a few quasi-static load steps (a factorisation in use) and again in the explicit
+  // phase; a fresh run restored from each goes on bitwise with the uninterrupted one.
+  for (const bool explicit_phase : {false, true}) {
+    BarRun a;
+    int steps = 0;
+    while (explicit_phase ? a.mixed.mode() != pd::Mixed::kExplicit || steps < 30 : steps < 3) a.step(), ++steps;
+    if (!explicit_phase) ASSERT_GT(a.mixed.factorisations_in_use(), 0);
+    const std::vector<char> saved = a.mixed.save_state();
+    BarRun b;
+    b.state = a.state;
+    b.model.bonds.broken = a.model.bonds.broken;
+    b.mixed.load_state(saved);
+    b.t = a.t, b.dt = a.dt;
+    for (int k = 0; k < 20; ++k) {
+      a.step(), b.step();
+      ASSERT_EQ(*a.mixed.step_mode(), *b.mixed.step_mode()) << "step " << k;
+      ASSERT_TRUE(same_bits(a.state.u, b.state.u)) << (explicit_phase ? "explicit" : "quasi-static") << ", step " << k;
+      ASSERT_EQ(a.t, b.t);
+    }
+    EXPECT_EQ(a.model.bonds.broken, b.model.bonds.broken);
+  }
+}
