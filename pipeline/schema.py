@@ -253,6 +253,17 @@ CASE = {
                                default=None, unit="s", above=0.0),
         restart_every_steps=Key("integer", "write the checkpoint every this many steps (may be combined "
                                 "with restart_every_time)", default=None, minimum=1),
+        precision=Key("choice", "frames' point fields (displacement, velocity, damage) as float32 or float64; "
+                      "reference points, TIME and step stay float64, history.csv and checkpoints are exact "
+                      "either way", default="float32", choices=("float32", "float64")),
+        compression=Key("choice", "frames' data in zlib blocks as VTK's vtkZLibDataCompressor writes them "
+                        "(ParaView, VisIt, meshio read them), or raw", default="zlib", choices=("zlib", "none")),
+        fields=Key("names", "point fields a frame carries (postprocess's maps need displacement and damage)",
+                   default=["displacement", "velocity", "damage", "block"],
+                   choices=("displacement", "velocity", "damage", "block")),
+        gmsh=Key("choice", "frames copied into gmsh/results.msh by postprocess: all, only those of the "
+                 "figures (figures.times), or none (no gmsh/ files)", default="figures",
+                 choices=("all", "figures", "none")),
     ),
     "figures": section(
         "what postprocess draws",

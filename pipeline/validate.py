@@ -118,9 +118,14 @@ class _Checker:
                 return []
             return [self.mapping(item, keypath + (i,), key.fields) for i, item in enumerate(value)]
         if kind == "names":
+            what = "names" if key.choices else "node-set names"
             if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-                self.error(keypath, f"expected a list of node-set names, got {value!r}")
+                self.error(keypath, f"expected a list of {what}, got {value!r}")
                 return []
+            for i, name in enumerate(value):  # a closed list of names (output.fields): each one of them
+                if key.choices and name not in key.choices:
+                    self.error(keypath + (i,), f"unknown name {name!r}{self.closest(name, key.choices)}; "
+                               f"valid: {', '.join(key.choices)}")
             return list(value)
         if kind == "numbers":
             if not isinstance(value, list):

@@ -8,6 +8,7 @@ import numbers
 from .errors import PostprocessError
 
 AXES = "xyz"
+GMSH_CHOICES = ("all", "figures", "none")
 
 
 @dataclasses.dataclass
@@ -19,6 +20,7 @@ class CaseSettings:
     times: list | None = None       # `figures.times` [s], or None for four frames spread over the run
     component: int = 0              # `figures.displacement_component`: 0, 1, 2 for x, y, z
     block_names: dict = dataclasses.field(default_factory=dict)  # block id -> name, for Gmsh
+    gmsh: str = "figures"           # `output.gmsh`: frames copied to gmsh/results.msh: all | figures | none
 
     @property
     def heading(self) -> str:
@@ -72,9 +74,13 @@ def load_case_settings(path: str) -> CaseSettings:
     component = figures.get("displacement_component", 0)
     if component not in (0, 1, 2) or isinstance(component, bool):
         fail("figures.displacement_component", f"expected 0, 1 or 2 (x, y, z), got {component!r}")
+    output = case.get("output") or {}
+    gmsh = output.get("gmsh", "figures") if isinstance(output, dict) else "figures"
+    if gmsh not in GMSH_CHOICES:
+        fail("output.gmsh", f"expected one of {', '.join(GMSH_CHOICES)}, got {gmsh!r}")
     blocks = case.get("blocks") or []
     block_names = {b["id"]: b["name"] for b in blocks if isinstance(b, dict)
                    and isinstance(b.get("id"), int) and isinstance(b.get("name"), str)}
     return CaseSettings(name=name, dimension=dimension, title=title,
                         grid_spacing=None if spacing is None else float(spacing),
-                        times=times, component=int(component), block_names=block_names)
+                        times=times, component=int(component), block_names=block_names, gmsh=gmsh)

@@ -85,11 +85,16 @@ def read_frame(vtu_path: str) -> Frame:
         raise PostprocessError(f"{vtu_path}: points have shape {points.shape}, expected (N, 3)")
     if points.shape[1] == 2:
         points = np.column_stack([points, np.zeros(len(points))])
-    point_data = {name: np.asarray(values) for name, values in mesh.point_data.items()}
+    # Frames store their fields as float32 by default (output.precision): every reader downstream
+    # (maps, probe, Gmsh copy, validation) computes in float64, as it did before, so the only
+    # difference is the storage's rounding.
+    point_data = {name: np.asarray(values, dtype=np.float64) if np.issubdtype(np.asarray(values).dtype, np.floating)
+                  else np.asarray(values) for name, values in mesh.point_data.items()}
     missing = [name for name in REQUIRED_POINT_DATA if name not in point_data]
     if missing:
         raise PostprocessError(f"{vtu_path}: point data lacks {', '.join(missing)}; "
-                               f"has {', '.join(sorted(point_data)) or 'none'} (pipeline/formats.md §4)")
+                               f"has {', '.join(sorted(point_data)) or 'none'} (pipeline/formats.md §4); "
+                               f"postprocess needs them: list them in output.fields")
     n = len(points)
     for name, values in point_data.items():
         if len(values) != n:

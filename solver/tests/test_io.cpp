@@ -6,10 +6,16 @@
 #include <fstream>
 #include <sstream>
 #include <unistd.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstring>
+#include <regex>
 
 #include "core/error.hpp"
 #include "io/case_reader.hpp"
 #include "io/node_file.hpp"
+#include "io/output.hpp"
 #include "io/vtu.hpp"
 #include "files.hpp"
 #include "lattice.hpp"
@@ -203,4 +209,102 @@ TEST(CaseFile, RejectsBadValuesNamingTheKey) {
   expect_case_error("\"thickness\": 0.001,", "", {"thickness: required key is missing"});
   expect_case_error("\"damping\": 200.0", "\"dampng\": 200.0", {"dampng: unknown key (did you mean 'damping'?)"});
   expect_case_error("\"horizon\": 0.0015075", "\"horizon\": 0.0015075,", {"not valid JSON"});
+}
+
+// Frames in the compact encoding (output.precision float32, output.compression zlib): the bytes on
+// disk are vtkZLibDataCompressor blocks (inflated here with zlib itself, not with our reader), and
+// the values read back are the doubles rounded to float32.
+TEST(Frames, Float32ZlibFrameReadsBackToFloat32RoundOff) {
+  const fs::path dir = temp_dir("zlib_frame");
+  const std::size_t n = 20000;  // 240 000 bytes of displacement: 8 blocks of 32 KiB, the last partial
+  pd::VtuGrid g;
+  std::vector<double> x(n), y(n), z(n, 0.0), u(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = 1e-3 * static_cast<double>(i % 200), y[i] = 1e-3 * static_cast<double>(i / 200),
+                                      u[i] = 1e-5 * std::sin(0.001 * static_cast<double>(i)) + 1.0 / 3.0;
+  g.field_data.push_back(pd::make_array("TIME", std::vector<double>{0.125}));
+  g.points = pd::make_vec3_array("Points", x, y, z);
+  g.point_data.push_back(pd::make_vec3_array<float>("displacement", u, x, y));
+  g.point_data.push_back(pd::make_array_as<float>("damage", u));
+  std::vector<std::int64_t> conn(n), offs(n);
+  for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int64_t>(i), offs[i] = static_cast<std::int64_t>(i + 1);
+  g.connectivity = pd::make_array("connectivity", conn);
+  g.offsets = pd::make_array("offsets", offs);
+  g.types = pd::make_array("types", std::vector<std::uint8_t>(n, 1));
+  pd::write_vtu(dir / "f.vtu", g, pd::VtuCompression::zlib);
+  const std::string text = slurp(dir / "f.vtu");
+  ASSERT_NE(text.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
+
+  // By hand: the displacement array's offset, its block header, and zlib's own inflate.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, std::regex("Name=\"displacement\" NumberOfComponents=\"3\" format=\"appended\" offset=\"([0-9]+)\"")));
+  const std::size_t data = text.find('_', text.find("<AppendedData")) + 1;
+  const auto* at = reinterpret_cast<const unsigned char*>(text.data()) + data + std::stoull(m[1]);
+  std::uint64_t head[3];
+  std::memcpy(head, at, sizeof head);
+  const std::uint64_t bytes = 3 * n * sizeof(float);
+  EXPECT_EQ(head[0], (bytes + 32767) / 32768);  // number of blocks
+  EXPECT_EQ(head[1], 32768u);                   // block size
+  EXPECT_EQ(head[2], bytes % 32768);            // the partial last block
+  std::vector<unsigned char> inflated;
+  std::size_t pos = 8 * (3 + head[0]);
+  for (std::uint64_t k = 0; k < head[0]; ++k) {
+    std::uint64_t csize = 0;
+    std::memcpy(&csize, at + 8 * (3 + k), 8);
+    std::vector<unsigned char> block(32768);
+    uLongf got = block.size();
+    ASSERT_EQ(uncompress(block.data(), &got, at + pos, csize), Z_OK) << "block " << k;
+    inflated.insert(inflated.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(got));
+    pos += csize;
+  }
+  ASSERT_EQ(inflated.size(), bytes);
+  std::vector<float> by_hand(3 * n);
+  std::memcpy(by_hand.data(), inflated.data(), bytes);
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(by_hand[3 * i], static_cast<float>(u[i])) << i;
+    ASSERT_EQ(by_hand[3 * i + 1], static_cast<float>(x[i])) << i;
+  }
+
+  // And through our reader: Float32 fields to float32 round-off, Float64 points exact.
+  const pd::VtuGrid r = pd::read_vtu(dir / "f.vtu");
+  EXPECT_EQ(pd::values_of<double>(r.points), pd::values_of<double>(g.points));
+  const auto damage = pd::values_as_double(*r.find(r.point_data, "damage"));
+  ASSERT_EQ(damage.size(), n);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(damage[i], u[i], 6e-8 * std::fabs(u[i])) << i;
+  EXPECT_EQ(r.find(r.point_data, "displacement")->type, "Float32");
+  EXPECT_LT(text.size(), 8u * n * 3 + 4u * n * 4);  // smaller than the raw points and fields alone
+
+  // A damaged block is an error naming the file and saying the data are compressed.
+  std::string cut = text;
+  cut[data + std::stoull(m[1]) + 8 * (3 + head[0]) + 10] ^= 0x5a;
+  spit(dir / "bad.vtu", cut);
+  try {
+    pd::read_vtu(dir / "bad.vtu");
+    FAIL() << "a corrupted zlib block was accepted";
+  } catch (const pd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.vtu"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("compressed"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CaseFile, OutputFormatKeysAreCheckedAndDefaultToTheCompactFrames) {
+  const std::string out = "\"history_every\": 1";
+  expect_case_error(out, out + R"(, "fields": ["displacement", "velocty"])",
+                    {"output.fields[1]: unknown field 'velocty' (did you mean 'velocity'?)",
+                     "known: displacement, velocity, damage, block"});
+  expect_case_error(out, out + R"(, "fields": ["damage", "damage"])", {"output.fields", "'damage' is listed twice"});
+  expect_case_error(out, out + R"(, "precision": "float16")", {"output.precision: unknown value 'float16'; known: float32, float64"});
+  expect_case_error(out, out + R"(, "compression": "lzma")", {"output.compression: unknown value 'lzma'; known: zlib, none"});
+  expect_case_error(out, out + R"(, "gmsh": "some")", {"output.gmsh: unknown value 'some'; known: all, figures, none"});
+  const pd::Case c = pd::parse_case(kCase, "out/x/case.json");
+  EXPECT_EQ(c.output.precision, "float32");
+  EXPECT_EQ(c.output.compression, "zlib");
+  EXPECT_EQ(c.output.fields, (std::vector<std::string>{"displacement", "velocity", "damage", "block"}));
+  std::string chosen = kCase;
+  chosen.replace(chosen.find(out), out.size(), out + R"(, "fields": ["damage"], "precision": "float64", "compression": "none")");
+  const pd::Case d = pd::parse_case(chosen, "out/x/case.json");
+  EXPECT_EQ(d.output.fields, std::vector<std::string>{"damage"});
+  const pd::FrameFormat f = pd::frame_format_of(d.output);
+  EXPECT_FALSE(f.float32);
+  EXPECT_FALSE(f.zlib);
 }

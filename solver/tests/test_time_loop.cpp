@@ -92,7 +92,7 @@ TEST(TimeLoop, VerletAboveTheExactLimitIsStoppedWithoutNonFiniteFrames) {
   for (const auto& entry : fs::directory_iterator(dir / "out" / "frames")) {
     const pd::VtuGrid g = pd::read_vtu(entry.path());
     for (const char* name : {"displacement", "velocity"})
-      for (double x : pd::values_of<double>(*g.find(g.point_data, name))) ASSERT_TRUE(std::isfinite(x)) << entry.path();
+      for (double x : pd::values_as_double(*g.find(g.point_data, name))) ASSERT_TRUE(std::isfinite(x)) << entry.path();
   }
   EXPECT_EQ(slurp(dir / "out" / "history.csv").find("nan"), std::string::npos);
   EXPECT_EQ(slurp(dir / "out" / "history.csv").find("inf"), std::string::npos);

@@ -203,3 +203,18 @@ def test_adaptive_tol_not_positive_and_kd_below_one_are_rejected(tmp_path, tol, 
     message = error_of(tmp_path, MINIMAL + f"adaptive:\n  tol: {tol}\n  kd: {kd}\n")
     assert f"plate.yaml:12: adaptive.tol: must be greater than 0, got {float(tol):g}" in message
     assert f"plate.yaml:13: adaptive.kd: must be at least 1, got {int(kd)}" in message
+
+
+def test_unknown_output_field_names_line_and_lists_the_valid_ones(tmp_path):
+    text = MINIMAL + "output:\n  fields: [displacement, velocty]\n"
+    message = error_of(tmp_path, text)
+    assert "plate.yaml:12: output.fields[1]: unknown name 'velocty' (did you mean 'velocity'?); " \
+           "valid: displacement, velocity, damage, block" in message
+
+
+def test_output_format_defaults_are_the_compact_frames(tmp_path):
+    output = load_case(write(tmp_path, MINIMAL))["output"]
+    assert (output["precision"], output["compression"], output["gmsh"]) == ("float32", "zlib", "figures")
+    assert output["fields"] == ["displacement", "velocity", "damage", "block"]
+    assert "precision: 'float16' is not one of 'float32', 'float64'" in \
+        error_of(tmp_path, MINIMAL + "output:\n  precision: float16\n")

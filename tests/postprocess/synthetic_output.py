@@ -162,7 +162,8 @@ def make_run(out, *, dimension=2, shape=(9, 7), frames=6, figure_times=None, com
     case = {"format_version": 1, "case": out.name, "title": "synthetic test output (§5.1, façade)",
             "dimension": dimension, "grid_spacing": DX,
             "blocks": [{"id": 1, "name": "left", "model": "pmb"}, {"id": 2, "name": "right", "model": "pmb"}],
-            "figures": {"times": figure_times, "displacement_component": component}}
+            "figures": {"times": figure_times, "displacement_component": component},
+            "output": {"gmsh": "all"}}  # every frame into results.msh: what the Gmsh tests check
     (out / "case.json").write_text(json.dumps(case, indent=1))
     return SyntheticRun(out=out, dimension=dimension, times=times, points=points, displacements=displacements,
                         damages=damages, broken=broken, history=history, centre=centre)

@@ -125,3 +125,28 @@ def test_3d_export_round_trips(run3d, gmsh_session):
     assert [gmsh.option.getNumber(f"View[{gmsh.view.getIndex(t)}].NbTimeStep") for t in tags] == [4] * len(ARRAYS)
     _, _, data, time, _ = gmsh.view.getModelData(tags[0], 3)
     assert time == run3d.times[3] and np.array_equal(np.array(data), run3d.displacements[3])
+
+
+def _set_gmsh(run, value):
+    import json
+    case = json.loads(run.case_json.read_text())
+    case["output"] = {"gmsh": value}
+    run.case_json.write_text(json.dumps(case))
+
+
+def test_output_gmsh_figures_copies_only_the_figure_frames_and_none_writes_no_gmsh_files(run2d):
+    from postprocess.selection import default_times, select_frames
+    _set_gmsh(run2d, "figures")
+    views = read_msh_node_data(str(export(run2d) / "results.msh"))
+    wanted = select_frames(run2d.times.tolist(), default_times(run2d.times.tolist()))
+    assert sorted(wanted) != list(range(len(run2d.times)))  # the test would not tell the modes apart
+    for name in ARRAYS:
+        assert [b[1] for b in views[name]] == sorted(set(wanted))  # frame indices of the figures only
+    pos = (run2d.out / "gmsh" / "damage_final.pos").read_text()
+    assert f"TIME{{{float(run2d.times[-1])!r}}}" in pos  # still the last frame
+    _set_gmsh(run2d, "none")
+    for name in ("results.msh", "damage_final.pos"):
+        (run2d.out / "gmsh" / name).unlink()
+    cli.run(str(run2d.out), log=lambda *_: None)
+    assert not (run2d.out / "gmsh" / "results.msh").exists()
+    assert (run2d.out / "figures" / "probe.png").exists()  # the frames were still read for the figures

@@ -73,6 +73,14 @@ struct OutputSettings {
   // simulated time and/or every restart_every_steps steps; neither: only on SIGINT/SIGTERM.
   std::optional<double> restart_every_time;  // s
   std::optional<std::int64_t> restart_every_steps;
+  // How frames are stored (pipeline/formats.md §4; checkpoints are always exact): the point fields
+  // rounded to float32 or kept float64 (reference points stay Float64 either way), zlib blocks as
+  // VTK's vtkZLibDataCompressor writes them or raw, and which point fields a frame carries (the
+  // names of io/output.hpp frame_fields()).
+  std::string precision = "float32";  // float32 | float64
+  std::string compression = "zlib";   // zlib | none
+  std::vector<std::string> fields = {"displacement", "velocity", "damage", "block"};
+  std::string gmsh = "figures";       // read by postprocess only: all | figures | none
 };
 
 // A pre-crack: bonds crossing the segment from–to (in the xy plane; in 3D the plane through it

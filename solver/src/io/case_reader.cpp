@@ -9,12 +9,14 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "core/error.hpp"
 #include "core/partial_volume.hpp"
 #include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
+#include "io/output.hpp"
 #include "materials/bond_model.hpp"
 
 namespace pd {
@@ -41,6 +43,21 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 std::string show(const json& j) {
   std::string s = j.dump();
   return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+// " (did you mean 'x'?)" for the known name within 3 edits of `name`, else "".
+std::string closest(const std::string& name, const std::vector<std::string>& known) {
+  std::string best;
+  std::size_t best_distance = 1000;
+  for (const auto& k : known)
+    if (const std::size_t d = edit_distance(name, k); d < best_distance) best_distance = d, best = k;
+  return best_distance <= 3 ? " (did you mean '" + best + "'?)" : std::string();
 }
 
 class Checker {
@@ -365,7 +382,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"mixed", {"unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
-                  "restart_every_steps"}},
+                  "restart_every_steps", "precision", "compression", "fields", "gmsh"}},
   };
   return keys;
 }
@@ -495,6 +512,27 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
     for (const auto& name : c.output.reactions)
       if (std::find(c.node_sets.begin(), c.node_sets.end(), name) == c.node_sets.end())
         ck.fail("output.reactions", "'" + name + "' is not in node_sets");
+  }
+  for (auto [name, slot, choices] :
+       {std::tuple{"precision", &c.output.precision, std::vector<std::string>{"float32", "float64"}},
+        std::tuple{"compression", &c.output.compression, std::vector<std::string>{"zlib", "none"}},
+        std::tuple{"gmsh", &c.output.gmsh, std::vector<std::string>{"all", "figures", "none"}}}) {
+    const std::string key = std::string("output.") + name;
+    if (const json* j = ck.optional(output, name)) *slot = ck.string(*j, key);
+    if (std::find(choices.begin(), choices.end(), *slot) == choices.end())
+      ck.fail(key, "unknown value '" + *slot + "'; known: " + joined(choices));
+  }
+  if (const json* j = ck.optional(output, "fields")) {
+    c.output.fields = ck.strings(*j, "output.fields");
+    const std::vector<std::string>& known = frame_fields();
+    for (std::size_t k = 0; k < c.output.fields.size(); ++k) {
+      const std::string& name = c.output.fields[k];
+      if (std::find(known.begin(), known.end(), name) == known.end())
+        ck.fail("output.fields[" + std::to_string(k) + "]", "unknown field '" + name + "'" + closest(name, known) +
+                                                                 "; known: " + joined(known));
+      if (std::count(c.output.fields.begin(), c.output.fields.end(), name) > 1)
+        ck.fail("output.fields", "'" + name + "' is listed twice");
+    }
   }
   return c;
 }

@@ -13,6 +13,7 @@
 #include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
 #include "io/case_reader.hpp"
+#include "io/output.hpp"
 
 namespace pd {
 
@@ -147,6 +148,11 @@ json describe_case() {
   keys["output.restart_every_time"] = defaulted("number", value_or_null(o.restart_every_time),
                                               {{"above", 0.0}, {"unit", "s"}});
   keys["output.restart_every_steps"] = defaulted("integer", value_or_null(o.restart_every_steps), {{"minimum", 1}});
+  keys["output.precision"] = defaulted("string", o.precision, {{"choices", {"float32", "float64"}}});
+  keys["output.compression"] = defaulted("string", o.compression, {{"choices", {"zlib", "none"}}});
+  keys["output.fields"] = defaulted("strings", o.fields, {{"choices", frame_fields()}});
+  keys["output.gmsh"] = defaulted("string", o.gmsh, {{"choices", {"all", "figures", "none"}},
+                                                     {"note", "postprocess only: checked to be one of the choices"}});
   keys["figures"] = defaulted("object", json::object(), {{"note", "postprocess only: checked to be an object"}});
 
   // Every key the reader accepts is described, and nothing else (blocks: id, name + the material's).

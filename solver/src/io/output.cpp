@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -25,17 +26,41 @@ namespace pd {
 const char* const kHistoryHeader =
     "step,time,dt,iterations,rejected,kinetic_energy,strain_energy,external_work,damping_work,broken_bonds,wall_time";
 
+const std::vector<std::string>& frame_fields() {
+  static const std::vector<std::string> names = {"displacement", "velocity", "damage", "block"};
+  return names;
+}
+
+FrameFormat frame_format_of(const OutputSettings& output) {
+  return FrameFormat{output.precision == "float32", output.compression == "zlib", output.fields};
+}
+
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
-                 std::int64_t step) {
+                 std::int64_t step, const FrameFormat& format) {
   const std::size_t n = model.nodes.size();
   VtuGrid g;
+  // TIME and step stay exact: readers match frames to history.csv rows and the .pvd by them.
   g.field_data.push_back(make_array("TIME", std::vector<double>{time}));
   g.field_data.push_back(make_array("step", std::vector<std::int64_t>{step}));
+  // The reference points stay Float64 whatever the precision: post-processing differences them
+  // (strains from u over neighbouring nodes; the nearest node to a probe), a float32 coordinate
+  // would be off by up to 3e-9 m at 0.05 m, and compressed they cost little because every frame
+  // repeats the same lattice (cases/plate_with_hole/README.md, "Output size").
   g.points = make_vec3_array("Points", model.nodes.x[0], model.nodes.x[1], model.nodes.x[2]);
-  g.point_data.push_back(make_vec3_array("displacement", state.u[0], state.u[1], state.u[2]));
-  g.point_data.push_back(make_vec3_array("velocity", state.v[0], state.v[1], state.v[2]));
-  g.point_data.push_back(make_array("damage", model.bond_model->damage(model)));
-  g.point_data.push_back(make_array("block", model.nodes.block));
+  auto wanted = [&](const char* name) {
+    return std::find(format.fields.begin(), format.fields.end(), name) != format.fields.end();
+  };
+  auto vec3 = [&](const char* name, const Vec3Array& c) {
+    return format.float32 ? make_vec3_array<float>(name, c[0], c[1], c[2]) : make_vec3_array<double>(name, c[0], c[1], c[2]);
+  };
+  // In the order of frame_fields(), whatever the order of output.fields.
+  if (wanted("displacement")) g.point_data.push_back(vec3("displacement", state.u));
+  if (wanted("velocity")) g.point_data.push_back(vec3("velocity", state.v));
+  if (wanted("damage")) {
+    const std::vector<double> damage = model.bond_model->damage(model);
+    g.point_data.push_back(format.float32 ? make_array_as<float>("damage", damage) : make_array("damage", damage));
+  }
+  if (wanted("block")) g.point_data.push_back(make_array("block", model.nodes.block));  // an integer: as is
 
   // Cells: a vertex per node, then a line per broken bond (each once, from its end i < j), in node
   // order. Counted per node in parallel, so a frame does not walk every bond on one thread.
@@ -74,7 +99,7 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
   g.offsets = make_array("offsets", offs);
   g.types = make_array("types", types);
   g.cell_data.push_back(make_array("broken_bond", broken_flag));
-  write_vtu(path, g);
+  write_vtu(path, g, format.zlib ? VtuCompression::zlib : VtuCompression::none);
 }
 
 namespace {
@@ -92,8 +117,8 @@ std::string frame_file(std::size_t k) {
 }  // namespace
 
 OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns,
-                           const OutputResume* resume)
-    : dir_(std::move(output_dir)) {
+                           const OutputResume* resume, FrameFormat format)
+    : dir_(std::move(output_dir)), format_(std::move(format)) {
   std::error_code ec;
   std::filesystem::create_directories(dir_ / "frames", ec);
   if (ec) throw Error((dir_ / "frames").string() + ": cannot create the directory: " + ec.message());
@@ -177,7 +202,7 @@ void OutputWriter::write_pvd() const {
 
 void OutputWriter::frame(const Model& model, const State& state, double time, std::int64_t step) {
   const std::string name = frame_file(frames_.size());
-  write_frame(dir_ / name, model, state, time, step);
+  write_frame(dir_ / name, model, state, time, step, format_);
   frames_.emplace_back(time, name);
   write_pvd();
   flush_history();

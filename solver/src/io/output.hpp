@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/state.hpp"
 
@@ -27,10 +28,24 @@ struct HistoryRow {
 // The header line of history.csv, exactly the columns of formats.md §4.
 extern const char* const kHistoryHeader;
 
-// One frame as a VTU grid: reference points, displacement, velocity, damage, block; vertex cells
-// then one line cell per broken bond (i < j); FieldData TIME and step.
+// How a frame is stored (output.precision, output.compression, output.fields of case.json).
+struct FrameFormat {
+  bool float32 = true;  // point fields as Float32 (the reference points stay Float64)
+  bool zlib = true;     // vtkZLibDataCompressor blocks
+  std::vector<std::string> fields = {"displacement", "velocity", "damage", "block"};
+};
+
+// The FrameFormat that a case's output section asks for.
+FrameFormat frame_format_of(const OutputSettings& output);
+
+// The point fields a frame can carry, in the order a frame writes them: the one list that the case
+// reader checks output.fields against and --describe prints.
+const std::vector<std::string>& frame_fields();
+
+// One frame as a VTU grid: reference points, the chosen point fields (displacement, velocity,
+// damage, block); vertex cells then one line cell per broken bond (i < j); FieldData TIME and step.
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
-                 std::int64_t step);
+                 std::int64_t step, const FrameFormat& format = FrameFormat{});
 
 // Where a restarted run picks up its output (io/checkpoint.hpp): the frames written so far and
 // the length of history.csv at the checkpoint.
@@ -50,7 +65,7 @@ class OutputWriter {
   // is missing), removes later ones, and cuts history.csv back to history_bytes (throws if it is
   // shorter or its header differs).
   explicit OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns = {},
-                        const OutputResume* resume = nullptr);
+                        const OutputResume* resume = nullptr, FrameFormat format = FrameFormat{});
   ~OutputWriter();
   OutputWriter(const OutputWriter&) = delete;
   OutputWriter& operator=(const OutputWriter&) = delete;
@@ -68,6 +83,7 @@ class OutputWriter {
  private:
   void write_pvd() const;
   std::filesystem::path dir_;
+  FrameFormat format_;
   std::vector<std::pair<double, std::string>> frames_;  // (time, relative file)
   int history_fd_ = -1;
   std::string history_buffer_;

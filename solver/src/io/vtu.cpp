@@ -1,4 +1,5 @@
-// Writer and checking reader for the VTK XML encoding of pipeline/formats.md §1.
+// Writer and checking reader for the VTK XML encoding of pipeline/formats.md §1, raw or with
+// vtkZLibDataCompressor blocks (io/vtk_zlib.hpp).
 #include "io/vtu.hpp"
 
 #include <cctype>
@@ -9,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/vtk_zlib.hpp"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
 #error "the VTU reader and writer copy raw little-endian bytes; port them for a big-endian host"
@@ -24,35 +26,48 @@ std::size_t VtuArray::value_size() const {
   return 1;
 }
 
-VtuArray make_vec3_array(const std::string& name, const std::vector<double>& x, const std::vector<double>& y,
-                         const std::vector<double>& z) {
-  // Straight into the array's bytes: a frame has three of these, each 24 bytes per node.
-  VtuArray a{name, vtk_type_name<double>(), 3, {}};
-  a.bytes.reserve(3 * x.size() * sizeof(double));
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const double point[3] = {x[i], y[i], z[i]};
-    const auto* first = reinterpret_cast<const unsigned char*>(point);
-    a.bytes.insert(a.bytes.end(), first, first + sizeof point);
+std::vector<double> values_as_double(const VtuArray& a) {
+  if (a.type == "Float64") return values_of<double>(a);
+  if (a.type == "Float32") {
+    const std::vector<float> f = values_of<float>(a);
+    return std::vector<double>(f.begin(), f.end());
   }
-  return a;
+  throw Error("DataArray '" + a.name + "' is " + a.type + ", not Float64 or Float32");
 }
 
 // ---------------------------------------------------------------- writing
 
-void write_vtu(const std::filesystem::path& path, const VtuGrid& g) {
+void write_vtu(const std::filesystem::path& path, const VtuGrid& g, VtuCompression compression) {
+  const bool zlib = compression == VtuCompression::zlib;
+  // Every array in the order of its data in the appended block: known before the XML head, since
+  // each DataArray's offset (from the first byte after '_', VTK format doc, "Appended Data
+  // Section") counts the bytes of the arrays before it, and compressed sizes are known only after
+  // compressing.
+  std::vector<const VtuArray*> order;
+  for (const auto& a : g.field_data) order.push_back(&a);
+  order.push_back(&g.points);
+  for (const auto& a : g.point_data) order.push_back(&a);
+  for (const auto& a : g.cell_data) order.push_back(&a);
+  for (const VtuArray* a : {&g.connectivity, &g.offsets, &g.types}) order.push_back(a);
+  std::vector<std::vector<unsigned char>> packed(zlib ? order.size() : 0);
+  for (std::size_t k = 0; k < packed.size(); ++k)
+    packed[k] = vtk_zlib_compress(order[k]->bytes.data(), order[k]->bytes.size());
+  // Raw: a UInt64 byte count, then the bytes. zlib: the block header and blocks (vtk_zlib.hpp).
+  auto stored_size = [&](std::size_t k) { return zlib ? packed[k].size() : 8 + order[k]->bytes.size(); };
+
   std::ostringstream head;
-  std::vector<const VtuArray*> order;  // arrays in the order of their data in the appended block
+  std::size_t next = 0;
   std::uint64_t offset = 0;
   auto array_tag = [&](const VtuArray& a, bool field) {
     head << "        <DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\" NumberOfComponents=\""
          << a.components << "\"";
     if (field) head << " NumberOfTuples=\"" << a.tuples() << "\"";
     head << " format=\"appended\" offset=\"" << offset << "\"/>\n";
-    offset += 8 + a.bytes.size();
-    order.push_back(&a);
+    offset += stored_size(next++);
   };
   head << "<?xml version=\"1.0\"?>\n"
-       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\""
+       << (zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
        << "  <UnstructuredGrid>\n";
   if (!g.field_data.empty()) {
     head << "    <FieldData>\n";
@@ -76,6 +91,10 @@ void write_vtu(const std::filesystem::path& path, const VtuGrid& g) {
   for (const VtuArray* a : order) counts.push_back(a->bytes.size());
   std::vector<std::string_view> pieces{text};
   for (std::size_t k = 0; k < order.size(); ++k) {
+    if (zlib) {
+      pieces.emplace_back(reinterpret_cast<const char*>(packed[k].data()), packed[k].size());
+      continue;
+    }
     pieces.emplace_back(reinterpret_cast<const char*>(&counts[k]), 8);
     pieces.emplace_back(reinterpret_cast<const char*>(order[k]->bytes.data()), order[k]->bytes.size());
   }
@@ -213,9 +232,13 @@ VtuGrid parse_vtu(const std::string& text, const std::string& file) {
   expect("type", "UnstructuredGrid");
   expect("byte_order", "LittleEndian");
   expect("header_type", "UInt64");
-  if (tag.attributes.count("compressor") && !tag.attributes.at("compressor").empty())
-    scan.fail("compressed data (compressor=\"" + tag.attributes.at("compressor") + "\") is not supported; "
-              "write raw appended data (pipeline/formats.md §1)");
+  bool zlib = false;
+  if (tag.attributes.count("compressor") && !tag.attributes.at("compressor").empty()) {
+    if (tag.attributes.at("compressor") != "vtkZLibDataCompressor")
+      scan.fail("compressed data (compressor=\"" + tag.attributes.at("compressor") + "\") is not supported; "
+                "write raw or vtkZLibDataCompressor appended data (pipeline/formats.md §1)");
+    zlib = true;
+  }
 
   std::vector<std::string> stack{"VTKFile"};
   std::vector<PendingArray> arrays;
@@ -244,9 +267,9 @@ VtuGrid parse_vtu(const std::string& text, const std::string& file) {
       p.array.name = at.count("Name") ? at.at("Name") : "";
       const std::string label = "DataArray '" + p.array.name + "' in <" + p.section + ">";
       p.array.type = at.count("type") ? at.at("type") : "";
-      if (p.array.type != "Float64" && p.array.type != "Int64" && p.array.type != "Int32" &&
-          p.array.type != "UInt8")
-        scan.fail(label + " has type '" + p.array.type + "'; expected Float64, Int64, Int32 or UInt8");
+      if (p.array.type != "Float64" && p.array.type != "Float32" && p.array.type != "Int64" &&
+          p.array.type != "Int32" && p.array.type != "UInt8")
+        scan.fail(label + " has type '" + p.array.type + "'; expected Float64, Float32, Int64, Int32 or UInt8");
       const std::string format = at.count("format") ? at.at("format") : "(missing)";
       if (format != "appended")
         scan.fail(label + " has format=\"" + format + "\"; every array must be format=\"appended\" (pipeline/formats.md §1)");
@@ -285,12 +308,20 @@ VtuGrid parse_vtu(const std::string& text, const std::string& file) {
     const std::size_t value_size = p.array.value_size();
     if (p.offset > data_end - data_begin || data_end - data_begin - p.offset < 8)
       scan.fail(label + ": offset " + std::to_string(p.offset) + " lies beyond the data (truncated file?)");
+    std::vector<unsigned char> inflated;
     std::uint64_t count = 0;
-    std::memcpy(&count, text.data() + data_begin + p.offset, 8);
-    const std::size_t start = data_begin + p.offset + 8;
-    if (count > data_end - start)
-      scan.fail(label + ": " + std::to_string(count) + " bytes announced but only " +
-                std::to_string(data_end - start) + " left (truncated file?)");
+    std::size_t start = data_begin + p.offset + 8;
+    if (zlib) {
+      std::size_t consumed = 0;
+      inflated = vtk_zlib_decompress(reinterpret_cast<const unsigned char*>(text.data()) + data_begin + p.offset,
+                                     data_end - data_begin - p.offset, consumed, file + ": " + label);
+      count = inflated.size();
+    } else {
+      std::memcpy(&count, text.data() + data_begin + p.offset, 8);
+      if (count > data_end - start)
+        scan.fail(label + ": " + std::to_string(count) + " bytes announced but only " +
+                  std::to_string(data_end - start) + " left (truncated file?)");
+    }
     if (count % (value_size * static_cast<std::size_t>(p.array.components)) != 0)
       scan.fail(label + ": " + std::to_string(count) + " bytes is not a whole number of tuples");
     const std::uint64_t tuples = count / (value_size * static_cast<std::size_t>(p.array.components));
@@ -300,8 +331,11 @@ VtuGrid parse_vtu(const std::string& text, const std::string& file) {
     else if (p.section == "CellData" || (p.section == "Cells" && p.array.name != "connectivity")) want = n_cells;
     if (tuples != want)
       scan.fail(label + " has " + std::to_string(tuples) + " tuples, expected " + std::to_string(want));
-    p.array.bytes.assign(text.begin() + static_cast<std::ptrdiff_t>(start),
-                         text.begin() + static_cast<std::ptrdiff_t>(start + count));
+    if (zlib)
+      p.array.bytes = std::move(inflated);
+    else
+      p.array.bytes.assign(text.begin() + static_cast<std::ptrdiff_t>(start),
+                           text.begin() + static_cast<std::ptrdiff_t>(start + count));
     if (p.section == "FieldData") g.field_data.push_back(std::move(p.array));
     else if (p.section == "PointData") g.point_data.push_back(std::move(p.array));
     else if (p.section == "CellData") g.cell_data.push_back(std::move(p.array));

@@ -81,9 +81,11 @@ Start start_or_restore(const RunOptions& opt, Prepared& p) {
 std::filesystem::path checkpoint_path(const Case& c) { return (c.output_dir / "checkpoint.bin").lexically_normal(); }
 
 OutputWriter open_output(const RunOptions& opt, const Prepared& p, const Start& s, const HistoryColumns& columns) {
-  if (!s.restarting) return OutputWriter(p.c.output_dir, columns.names());
+  // The frames' format (output.precision, compression, fields) reaches the writer here.
+  const FrameFormat format = frame_format_of(p.c.output);
+  if (!s.restarting) return OutputWriter(p.c.output_dir, columns.names(), nullptr, format);
   try {
-    return OutputWriter(p.c.output_dir, columns.names(), &s.resume);
+    return OutputWriter(p.c.output_dir, columns.names(), &s.resume, format);
   } catch (const Error& e) {  // history.csv shorter than recorded, a frame missing
     throw start_over(opt, e);
   }
