@@ -12,7 +12,37 @@
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
 case    ?= membrane
-config  ?= $(case)
+
+# case= and config= become paths (cases/<case>/, out/<case>/), and make expands command-line
+# variables in every recipe's environment: `case=a\`cmd\`` or `case=$$(shell cmd)` would run cmd,
+# and `case=../x` would read and delete outside the repository. So each is checked here, once,
+# before anything expands it: one word of SAFE_NAME_CHARS only, naming what exists.
+# $(value) and := never expand the text they hold, so a `$(shell …)` in the value stays text.
+SAFE_NAME_CHARS := a b c d e f g h i j k l m n o p q r s t u v w x y z \
+                   A B C D E F G H I J K L M N O P Q R S T U V W X Y Z 0 1 2 3 4 5 6 7 8 9 _ -
+# $(call unsafe_name,VAR): empty if the unexpanded value of VAR matches [A-Za-z0-9_-]+.
+unsafe_name = $(strip $(eval _pd_rest := $$(value $(1)))$(foreach c,$(SAFE_NAME_CHARS),$(eval \
+    _pd_rest := $$(subst $(c),,$$(_pd_rest))))$(if $(filter-out 1,$(words $(value $(1))))$(_pd_rest),bad))
+CASE_NAMES = $(patsubst cases/%/,%,$(wildcard cases/*/))
+ifneq ($(call unsafe_name,case),)
+  $(error case='$(value case)' is not a case name: a case is a folder cases/<name>/ with <name> made of \
+      letters, digits, '_' and '-' only; the cases are: $(CASE_NAMES))
+endif
+ifeq ($(wildcard cases/$(case)/),)
+  $(error case=$(case): no folder cases/$(case)/; the cases are: $(CASE_NAMES))
+endif
+ifeq ($(origin config),undefined)
+  config := $(case)
+endif
+ifneq ($(call unsafe_name,config),)
+  $(error config='$(value config)' is not a config name: a config is a file cases/$(case)/<name>.yaml \
+      with <name> made of letters, digits, '_' and '-' only)
+endif
+ifeq ($(wildcard cases/$(case)/$(config).yaml),)
+  $(error config=$(config): no file cases/$(case)/$(config).yaml; the configs of $(case) are: \
+      $(patsubst cases/$(case)/%.yaml,%,$(wildcard cases/$(case)/*.yaml)))
+endif
+
 PY      := /usr/bin/python3
 PYTEST  := /usr/bin/python3 -m pytest
 JOBS    ?= 2
@@ -49,17 +79,17 @@ $(SOLVER): $(SOLVER_SOURCES) | $(DEPS)
 	@touch $@
 
 check: | $(DEPS)
-	$(PY) -m pipeline.run check $(YAML)
+	$(PY) -m pipeline.run check '$(YAML)'
 
 # gmsh parameters live in the .yaml; this file changes only when they do.
 $(OUT)/mesh-parameters.json: $(YAML) $(PRE_SOURCES) | $(DEPS)
-	$(PY) -m pipeline.run mesh-parameters $< $@
+	$(PY) -m pipeline.run mesh-parameters '$<' '$@'
 
 $(OUT)/mesh.msh: $(CASEDIR)/$(case).geo $(OUT)/mesh-parameters.json | $(DEPS)
-	$(PY) -m pipeline.run mesh $(YAML) $< $@
+	$(PY) -m pipeline.run mesh '$(YAML)' '$<' '$@'
 
 $(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
-	$(PY) -m pipeline.run preprocess $< $(MESH) $(OUT)
+	$(PY) -m pipeline.run preprocess '$<' '$(MESH)' '$(OUT)'
 
 # A stamp, not history.csv, marks a finished solve: an interrupted run keeps its files (Ctrl-C and
 # SIGTERM write checkpoint.bin, pipeline/formats.md §5) and the next `make` resumes it, bitwise as if
@@ -68,24 +98,24 @@ $(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
 # (which then writes its checkpoint) instead of killing a shell and orphaning the solver.
 CHECKPOINT := $(OUT)/checkpoint.bin
 $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
-	@if [ -f $(CHECKPOINT) ] && [ $(CHECKPOINT) -nt $(OUT)/case.json ] && [ $(CHECKPOINT) -nt $(OUT)/nodes.vtu ] \
-	    && [ $(CHECKPOINT) -nt $(SOLVER) ]; then \
+	@if [ -f '$(CHECKPOINT)' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/case.json' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/nodes.vtu' ] \
+	    && [ '$(CHECKPOINT)' -nt '$(SOLVER)' ]; then \
 	  echo "$(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
-	  exec $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT); \
+	  exec '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
 	else \
 	  echo "$(SOLVER) $(OUT)/case.json"; \
-	  exec $(SOLVER) $(OUT)/case.json; \
+	  exec '$(SOLVER)' '$(OUT)/case.json'; \
 	fi
-	@touch $@
+	@touch '$@'
 
 $(OUT)/figures/.done: $(OUT)/.solved $(POST_SOURCES)
-	$(PY) -m postprocess $(OUT)
-	@touch $@
+	$(PY) -m postprocess '$(OUT)'
+	@touch '$@'
 
 # Redraw from existing results, never solving again.
 figures: | $(DEPS)
-	$(PY) -m postprocess $(OUT)
-	@touch $(OUT)/figures/.done
+	$(PY) -m postprocess '$(OUT)'
+	@touch '$(OUT)/figures/.done'
 
 test: $(SOLVER) | $(DEPS)
 	ctest --test-dir build/solver --output-on-failure -j$(JOBS)
@@ -152,6 +182,6 @@ validate: $(SOLVER) | $(DEPS)
 	$(PY) -m validation
 
 clean-case:
-	rm -rf $(OUT)
+	rm -rf -- '$(OUT)'
 clean:
 	rm -rf build out

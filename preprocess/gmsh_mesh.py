@@ -8,19 +8,43 @@ import subprocess
 from pipeline.atomic import atomic_path
 
 from .errors import PreprocessError
+from .geo_guard import check_geo
 
 GMSH = "gmsh"
 MAX_ERROR_LINES = 20
+# A mesh of the shipped cases takes seconds; a .geo that loops (For without end, a huge mesh)
+# must not hold `make` for ever. PD_GMSH_TIMEOUT (seconds) changes the limit.
+DEFAULT_TIMEOUT = 600.0
 
 
-def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[str, float]) -> None:
+def gmsh_timeout() -> float:
+    text = os.environ.get("PD_GMSH_TIMEOUT", "")
+    if not text:
+        return DEFAULT_TIMEOUT
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value > 0 or value != value or value == float("inf"):
+        raise PreprocessError(f"PD_GMSH_TIMEOUT={text!r}: expected a number of seconds > 0")
+    return value
+
+
+def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[str, float],
+             timeout: float | None = None) -> None:
     """`gmsh -<dimension> geo -o out -format msh4 -setnumber NAME VALUE ...`, written to a temporary
     name in the output directory and renamed on success. Gmsh's own error lines are in the
-    PreprocessError raised when gmsh fails (non-zero exit or any 'Error' line)."""
+    PreprocessError raised when gmsh fails (non-zero exit or any 'Error' line).
+
+    The .geo (and every file it makes gmsh read) is checked first by geo_guard: a .geo that runs
+    commands or writes files is refused before gmsh starts. gmsh is stopped after `timeout`
+    seconds (default PD_GMSH_TIMEOUT, else DEFAULT_TIMEOUT)."""
     if dimension not in (1, 2, 3):
         raise PreprocessError(f"{geo_path}: mesh dimension must be 1, 2 or 3, not {dimension}")
     if not os.path.isfile(geo_path):
         raise PreprocessError(f"{geo_path}: no such .geo file")
+    check_geo(geo_path)
+    limit = gmsh_timeout() if timeout is None else timeout
     exe = shutil.which(GMSH)
     if exe is None:
         raise PreprocessError(f"{geo_path}: the gmsh command is not installed (Debian package gmsh)")
@@ -28,7 +52,13 @@ def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[
         cmd = [exe, f"-{dimension}", geo_path, "-o", tmp, "-format", "msh4", "-nopopup"]
         for name, value in parameters.items():
             cmd += ["-setnumber", str(name), repr(float(value))]
-        result = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True)
+        try:
+            result = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                                    timeout=limit)
+        except subprocess.TimeoutExpired:  # subprocess.run has killed gmsh
+            raise PreprocessError(f"{geo_path}: gmsh did not finish within {limit:g} s and was stopped; "
+                                  f"coarsen the mesh (a larger mesh size) or raise the limit with "
+                                  f"PD_GMSH_TIMEOUT=<seconds>") from None
         output = (result.stdout + "\n" + result.stderr).splitlines()
         errors = []
         for line in output:

@@ -1,0 +1,199 @@
+"""Refuse a .geo file that would do more than describe geometry, before gmsh ever reads it.
+
+Cases are shared: opening one must not run a program, write or delete a file, or read one from
+outside its case folder. Gmsh's .geo language can do all of these (gmsh 4.8.4, Parser/Gmsh.y and
+Gmsh.l, the grammar gmsh itself is built from), so every file gmsh would read for a case is scanned
+here first: the .geo, every file it Includes or Merges (recursively, confined to the case folder),
+and the `<file>.opt` that gmsh merges by itself after reading `<file>` (Common/OpenFile.cpp).
+
+The scan works on tokens, as gmsh's lexer does: `//` and `/* */` comments and "…" / '…' strings are
+recognised first (gmsh has no escapes in strings), so a comment or a string that mentions
+SystemCall is fine, and only identifiers can trigger a rule. gmsh dispatches a command on an
+identifier (`SystemCall "…";` is `String__Index StringExpr ;`), and the one way to build that
+identifier from strings is StringToName[…] / S2N[…], which is refused; `name~{i}` only appends
+`_<i>`. Macro/Call with a computed name are allowed: they can only run a function whose body is in
+a file scanned here. Include/Merge take a string literal only, so the path that gmsh opens is the
+path checked.
+"""
+from __future__ import annotations
+
+import os
+import re
+
+from .errors import PreprocessError
+
+FIX = "a case's .geo may only describe geometry and mesh sizes; remove it"
+
+# Identifiers that act on the system or stop gmsh, whatever follows them (gmsh 4.8.4 Gmsh.y).
+FORBIDDEN = {
+    "SystemCall": "runs a shell command",
+    "System": "runs a shell command",
+    "NonBlockingSystemCall": "runs a shell command",
+    "OnelabRun": "runs an external program (a ONELAB client)",
+    "OnelabAction": "talks to ONELAB clients (external programs)",
+    "CreateDir": "creates a folder",
+    "Print": "writes an image file",
+    "Save": "writes a file",
+    "SendToServer": "sends data to a ONELAB server",
+    "Sleep": "pauses gmsh",
+    "Exit": "ends gmsh before the mesh is written",
+    "Abort": "ends the parse before the mesh is made",
+    "StringToName": "turns a string into a command or a name, so a forbidden command could be spelt in pieces",
+    "S2N": "turns a string into a command or a name, so a forbidden command could be spelt in pieces",
+    "Plugin": "runs a gmsh plugin (some write or read files)",
+    # Not in gmsh 4.8; refused in advance should a later gmsh add file commands under these names.
+    "DeleteFile": "deletes a file",
+    "RenameFile": "renames a file",
+    "CreateFile": "writes a file",
+}
+
+# Commands whose argument is a file that gmsh reads: a string literal, inside the case folder.
+READS_FILE = {"Include", "Merge", "MergeWithBoundingBox", "ShapeFromFile", "ListFromFile"}
+
+# Options that name a program to launch or a file to write (gmsh 4.8.4 Common/DefaultOptions.h).
+# Solver.* are the ONELAB clients' executables and remote logins: the whole category is refused.
+OPTION_RISK = re.compile(r"(FileName|Command|Executable\d*|TextEditor|WebBrowser|Interpreter|"
+                         r"RemoteLogin\d*|SaveOptions|SaveSession|Socket.*)$")
+
+# Files gmsh reads as data, not as .geo commands (everything else it would parse as .geo).
+DATA_EXTENSIONS = {".msh", ".step", ".stp", ".brep", ".iges", ".igs", ".stl", ".unv", ".med", ".vtk"}
+
+MAX_INCLUDE_DEPTH = 20
+MAX_GEO_BYTES = 10 * 1024 * 1024
+
+TOKEN = re.compile(r"""
+    (?P<space>[ \t\r\f]+) | (?P<newline>\n)
+  | (?P<line_comment>//[^\n]*)
+  | (?P<block_comment>/\*)
+  | (?P<string>"[^"]*"|'[^']*')
+  | (?P<open_string>["'])
+  | (?P<number>(?:\d+\.?\d*|\.\d+)(?:[Ee][-+]?\d+)?)
+  | (?P<ident>[A-Za-z_][A-Za-z0-9_]*)
+  | (?P<punct>>>|>=|<<|<=|==|!=|&&|\|\||\+\+|--|::|\.\.\.|[-+*/=]=|.)
+""", re.VERBOSE)
+
+
+def tokens(text: str, path: str):
+    """(kind, value, line) for every token outside comments: kind is ident, string, number or punct."""
+    line, at = 1, 0
+    while at < len(text):
+        m = TOKEN.match(text, at)
+        kind = m.lastgroup
+        if kind == "block_comment":
+            end = text.find("*/", m.end())
+            if end < 0:
+                raise PreprocessError(f"{path}:{line}: a /* comment is never closed; close it with */")
+            line += text.count("\n", at, end)
+            at = end + 2
+            continue
+        if kind == "open_string":
+            raise PreprocessError(f"{path}:{line}: a string is never closed; close it with {m.group()}")
+        if kind == "newline":
+            line += 1
+        elif kind == "string":
+            yield kind, m.group()[1:-1], line
+            line += m.group().count("\n")
+        elif kind in ("ident", "number", "punct"):
+            yield kind, m.group(), line
+        at = m.end()
+
+
+def check_geo(geo_path: str, case_dir: str | None = None) -> list[str]:
+    """Raise PreprocessError naming the file, the line and what to do if `geo_path` or any file it
+    makes gmsh read could run a command, write a file or read outside `case_dir` (default: the
+    .geo's folder). Returns the files scanned."""
+    case_dir = os.path.realpath(case_dir or os.path.dirname(os.path.abspath(geo_path)))
+    scanned: list[str] = []
+    _scan(geo_path, case_dir, scanned, depth=0)
+    return scanned
+
+
+def _scan(path: str, case_dir: str, scanned: list, depth: int):
+    real = os.path.realpath(path)
+    if real in scanned:
+        return  # an Include cycle: gmsh would loop, the .geo is wrong, but nothing new to check
+    scanned.append(real)
+    try:
+        if os.path.getsize(path) > MAX_GEO_BYTES:
+            raise PreprocessError(f"{path}: larger than {MAX_GEO_BYTES >> 20} MB; a .geo is a short script")
+        with open(path, "rb") as stream:
+            raw = stream.read()
+    except OSError as err:
+        raise PreprocessError(f"{path}: cannot read: {err.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = raw[:err.start].count(b"\n") + 1
+        raise PreprocessError(f"{path}:{line}: not UTF-8 text; a .geo is a text file") from None
+    found = list(tokens(text, path))
+    for k, (kind, value, line) in enumerate(found):
+        if kind != "ident":
+            continue
+        where = f"{path}:{line}"
+        if value in FORBIDDEN:
+            raise PreprocessError(f"{where}: '{value}' {FORBIDDEN[value]}; {FIX}")
+        if value == "Printf" and _printf_redirects(found, k):
+            raise PreprocessError(f"{where}: Printf(…) > \"file\" writes a file; {FIX}, or print to the "
+                                  f"terminal with Printf(…); alone")
+        if k + 2 < len(found) and found[k + 1][1] == "." and found[k + 2][0] == "ident":
+            option = found[k + 2][1]
+            if value == "Solver" or OPTION_RISK.search(option):
+                raise PreprocessError(f"{where}: the option {value}.{option} names a program to run or a "
+                                      f"file to write; {FIX}")
+        if value in READS_FILE:
+            target = _literal_argument(found, k)
+            if target is None:
+                raise PreprocessError(f"{where}: {value} needs a plain \"file name\" (a string literal, so "
+                                      f"that the file can be checked); write the name out")
+            _check_read(value, target, path, line, case_dir, scanned, depth)
+    opt = path + ".opt"
+    if os.path.exists(opt):  # gmsh merges <file>.opt after <file>, as .geo commands
+        _scan(opt, case_dir, scanned, depth + 1)
+
+
+def _printf_redirects(found, k) -> bool:
+    """Printf ( … ) followed by > or >> before the end of the statement: gmsh's SendToFile."""
+    depth = 0
+    for kind, value, _ in found[k + 1:]:
+        if kind != "punct":
+            continue
+        if value in "([{":
+            depth += 1
+        elif value in ")]}":
+            depth -= 1
+        elif value == ";" and depth <= 0:
+            return False
+        elif value in (">", ">>") and depth == 0:
+            return True
+    return False
+
+
+def _literal_argument(found, k):
+    """The file name of Include "f"; / Merge "f"; / ShapeFromFile("f") / ListFromFile["f"], when it is
+    one string literal followed by the end of the argument; else None."""
+    rest = found[k + 1:k + 4]
+    if len(rest) >= 2 and rest[0][0] == "string" and rest[1][1] == ";":
+        return rest[0][1]
+    if len(rest) == 3 and rest[0][1] in "([" and rest[1][0] == "string" and rest[2][1] in ")]":
+        return rest[1][1]
+    return None
+
+
+def _check_read(command, target, path, line, case_dir, scanned, depth):
+    where = f"{path}:{line}"
+    parts = re.split(r"[/\\]", target)
+    if os.path.isabs(target) or target.startswith("~") or ".." in parts:
+        raise PreprocessError(f"{where}: {command} \"{target}\": a case reads only files inside its own "
+                              f"folder; copy the file into {case_dir} and name it relative to {path}")
+    resolved = os.path.join(os.path.dirname(os.path.abspath(path)), target)
+    real = os.path.realpath(resolved)
+    if os.path.commonpath([real, case_dir]) != case_dir:
+        raise PreprocessError(f"{where}: {command} \"{target}\" leads outside the case folder {case_dir} "
+                              f"(a symbolic link?); copy the file into the case folder")
+    if not os.path.isfile(real):
+        raise PreprocessError(f"{where}: {command} \"{target}\": no such file in the case folder")
+    if os.path.splitext(real)[1].lower() in DATA_EXTENSIONS:
+        return
+    if depth >= MAX_INCLUDE_DEPTH:
+        raise PreprocessError(f"{where}: files included more than {MAX_INCLUDE_DEPTH} deep; include fewer")
+    _scan(resolved, case_dir, scanned, depth + 1)

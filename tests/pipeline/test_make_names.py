@@ -1,0 +1,80 @@
+"""The Makefile's case= and config= are names of what is under cases/, checked before anything
+expands them: a command in the name never runs, and a path never leaves the repository.
+
+These run the real make (parse-time checks only: no stage runs) with a marker file or a victim
+folder in a temporary directory, and assert that nothing happened and make said why."""
+import os
+import shutil
+import subprocess
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def make(*args):
+    env = {k: v for k, v in os.environ.items() if k not in ("case", "config", "MAKEFLAGS", "MAKELEVEL")}
+    return subprocess.run(["make", "--no-print-directory", "-C", ROOT, *args], env=env,
+                          capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+
+
+@pytest.mark.parametrize("name", [
+    "a`touch$${IFS}{marker}`",          # a shell command substitution in the recipe
+    "a$$(touch$${IFS}{marker})",
+    "$(shell touch {marker})",           # a make function, expanded wherever $(case) is
+    "a;touch {marker}",
+])
+@pytest.mark.parametrize("variable", ["case", "config"])
+def test_a_command_in_the_name_never_runs(tmp_path, variable, name):
+    marker = tmp_path / "pwned"
+    value = name.replace("{marker}", str(marker))
+    extra = ["case=membrane"] if variable == "config" else []
+    result = make("clean-case", *extra, f"{variable}={value}")
+    assert result.returncode != 0
+    assert f"is not a {variable} name" in result.stderr, result.stderr
+    assert "letters, digits, '_' and '-' only" in result.stderr
+    assert not marker.exists()
+
+
+def test_clean_case_never_deletes_outside_out(tmp_path):
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (victim / "keep.txt").write_text("precious\n")
+    relative = os.path.relpath(victim, os.path.join(ROOT, "out"))   # out/../../…/victim
+    assert relative.startswith("..")
+    result = make("clean-case", f"case={relative}")
+    assert result.returncode != 0
+    assert f"case='{relative}' is not a case name" in result.stderr, result.stderr
+    assert (victim / "keep.txt").read_text() == "precious\n"
+
+
+def test_a_case_path_never_writes_outside_out(tmp_path):
+    # cases/<rel> and out/<rel> are the same folder outside the repository: before the check,
+    # make wrote mesh-parameters.json into it.
+    folder = tmp_path / "x"
+    folder.mkdir()
+    shutil.copy(os.path.join(ROOT, "cases", "membrane", "membrane.yaml"), folder / "x.yaml")
+    relative = os.path.relpath(folder, os.path.join(ROOT, "cases"))
+    result = make(f"case={relative}", f"out/{relative}/mesh-parameters.json")
+    assert result.returncode != 0
+    assert "is not a case name" in result.stderr, result.stderr
+    assert sorted(p.name for p in folder.iterdir()) == ["x.yaml"]
+
+
+def test_a_missing_case_or_config_is_named():
+    result = make("clean-case", "case=no_such_case")
+    assert result.returncode != 0
+    assert "case=no_such_case: no folder cases/no_such_case/; the cases are: " in result.stderr
+    assert "membrane" in result.stderr
+    result = make("clean-case", "case=membrane", "config=no_such_config")
+    assert result.returncode != 0
+    assert "no file cases/membrane/no_such_config.yaml; the configs of membrane are: adaptive membrane" \
+        in result.stderr, result.stderr
+
+
+def test_valid_names_pass_and_are_quoted():
+    result = make("-n", "clean-case", "case=membrane", "config=adaptive")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "rm -rf -- 'out/membrane-adaptive'"
+    result = make("-n", "clean-case")   # the default case
+    assert result.returncode == 0 and result.stdout.strip() == "rm -rf -- 'out/membrane'"
