@@ -25,7 +25,18 @@ def plot_timestep(history: dict, case: CaseSettings, path: str):
     a.set_xlabel("step")
     a.set_ylabel("time step Δt [s]")
     a.set_title(f"{case.heading}: time step and iterations")
-    b.plot(t, dt, marker=marker, linewidth=0.8)
+    if "mode" in history:
+        # The mixed scheme (integrators/mixed.hpp): its load steps and explicit steps differ by
+        # orders of magnitude, so Δt is drawn on a log scale with each mode in its own colour.
+        for value, label in ((1, "quasi-static load steps"), (0, "explicit (Verlet) steps")):
+            chosen = history["mode"] == value
+            if np.any(chosen):
+                b.plot(t[chosen], dt[chosen], ".", markersize=3, label=label)
+        b.set_yscale("log")
+        b.legend(fontsize="small", loc="best")
+        a.set_yscale("log")
+    else:
+        b.plot(t, dt, marker=marker, linewidth=0.8)
     b.set_xlabel("time t [s]")
     b.set_ylabel("time step Δt [s]")
     c.plot(step, history["iterations"], marker=marker, linewidth=0.8, drawstyle="steps-pre",
