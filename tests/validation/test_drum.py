@@ -46,9 +46,10 @@ def test_pre_strain_energy_is_the_lattice_sum(out):
     # each pair once: ½·c·s²·|ξ|·V_i·V_j (= ¼ summed over both ends), s = ε0 for every bond
     expected = 0.5 * c * eps ** 2 * np.sum(length * volume[pairs[:, 0]] * volume[pairs[:, 1]])
     assert run.history["strain_energy"][0] == pytest.approx(expected, rel=1e-9)
-    # and every node starts at u = ε0·x, y alike (the frame included)
+    # and every node starts at u = ε0·x, y alike (the frame included, its fields stored as float32
+    # by default, output.precision: so equal to float32 rounding, half an ulp: 2⁻²⁴ relative)
     u0 = run.frame(0).displacement
-    assert np.allclose(u0[:, :2], eps * run.x[:, :2], rtol=0, atol=1e-15)
+    assert np.allclose(u0[:, :2], eps * run.x[:, :2], rtol=2.0 ** -24, atol=1e-15)
 
 
 def test_energy_error_falls_4x_when_dt_halves(tmp_path_factory):
