@@ -5,6 +5,7 @@
 
 #include "core/stability.hpp"
 #include "forces/damping.hpp"
+#include "parallel/node_sum.hpp"
 
 namespace pd {
 
@@ -24,6 +25,7 @@ ForceOperator::ForceOperator(Model& model) : model_(model) {
 }
 
 void ForceOperator::evaluate(State& s, double t) const {
+  if (decomposed_) decomposed_->update_ghosts(s.u);
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
   model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
   s.contact_energy = 0.0;
@@ -32,7 +34,19 @@ void ForceOperator::evaluate(State& s, double t) const {
 
 BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
-  const BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
+  BreakReport report;
+  if (!decomposed_) {
+    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
+  } else {
+    // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
+    // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
+    decomposed_->update_ghosts(s.u);
+    std::vector<double> lost(s.size(), 0.0);
+    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost.data());
+    report.broken = decomposed_->total(report.broken);
+    // The energy the broken bonds held, summed per node in node order as the serial path sums it.
+    if (report.broken > 0) report.energy = decomposed_->ordered_sum(lost);
+  }
   s.contact_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
   return report;
@@ -169,17 +183,13 @@ void ForceOperator::impose_prescribed_velocity(Vec3Array& v, double t1) const {
 
 double ForceOperator::kinetic_energy(const State& s) const {
   const Model& m = model_;
-  double sum = 0.0;  // serial, node order: the same for any thread count
-  for (std::size_t i = 0; i < s.size(); ++i)
-    sum += 0.5 * m.density[i] * m.nodes.volume[i] *
-           (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
-  return sum;
+  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) {
+    return 0.5 * m.density[i] * m.nodes.volume[i] * (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
+  });
 }
 
 double ForceOperator::strain_energy(const State& s) const {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < s.size(); ++i) sum += s.w[i] * model_.nodes.volume[i];
-  return sum;
+  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) { return s.w[i] * model_.nodes.volume[i]; });
 }
 
 double ForceOperator::external_power(const State& s, double t) const {
