@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/error.hpp"
 #include "core/stability.hpp"
 #include "forces/damping.hpp"
 #include "parallel/node_sum.hpp"
@@ -193,6 +194,7 @@ double ForceOperator::strain_energy(const State& s) const {
 }
 
 double ForceOperator::external_power(const State& s, double t) const {
+  if (decomposed_) return decomposed_external_power(s, t);
   double p = 0.0;
   for (const ForceTerm* term : power_terms_) term->add_power(s, t, p);
   for (const auto& bc : model_.conditions.prescribed) {
@@ -207,17 +209,62 @@ double ForceOperator::external_power(const State& s, double t) const {
   return p;
 }
 
+// The serial loops of external_power and damping_power, one ordered sum per loop, each continuing
+// the last (parallel/decomposed.hpp): the same additions in the same order, so the same bits.
+double ForceOperator::decomposed_external_power(const State& s, double t) const {
+  // The force terms' powers are their own loops (forces/): none is decomposed yet, and the run
+  // refuses a decomposed scene that has one (check_decomposable).
+  if (!power_terms_.empty())
+    throw Error("external_power: a force term's power (body force, contact, indenters) is not decomposed yet");
+  double p = 0.0;
+  std::vector<double> term(s.size());
+  for (const auto& bc : model_.conditions.prescribed) {
+    const auto c = static_cast<std::size_t>(bc.component);
+    const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;
+    std::fill(term.begin(), term.end(), 0.0);
+    for (std::int32_t i32 : bc.nodes) {
+      const auto i = static_cast<std::size_t>(i32);
+      const double reaction = model_.density[i] * a - s.f[c][i];
+      term[i] = model_.nodes.volume[i] * reaction * s.v[c][i];
+    }
+    p = decomposed_->ordered_sum(term, p);
+  }
+  return p;
+}
+
+double ForceOperator::decomposed_damping_power(const State& s) const {
+  if (model_.damping == 0.0) return 0.0;
+  const Model& m = model_;
+  double p = 0.0;
+  std::vector<double> term(s.size());
+  for (std::size_t d = 0; d < 3; ++d) {
+    for (std::size_t i = 0; i < term.size(); ++i)
+      term[i] = m.conditions.fixed[d][i] ? 0.0 : m.density[i] * m.nodes.volume[i] * s.v[d][i] * s.v[d][i];
+    p = decomposed_->ordered_sum(term, p);
+  }
+  return model_.damping * p;
+}
+
 void ForceOperator::update_work(State& s, double t, double dt) const {
   const double pe = external_power(s, t);
-  const double pd = damping_power(model_.damping, model_.density, model_.nodes.volume, s.v, model_.conditions.fixed);
+  const double pd = decomposed_ ? decomposed_damping_power(s)
+                                : damping_power(model_.damping, model_.density, model_.nodes.volume, s.v, model_.conditions.fixed);
   s.external_work += 0.5 * dt * (s.external_power + pe);
   s.damping_work += 0.5 * dt * (s.damping_power + pd);
   s.external_power = pe;
   s.damping_power = pd;
 }
 
-double ForceOperator::stable_time_step() const { return pd::stable_time_step(model_); }
-double ForceOperator::exact_time_step() const { return pd::exact_time_step(model_); }
+double ForceOperator::stable_time_step() const {
+  // A ghost's row is empty, so the local minimum is over owned nodes; min is exact in any order.
+  const double dt = pd::stable_time_step(model_);
+  return decomposed_ ? decomposed_->minimum(dt) : dt;
+}
+
+double ForceOperator::exact_time_step() const {
+  if (decomposed_) throw Error("time.dt: exact (the Lanczos limit) is not decomposed yet: use dt: stable on several ranks");
+  return pd::exact_time_step(model_);
+}
 
 std::vector<std::string> ForceOperator::work_plan(const Case& c) const {
   std::vector<std::string> lines;

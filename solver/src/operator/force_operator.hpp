@@ -94,6 +94,8 @@ class ForceOperator {
   std::vector<const ForceTerm*> power_terms_;            // the same, in power order
   std::vector<const ForceTerm*> built_;                  // per registry entry: its term, or null
   const Decomposed* decomposed_ = nullptr;
+  double decomposed_external_power(const State& s, double t) const;
+  double decomposed_damping_power(const State& s) const;
 };
 
 }  // namespace pd

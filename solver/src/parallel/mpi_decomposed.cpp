@@ -27,6 +27,12 @@ std::int64_t MpiDecomposed::total(std::int64_t local) const {
   return sum;
 }
 
+double MpiDecomposed::minimum(double local) const {
+  double least = local;
+  MPI_Allreduce(&local, &least, 1, MPI_DOUBLE, MPI_MIN, comm_);
+  return least;
+}
+
 Vec3Array MpiDecomposed::gather(const Vec3Array& a) const {
   Vec3Array out;
   for (int d = 0; d < 3; ++d) out[static_cast<std::size_t>(d)] = sum_->gather(a[static_cast<std::size_t>(d)]);

@@ -30,8 +30,11 @@ class MpiDecomposed : public Decomposed {
   const HaloExchange& halo() const { return *halo_; }
 
   void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
-  double ordered_sum(const std::vector<double>& per_node) const override { return sum_->sum(per_node); }
+  double ordered_sum(const std::vector<double>& per_node, double start = 0.0) const override {
+    return sum_->sum(per_node, start);
+  }
   std::int64_t total(std::int64_t local) const override;
+  double minimum(double local) const override;
 
   // The owned entries of a local per-node array in global node order, on rank 0 (empty elsewhere).
   std::vector<double> gather(const std::vector<double>& per_node) const { return sum_->gather(per_node); }

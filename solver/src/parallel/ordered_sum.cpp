@@ -34,8 +34,8 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) cons
   return out;
 }
 
-double OrderedSum::sum(const std::vector<double>& per_node) const {
-  double total = 0.0;
+double OrderedSum::sum(const std::vector<double>& per_node, double start) const {
+  double total = start;
   const std::vector<double> ordered = gather(per_node);
   if (rank_ == 0)
     for (double term : ordered) total += term;  // one by one in node order: the serial loop's bits

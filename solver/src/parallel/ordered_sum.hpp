@@ -20,8 +20,8 @@ class OrderedSum {
   // Collective over comm: rank 0 learns every rank's owned global numbers once.
   OrderedSum(MPI_Comm comm, const LocalPiece& piece);
 
-  // Σ per_node[l] over owned l, in global node order, on every rank. Collective.
-  double sum(const std::vector<double>& per_node) const;
+  // start + Σ per_node[l] over owned l, added in global node order, on every rank. Collective.
+  double sum(const std::vector<double>& per_node, double start = 0.0) const;
   // The owned entries of every rank, in global node order, on rank 0 (empty elsewhere). Collective.
   std::vector<double> gather(const std::vector<double>& per_node) const;
 
