@@ -268,7 +268,10 @@ double ForceOperator::exact_time_step() const {
 
 std::vector<std::string> ForceOperator::work_plan(const Case& c) const {
   std::vector<std::string> lines;
-  lines.push_back("work: bond forces over " + std::to_string(model_.bonds.directed() / 2) + " bonds, partial volume " +
+  // A piece's rows hold every bond of its owned nodes: summed over the ranks, each bond twice.
+  const auto directed = static_cast<std::int64_t>(model_.bonds.directed());
+  lines.push_back("work: bond forces over " + std::to_string((decomposed_ ? decomposed_->total(directed) : directed) / 2) +
+                  " bonds, partial volume " +
                   c.partial_volume + (c.dimension == 2 ? "; 2D (cell grids one bin thick)" : "; 3D"));
   const auto& registry = force_term_registry();
   for (std::size_t k = 0; k < registry.size(); ++k) {

@@ -4,11 +4,15 @@
 // parallel/node_sum.hpp then sums in node order exactly as before.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "core/bonds.hpp"
 #include "core/nodes.hpp"
 
 namespace pd {
+
+struct LocalPiece;
 
 class Decomposed {
  public:
@@ -27,6 +31,25 @@ class Decomposed {
   virtual std::int64_t total(std::int64_t local) const = 0;
   // The least of the ranks' values (exact, so the order does not matter). Collective.
   virtual double minimum(double local) const = 0;
+
+  virtual int rank() const = 0;
+  virtual int ranks() const = 0;
+  virtual const LocalPiece& piece() const = 0;
+  virtual LocalPiece& piece() = 0;
+  // The owned entries of a local per-node array, in global node order, on rank 0 (empty elsewhere).
+  // Collective.
+  virtual std::vector<double> gather(const std::vector<double>& per_node) const = 0;
+  Vec3Array gather(const Vec3Array& a) const {
+    return {gather(a[0]), gather(a[1]), gather(a[2])};
+  }
+  // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
+  // frames' damage reads). Collective.
+  virtual void gather_broken(const BondList& local, BondList& global) const = 0;
 };
+
+struct Model;
+// A run on several MPI ranks: the model decomposed over them (parallel/mpi_decomposed); null for a
+// run on one rank (or a build without MPI), which then takes the serial path. Collective.
+std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global);
 
 }  // namespace pd

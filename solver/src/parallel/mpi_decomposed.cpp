@@ -33,10 +33,12 @@ double MpiDecomposed::minimum(double local) const {
   return least;
 }
 
-Vec3Array MpiDecomposed::gather(const Vec3Array& a) const {
-  Vec3Array out;
-  for (int d = 0; d < 3; ++d) out[static_cast<std::size_t>(d)] = sum_->gather(a[static_cast<std::size_t>(d)]);
-  return out;
+std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global) {
+  int initialized = 0, ranks = 1;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  if (ranks == 1) return nullptr;
+  return std::make_unique<MpiDecomposed>(MPI_COMM_WORLD, global);
 }
 
 }  // namespace pd

@@ -22,11 +22,11 @@ class MpiDecomposed : public Decomposed {
   // work (parallel/decomposition.hpp), so no rank waits for another.
   MpiDecomposed(MPI_Comm comm, const Model& global);
 
-  int rank() const { return rank_; }
-  int ranks() const { return decomposition_.ranks; }
+  int rank() const override { return rank_; }
+  int ranks() const override { return decomposition_.ranks; }
   const Decomposition& decomposition() const { return decomposition_; }
-  LocalPiece& piece() { return piece_; }
-  const LocalPiece& piece() const { return piece_; }
+  LocalPiece& piece() override { return piece_; }
+  const LocalPiece& piece() const override { return piece_; }
   const HaloExchange& halo() const { return *halo_; }
 
   void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
@@ -36,9 +36,9 @@ class MpiDecomposed : public Decomposed {
   std::int64_t total(std::int64_t local) const override;
   double minimum(double local) const override;
 
-  // The owned entries of a local per-node array in global node order, on rank 0 (empty elsewhere).
-  std::vector<double> gather(const std::vector<double>& per_node) const { return sum_->gather(per_node); }
-  Vec3Array gather(const Vec3Array& a) const;
+  using Decomposed::gather;
+  std::vector<double> gather(const std::vector<double>& per_node) const override { return sum_->gather(per_node); }
+  void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
 
  private:
   MPI_Comm comm_;

@@ -8,6 +8,7 @@ OrderedSum::OrderedSum(MPI_Comm comm, const LocalPiece& piece)
   int ranks = 1;
   MPI_Comm_rank(comm, &rank_);
   MPI_Comm_size(comm, &ranks);
+  ranks_ = ranks;
   const int mine = static_cast<int>(owned_local_.size());
   if (rank_ == 0) counts_.resize(static_cast<std::size_t>(ranks)), starts_.assign(static_cast<std::size_t>(ranks) + 1, 0);
   MPI_Gather(&mine, 1, MPI_INT, counts_.data(), 1, MPI_INT, 0, comm);
@@ -32,6 +33,35 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) cons
     for (std::size_t k = 0; k < received_.size(); ++k) out[static_cast<std::size_t>(gathered_node_[k])] = received_[k];
   }
   return out;
+}
+
+void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
+  std::vector<std::uint8_t> flags;
+  for (std::int32_t l : owned_local_)
+    flags.insert(flags.end(), local.broken.begin() + local.offsets[static_cast<std::size_t>(l)],
+                 local.broken.begin() + local.offsets[static_cast<std::size_t>(l) + 1]);
+  // Rank 0 knows every rank's owned rows (gathered_node_) and so how many flags each sends.
+  std::vector<int> counts, starts;
+  if (rank_ == 0) {
+    counts.assign(static_cast<std::size_t>(ranks_), 0);
+    starts.assign(static_cast<std::size_t>(ranks_) + 1, 0);
+    for (int r = 0; r < ranks_; ++r) {
+      for (int k = starts_[static_cast<std::size_t>(r)]; k < starts_[static_cast<std::size_t>(r) + 1]; ++k) {
+        const auto g = static_cast<std::size_t>(gathered_node_[static_cast<std::size_t>(k)]);
+        counts[static_cast<std::size_t>(r)] += static_cast<int>(global.offsets[g + 1] - global.offsets[g]);
+      }
+      starts[static_cast<std::size_t>(r) + 1] = starts[static_cast<std::size_t>(r)] + counts[static_cast<std::size_t>(r)];
+    }
+  }
+  std::vector<std::uint8_t> all(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
+  MPI_Gatherv(flags.data(), static_cast<int>(flags.size()), MPI_UINT8_T, all.data(), counts.data(), starts.data(),
+              MPI_UINT8_T, 0, comm_);
+  if (rank_ != 0) return;
+  std::size_t at = 0;
+  for (std::int32_t g32 : gathered_node_) {
+    const auto g = static_cast<std::size_t>(g32);
+    for (std::int64_t k = global.offsets[g]; k < global.offsets[g + 1]; ++k) global.broken[static_cast<std::size_t>(k)] = all[at++];
+  }
 }
 
 double OrderedSum::sum(const std::vector<double>& per_node, double start) const {

@@ -24,12 +24,16 @@ class OrderedSum {
   double sum(const std::vector<double>& per_node, double start = 0.0) const;
   // The owned entries of every rank, in global node order, on rank 0 (empty elsewhere). Collective.
   std::vector<double> gather(const std::vector<double>& per_node) const;
+  // The broken flags of the owned rows of `local` (the piece's bond list) into the same rows of
+  // `global` (the whole model's), on rank 0. Collective.
+  void gather_rows(const BondList& local, BondList& global) const;
 
  private:
   MPI_Comm comm_;
   int rank_ = 0;
   std::int64_t global_nodes_ = 0;
   std::vector<std::int32_t> owned_local_;
+  int ranks_ = 1;
   std::vector<int> counts_, starts_;        // rank 0: per rank, its owned count and offset
   std::vector<std::int32_t> gathered_node_; // rank 0: the global number of each gathered entry
   mutable std::vector<double> send_, received_;
