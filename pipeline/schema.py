@@ -19,7 +19,8 @@ class Key:
     kind: number | integer | string | choice | section | named (user-named
     sub-sections, e.g. materials) | list (of sections) | names (list of strings) | boolean
     | components (x/y/z → number or [[t, v], ...] table) | numbers (list of
-    numbers) | parameters (name → number) | number_or_choice.
+    numbers) | parameters (name → number) | number_or_choice | point_or_name (a point
+    [x, y] or [x, y, z], or a node-set name).
     """
     kind: str
     doc: str
@@ -271,6 +272,9 @@ CASE = {
                   "frames spread over the run)", default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
+        probe=Key("point_or_name", "where probe.png follows the displacement component: a point "
+                  "[x, y] or [x, y, z] (the node nearest to it), or a node-set name (the mean over its "
+                  "nodes); default: the node nearest the centre of the bounding box", default=None, unit="m"),
     ),
 }
 
@@ -290,6 +294,8 @@ def markdown() -> str:
         return f"`{key.default}`"
 
     def kind_text(key: Key) -> str:
+        if key.kind == "point_or_name":
+            return "point or name"
         if key.kind in ("choice", "number_or_choice"):
             extra = " or number" if key.kind == "number_or_choice" else ""
             return " \\| ".join(str(c) for c in key.choices) + extra

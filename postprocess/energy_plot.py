@@ -38,7 +38,7 @@ def balance_error(history: dict) -> tuple[np.ndarray, float, str]:
     balance = energy_balance(history)
     work = float(history["external_work"][-1])
     if work != 0.0:
-        return (balance - balance[0]) / abs(work), abs(work), "|external work| at the end"
+        return (balance - balance[0]) / abs(work), abs(work), "|W_ext| at the end"
     stored = sum(history[column] for column, _ in balance_terms(history) if column != "damping_work")
     reference = float(np.max(np.abs(stored))) or 1.0
     return (balance - balance[0]) / reference, reference, "the largest stored energy"
@@ -72,7 +72,7 @@ def plot_energy(history: dict, case: CaseSettings, path: str) -> str:
     bottom.grid(alpha=0.3)
     plain_ticks(bottom)
     end = 100.0 * float(drift[-1])
-    bottom.set_title(f"balance drift at the end: {end:+.3g} % of {reference}", fontsize="small")
+    bottom.set_title(f"drift at the end: {end:+.3g} % of {reference}", fontsize="small")
     fig.tight_layout()
     save_figure(fig, path)
     return f"energy.png: {', '.join(drawn)} and their balance (drift at the end {end:+.3g} % of {reference})"
