@@ -3,8 +3,9 @@
     /usr/bin/python3 -m postprocess OUT_DIR [--case-json PATH] [--only figures|gmsh]
 
 Reads OUT_DIR/case.json (or PATH), OUT_DIR/history.csv and OUT_DIR/frames.pvd with its frames;
-writes OUT_DIR/figures/{energy,timestep,probe,damage_<i>,displacement_<i>}.png and
-OUT_DIR/gmsh/{results.msh,damage_final.pos}. Every frame is read once, in order.
+writes OUT_DIR/figures/{energy,timestep,probe,damage_<i>,displacement_<i>}.png,
+OUT_DIR/gmsh/{results.msh,damage_final.pos} and OUT_DIR/history.json (units of history.csv), and
+says on stderr, one line each, what it draws. Every frame is read once, in order.
 Exit status 0 on success, 1 with a message naming the file on an error, 2 on a usage error.
 """
 from __future__ import annotations
@@ -116,6 +117,17 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
             yield index, t, frame
 
     written = []
+    history_csv = os.path.join(out_dir, "history.csv")
+    if os.path.isfile(history_csv):
+        # history.json: each column's unit and meaning, from the header (formats.md §4)
+        from .history_units import write_history_json
+
+        path = os.path.join(out_dir, "history.json")
+        content = write_history_json(history_csv, path)
+        written.append(path)
+        unknown = [name for name, column in content["columns"].items() if column["unit"] is None]
+        say(f"history.json: unit and meaning of the {len(content['columns'])} columns of history.csv"
+            + (f" ({', '.join(unknown)} not documented in formats.md §4)" if unknown else ""))
     if do_gmsh:
         from .gmsh_export import write_damage_pos, write_results_msh
 

@@ -195,7 +195,8 @@ def test_postprocess_says_what_it_draws_one_line_per_figure(run2d, capsys):
     for name in ("gmsh/results.msh", "gmsh/damage_final.pos", "energy.png", "timestep.png",
                  "damage_<i>.png and displacement_<i>.png", "probe.png"):
         assert sum(line.startswith(f"postprocess: {name}:") for line in err) == 1, (name, err)
-    assert len(written) == 2 + 3 + 8  # gmsh files, energy/timestep/probe, 4 × 2 maps
+    assert len(written) == 1 + 2 + 3 + 8  # history.json, gmsh files, energy/timestep/probe, 4 × 2 maps
+    assert sum(line.startswith("postprocess: history.json:") for line in err) == 1
 
 
 def test_probe_is_the_node_nearest_a_point_or_the_mean_of_a_node_set(run2d, keep):
