@@ -129,8 +129,10 @@ CASE = {
     "node_sets": Key("named", "options of node sets (every gmsh physical group is a node set)",
                      default={}, fields={
                          "layer": Key("number", "nodes within this distance of a curve/surface group "
-                                      "belong to it (thesis §2.1: conditions act in a layer); default: "
-                                      "the first row of nodes", default=None, unit="m", minimum=0.0),
+                                      "belong to it (thesis §2.1: conditions act in a layer), measured "
+                                      "through the body (not across a notch or a hole) and to the group's "
+                                      "end points too (a round cap there); default: the first row of nodes",
+                                      default=None, unit="m", minimum=0.0),
                      }),
     "no_fail": Key("names", "node sets whose bonds never break (e.g. where loads are applied)",
                    default=[]),

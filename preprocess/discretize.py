@@ -18,6 +18,12 @@ Node sets. Every named physical group becomes a node set:
     in 2D or a surface in 3D, so that the first row of cell-centred nodes along the entity is
     taken; the same row along an edge of a box in 3D (√2/2·dx) and the nearest corner node of
     a point (√d/2·dx).
+    The distance is measured to the whole group, its end points included: a layer on an open
+    curve has round caps of radius `layer` around the curve's ends (a layer on a notch face also
+    takes the nodes ahead of the notch tip within `layer`). On a lattice, a layer wider than dx is
+    measured through the body: a node counts only if the straight path to its nearest point of the
+    group stays inside the body (locate.reached_through_body), so a layer on one face of a notch or
+    of a slit does not reach across the gap to the nodes on the other side.
 """
 from __future__ import annotations
 
@@ -29,7 +35,8 @@ from scipy.spatial import cKDTree
 from .cloud import SET_NAME, NodeCloud
 from .errors import PreprocessError, PreprocessWarning
 from .geometry import element_measure, simplices
-from .locate import lattice_axes, lattice_points, locate_lattice, near_entities
+from .locate import (lattice_axes, lattice_points, locate_lattice, near_entities, reached_through_body,
+                     sample_entities)
 from .mesh import Mesh, element_dimension
 
 METHODS = ("lattice", "mesh-nodes")
@@ -291,8 +298,15 @@ def _node_sets(mesh, points, top, cloud, where, method, dx, set_layers) -> dict[
                 if tree is None:
                     tree = cKDTree(cloud.points)
                 mask = np.zeros(len(cloud.volume), dtype=bool)
-                for conn in _entities(mesh, name):
+                entities = _entities(mesh, name)
+                for conn in entities:
                     mask |= near_entities(cloud.points, tree, points, conn, layer)
+                if method == "lattice" and layer > dx:
+                    # measured through the body: not across a notch or a hole (module docstring)
+                    samples = np.concatenate([sample_entities(points, conn, 0.25 * dx) for conn in entities])
+                    inside = reached_through_body(cloud.points, tree, np.flatnonzero(mask), samples, dx, dimension)
+                    mask = np.zeros(len(cloud.volume), dtype=bool)
+                    mask[inside] = True
         if not np.any(mask):
             raise PreprocessError(f"{path}: physical group '{name}' ({group.dim}D) holds no node of the "
                                   f"{method} discretization; "
