@@ -60,7 +60,7 @@ def test_misspelt_names_are_errors_at_their_lines(tmp_path, mesh, capsys):
     assert "plate.yaml:6: materials.mian: block 'mian' is not a physical group of the mesh" in text
     assert "(did you mean 'main'?)" in text
     assert "plate.yaml:13: node set 'lefft' is not a physical group of the mesh (did you mean 'left'?)" in text
-    assert "plate.yaml:17: node set 'hoel' is not a physical group of the mesh (did you mean 'hole'?)" in text
+    assert "plate.yaml:18: node set 'hoel' is not a physical group of the mesh (did you mean 'hole'?)" in text
 
 
 def test_a_curve_is_no_material(tmp_path, mesh, capsys):
