@@ -21,7 +21,7 @@ class CaseSettings:
     component: int = 0              # `figures.displacement_component`: 0, 1, 2 for x, y, z
     block_names: dict = dataclasses.field(default_factory=dict)  # block id -> name, for Gmsh
     gmsh: str = "figures"           # `output.gmsh`: frames copied to gmsh/results.msh: all | figures | none
-    integrator: str = "verlet"      # `time.integrator`: what timestep.png shows
+    integrator: str | None = None   # `time.integrator`: what timestep.png shows (None: not in case.json)
     breakable: bool = True          # some block has a fracture_energy: else no damage maps
     probe: list | str | None = None  # `figures.probe`: a point [m], a node-set name, or None (the centre)
 
@@ -88,8 +88,8 @@ def load_case_settings(path: str) -> CaseSettings:
     if isinstance(probe, list):
         probe = [float(c) for c in probe] + [0.0] * (3 - len(probe))
     time = case.get("time") or {}
-    integrator = time.get("integrator", "verlet") if isinstance(time, dict) else "verlet"
-    if not isinstance(integrator, str):
+    integrator = time.get("integrator") if isinstance(time, dict) else None
+    if integrator is not None and not isinstance(integrator, str):
         fail("time.integrator", f"expected a name, got {integrator!r}")
     blocks = case.get("blocks") or []
     block_names = {b["id"]: b["name"] for b in blocks if isinstance(b, dict)
