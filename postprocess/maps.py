@@ -1,9 +1,9 @@
 """damage_<i>.png and displacement_<i>.png: one frame's damage or displacement component on the nodes.
 
 2D cases: a scatter in the x–y plane (reference positions), one square marker per node, sized to
-the node spacing, equal aspect; the damage map also draws every broken bond as a thin, light,
-half-transparent line over the nodes, so the damage colours along the crack stay readable (black
-lines hid them). Coordinates, displacement and time are drawn in the SI prefix that fits (mm, µm, µs).
+the node spacing, equal aspect; the damage map colours damage and, while broken bonds are few
+(BOND_SHARE), draws them as light half-transparent hairlines (black lines hid the damage colours
+along the crack). Coordinates, displacement and time are drawn in the SI prefix that fits (mm, µm, µs).
 3D cases: two panels, a 3D scatter of the whole body (its surface is what shows) and the slice of
 nodes nearest to the mid-plane z = (z_min + z_max)/2 drawn like a 2D map, so that cracks inside the
 body are visible.
@@ -19,8 +19,12 @@ from .plotting import DPI, new_figure, plain_ticks, plt, save_figure, short_titl
 from .series import Frame
 
 # Broken bonds: a light grey hairline, half transparent, over the nodes (issue 16: black at 0.3 pt
-# buried the damage colours under the lines where the crack is).
+# buried the damage colours under the lines where the crack is). Only while they are few (at most
+# BOND_SHARE per node drawn): then a single broken bond, too little to colour its nodes much, still
+# shows. Once a crack has run, every node along it has a dozen broken bonds; their lines would
+# cover the damage colours, which show the crack by themselves (gmsh/damage_final.pos has them all).
 BOND_COLOUR, BOND_WIDTH, BOND_ALPHA = "0.85", 0.15, 0.5
+BOND_SHARE = 0.1
 MAX_3D_POINTS = 60000  # a denser 3D scatter is subsampled (every k-th node): matplotlib draws each marker
 
 
@@ -50,10 +54,10 @@ def displacement_range(frames: list[Frame], component: int) -> tuple[float, floa
 
 
 def _draw_plane(ax, xy: np.ndarray, values, segments, spacing, cmap, vmin, vmax):
-    """Nodes as squares (sized later by _size_markers) and broken bonds as thin lines."""
+    """Nodes as squares (sized later by _size_markers) and, while few, broken bonds as hairlines."""
     scatter = ax.scatter(xy[:, 0], xy[:, 1], c=values, cmap=cmap, vmin=vmin, vmax=vmax, s=1.0,
                          marker="s", linewidths=0)
-    if segments is not None and len(segments):
+    if segments is not None and 0 < len(segments) <= BOND_SHARE * len(xy):
         ax.add_collection(LineCollection(segments, colors=BOND_COLOUR, linewidths=BOND_WIDTH, alpha=BOND_ALPHA))
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     ax.set_xlim(lo[0] - spacing, hi[0] + spacing)
@@ -95,6 +99,8 @@ def plot_map(frame: Frame, case: CaseSettings, path: str, *, quantity: str, time
     what = "damage" if quantity == "damage" else f"u_{AXES[case.component]}"
     subtitle = short_title(case, f"{what} at t = {time * t_scale:.4g} {t_unit}")
     note = f"frame {index}"
+    if len(bonds) > BOND_SHARE * len(points):
+        note += f", {len(bonds)} broken bonds (not drawn)"
     if requested is not None and f"{requested:.4g}" != f"{time:.4g}":
         note += f", the nearest to t = {requested * t_scale:.4g} {t_unit}"
 
