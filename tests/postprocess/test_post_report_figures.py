@@ -240,3 +240,17 @@ def test_a_legend_that_would_cover_every_place_moves_above_the_data():
     assert legend_covers(ax) == 0
     check_readable(fig)
     plt.close(fig)
+
+
+def test_a_run_crack_s_many_bonds_are_not_drawn_over_the_damage_colours(run2d, keep):
+    """A dozen broken bonds per node along a crack would cover its colours: the map says how many."""
+    from postprocess.series import Frame
+    points = run2d.points
+    pairs = np.array([(i, j) for i in range(len(points)) for j in range(i + 1, min(i + 4, len(points)))])
+    frame = Frame(path="f.vtu", points=points, point_data={"displacement": np.zeros((len(points), 3)),
+                                                           "damage": np.full(len(points), 0.5)},
+                  broken_bonds=pairs)
+    maps.plot_map(frame, case(grid_spacing=synth.DX), "damage_0.png", quantity="damage", time=1e-5, index=3)
+    ax = keep["damage_0.png"].axes[0]
+    assert not [c for c in ax.collections if isinstance(c, LineCollection)]
+    assert f"{len(pairs)} broken bonds (not drawn)" in ax.get_title()
