@@ -93,6 +93,8 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
                 print(f"postprocess: note: figures.times {t:g} s is outside the run "
                       f"[{times[0]:g}, {times[-1]:g}] s; drawing the nearest frame", file=sys.stderr)
 
+    say(f"reading {len(series)} frames of {out_dir} (frames.pvd)"
+        + (f"; Gmsh copy of {'all of them' if case.gmsh == 'all' else 'those of the figures'}" if do_gmsh else ""))
     kept: dict = {}
     probe: dict = {"values": [], "nodes": None, "where": "", "position": None}
     nodes_file = os.path.join(out_dir, "nodes.vtu")
