@@ -19,7 +19,8 @@ class Key:
     kind: number | integer | string | choice | section | named (user-named
     sub-sections, e.g. materials) | list (of sections) | names (list of strings) | boolean
     | components (x/y/z → number or [[t, v], ...] table) | numbers (list of
-    numbers) | parameters (name → number) | number_or_choice.
+    numbers) | parameters (name → number) | number_or_choice | point_or_name (a point
+    [x, y] or [x, y, z], or a node-set name).
     """
     kind: str
     doc: str
@@ -128,8 +129,10 @@ CASE = {
     "node_sets": Key("named", "options of node sets (every gmsh physical group is a node set)",
                      default={}, fields={
                          "layer": Key("number", "nodes within this distance of a curve/surface group "
-                                      "belong to it (thesis §2.1: conditions act in a layer); default: "
-                                      "the first row of nodes", default=None, unit="m", minimum=0.0),
+                                      "belong to it (thesis §2.1: conditions act in a layer), measured "
+                                      "through the body (not across a notch or a hole) and to the group's "
+                                      "end points too (a round cap there); default: the first row of nodes",
+                                      default=None, unit="m", minimum=0.0),
                      }),
     "no_fail": Key("names", "node sets whose bonds never break (e.g. where loads are applied)",
                    default=[]),
@@ -271,6 +274,9 @@ CASE = {
                   "frames spread over the run)", default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
+        probe=Key("point_or_name", "where probe.png follows the displacement component: a point "
+                  "[x, y] or [x, y, z] (the node nearest to it), or a node-set name (the mean over its "
+                  "nodes); default: the node nearest the centre of the bounding box", default=None, unit="m"),
     ),
 }
 
@@ -290,6 +296,8 @@ def markdown() -> str:
         return f"`{key.default}`"
 
     def kind_text(key: Key) -> str:
+        if key.kind == "point_or_name":
+            return "point or name"
         if key.kind in ("choice", "number_or_choice"):
             extra = " or number" if key.kind == "number_or_choice" else ""
             return " \\| ".join(str(c) for c in key.choices) + extra

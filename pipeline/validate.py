@@ -146,6 +146,14 @@ class _Checker:
             return out
         if kind == "components":
             return self.components(value, keypath, key)
+        if kind == "point_or_name":
+            if isinstance(value, str) and NAME_PATTERN.match(value):
+                return value
+            if isinstance(value, list) and len(value) in (2, 3):
+                out = [self.number(v, keypath + (i,), Key("number", "", unit=key.unit)) for i, v in enumerate(value)]
+                return None if None in out else out
+            self.error(keypath, f"expected a point [x, y] or [x, y, z]{self.unit(key)} or a node-set name, got {value!r}")
+            return None
         raise AssertionError(f"schema kind {kind!r} has no checker")
 
     def mapping(self, value, keypath: tuple, fields: dict):
@@ -236,6 +244,9 @@ def _check_context(case: dict, checker: _Checker):
     dim = case["dimension"]
     if case["analysis"] is None:
         case["analysis"] = "3d" if dim == 3 else "plane_stress"
+    probe = case["figures"]["probe"]
+    if isinstance(probe, list) and dim == 3 and len(probe) != 3:
+        checker.error(("figures", "probe"), f"a point of a 3D case has three coordinates [x, y, z], got {probe!r}")
     if dim == 3 and case["analysis"] != "3d":
         checker.error(("analysis",), f"'{case['analysis']}' is a 2D model but dimension is 3; use 3d")
     if dim == 2 and case["analysis"] == "3d":
