@@ -463,6 +463,13 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
       ck.fail("blocks[" + std::to_string(k) + "].model",
               "is '" + c.blocks[k].model + "' but blocks[0] is '" + c.blocks[0].model +
                   "': every block of a case must use the same material model");
+  // A text parameter (LPS's influence function) is one per case: m_i sums over both blocks of a bond.
+  for (std::size_t k = 1; k < c.blocks.size(); ++k)
+    for (const auto& [name, value] : c.blocks[k].choices)
+      if (value != c.blocks[0].choice(name, value))
+        ck.fail("blocks[" + std::to_string(k) + "]." + name, "is '" + value + "' but blocks[0] has '" +
+                                                               c.blocks[0].choice(name, value) +
+                                                               "': every block of a case must use the same " + name);
 
   if (const json* j = ck.optional(root, "no_fail_sets")) c.no_fail_sets = ck.strings(*j, "no_fail_sets");
   if (const json* j = ck.optional(root, "node_sets")) c.node_sets = ck.strings(*j, "node_sets");
