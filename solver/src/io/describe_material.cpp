@@ -36,8 +36,8 @@ nlohmann::json describe_material_keys() {
   for (auto& [name, key] : keys.items()) {
     if (!key.contains("models")) continue;
     bool everywhere = key["models"].size() == material_registry().keys().size();
-    for (const std::string& model : key["models"])
-      for (const MaterialParameter& p : material_registry().get(model).parameters)
+    for (const auto& model : key["models"])
+      for (const MaterialParameter& p : material_registry().get(model.get<std::string>()).parameters)
         if (p.name == name && !p.required) everywhere = false;
     if (everywhere) {
       key["required"] = true;

@@ -24,6 +24,7 @@
 // Peridigm, which keep m and drop it, are not.
 #pragma once
 #include <cfloat>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,7 +37,22 @@ namespace pd {
 // ω(|ξ|) (Peridigm's names: One, and Gaussian exp(−|ξ|²/δ²); 1/|ξ| as CabanaPD's second choice).
 enum class Influence { one, inverse_length, gaussian };
 Influence influence_named(const std::string& name);
-double influence(Influence kind, double length, double horizon);
+// Inline and in one expression per kind, so that the constructor's m_i and the kernel's m'_i are
+// computed by the same operations (bitwise equal while a family is whole).
+template <Influence kKind>
+inline double influence_of(double length, double horizon) {
+  if constexpr (kKind == Influence::inverse_length) return 1.0 / length;
+  else if constexpr (kKind == Influence::gaussian) return std::exp(-(length * length) / (horizon * horizon));
+  else return 1.0;
+}
+inline double influence(Influence kind, double length, double horizon) {
+  switch (kind) {
+    case Influence::inverse_length: return influence_of<Influence::inverse_length>(length, horizon);
+    case Influence::gaussian: return influence_of<Influence::gaussian>(length, horizon);
+    case Influence::one: break;
+  }
+  return influence_of<Influence::one>(length, horizon);
+}
 
 // The moduli of one block for the analysis: κ (3D bulk, or in-plane bulk in 2D) and μ [Pa].
 struct LpsModuli {

@@ -35,15 +35,6 @@ Influence influence_named(const std::string& name) {
   throw Error("unknown influence function '" + name + "'; known: one, inverse_length, gaussian");
 }
 
-double influence(Influence kind, double length, double horizon) {
-  switch (kind) {
-    case Influence::inverse_length: return 1.0 / length;
-    case Influence::gaussian: return std::exp(-(length * length) / (horizon * horizon));
-    case Influence::one: break;
-  }
-  return 1.0;
-}
-
 LpsModuli lps_moduli(double e, double nu, const std::string& analysis) {
   LpsModuli out;
   out.mu = e / (2.0 * (1.0 + nu));

@@ -51,8 +51,8 @@ struct LpsKernel {
     nodes = static_cast<std::int64_t>(model.nodes.size());
   }
 
-  // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, the stretch s (zeroed near round-off), the
-  // extension ext = s|ξ|'s unrounded form y − |ξ| (0 where s is), 1/y (1 for a crushed bond: its
+  // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, the stretch s = (y − |ξ|)/|ξ|, the extension
+  // ext = y − |ξ| (0 where |ext| ≤ kLpsStretchZero·|ξ|: round-off), 1/y (1 for a crushed bond: its
   // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j.
   struct Bond {
     double length, e0, e1, e2, y, s, ext, inv_y, omega, vj;
@@ -65,10 +65,10 @@ struct LpsKernel {
     t.e1 = (x[1][j] + u[1][j]) - (x[1][i] + u[1][i]);
     t.e2 = (x[2][j] + u[2][j]) - (x[2][i] + u[2][i]);
     t.y = std::sqrt(t.e0 * t.e0 + t.e1 * t.e1 + t.e2 * t.e2);
-    const double s = (t.y - t.length) / t.length;
-    const bool real = std::fabs(s) > kLpsStretchZero;
-    t.s = real ? s : 0.0;
-    t.ext = real ? t.y - t.length : 0.0;
+    const double ext = t.y - t.length;
+    const bool real = std::fabs(ext) > kLpsStretchZero * t.length;
+    t.s = ext / t.length;  // the breaking criterion's stretch, as PMB's
+    t.ext = real ? ext : 0.0;
     t.inv_y = 1.0 / (t.y > 0.0 ? t.y : 1.0);
     t.omega = influence(kind, t.length, horizon);
     t.vj = volume[j] * volume_weight(t.length);
@@ -109,6 +109,115 @@ struct LpsKernel {
 };
 
 namespace {
+
+// Bonds per chunk of a row: the chunk's terms are computed by loops the compiler vectorises (no
+// reduction in them), then summed in bond order by a short scalar loop, so the sums are those of
+// a plain loop over the row in order (and the slow exact paths above give bitwise the same).
+constexpr int kChunk = 64;
+
+// One binary for every x86-64 machine, each running its widest code with the same IEEE operations
+// (no FMA contraction: solver/CMakeLists.txt), as PMB's kernel (docs/performance.md).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define PD_LPS_CLONES __attribute__((target_clones("default", "arch=x86-64-v2", "arch=x86-64-v3")))
+#else
+#define PD_LPS_CLONES
+#endif
+
+// Sweep 1, row i from the current flags: Σ ω|ξ| ext V_j and m'_i; kBreaking also counts the intact
+// bonds over s0 (candidates: no-fail ends are left to dilatation_row).
+template <Influence kKind, bool kBreaking>
+PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const double* s0_row,
+                                       const std::int32_t* block, double& sum_theta, double& m_intact,
+                                       std::int64_t& over) {
+  const double xi0 = k.x[0][i], xi1 = k.x[1][i], xi2 = k.x[2][i];
+  const double yi0 = xi0 + k.u[0][i], yi1 = xi1 + k.u[1][i], yi2 = xi2 + k.u[2][i];
+  double st = 0.0, sm = 0.0;
+  std::int64_t ov = 0;
+  const std::int64_t end = k.offsets[i + 1];
+  for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
+    std::int64_t jq[kChunk];
+    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk];
+    for (int q = 0; q < m; ++q) {
+      jq[q] = k.neighbour[base + q];
+      intact[q] = k.broken[base + q] ? 0.0 : 1.0;
+      if constexpr (kBreaking) s0q[q] = s0_row[block[jq[q]]];
+    }
+    for (int q = 0; q < m; ++q) {
+      const std::int64_t j = jq[q];
+      const double d0 = k.x[0][j] - xi0, d1 = k.x[1][j] - xi1, d2 = k.x[2][j] - xi2;
+      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+      const double e0 = (k.x[0][j] + k.u[0][j]) - yi0, e1 = (k.x[1][j] + k.u[1][j]) - yi1,
+                   e2 = (k.x[2][j] + k.u[2][j]) - yi2;
+      const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+      const double raw = y - length;
+      const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
+      const double omega = influence_of<kKind>(length, k.horizon);
+      const double vj = k.volume[j] * k.volume_weight(length);
+      ta[q] = intact[q] * (omega * length * ext * vj);
+      tb[q] = intact[q] * (omega * length * length * vj);
+      if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw / length > s0q[q]);
+    }
+    for (int q = 0; q < m; ++q) {
+      st += ta[q];
+      sm += tb[q];
+    }
+  }
+  sum_theta = st;
+  m_intact = sm;
+  over = ov;
+}
+
+// Sweep 2, row i: the force density and W_i (lps.hpp), from θ and P of both ends.
+struct ForceRow {
+  double f0, f1, f2, w;
+};
+template <Influence kKind>
+PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const double* theta, const double* p) {
+  const double xi0 = k.x[0][i], xi1 = k.x[1][i], xi2 = k.x[2][i];
+  const double yi0 = xi0 + k.u[0][i], yi1 = xi1 + k.u[1][i], yi2 = xi2 + k.u[2][i];
+  const double pi = p[i], ai = k.a[i], th = theta[i], d = k.d;
+  double f0 = 0.0, f1 = 0.0, f2 = 0.0, dev = 0.0;
+  const std::int64_t end = k.offsets[i + 1];
+  for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
+    std::int64_t jq[kChunk];
+    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk];
+    for (int q = 0; q < m; ++q) {
+      jq[q] = k.neighbour[base + q];
+      intact[q] = k.broken[base + q] ? 0.0 : 1.0;
+      pq[q] = p[jq[q]];
+      aq[q] = k.a[jq[q]];
+    }
+    for (int q = 0; q < m; ++q) {
+      const std::int64_t j = jq[q];
+      const double d0 = k.x[0][j] - xi0, d1 = k.x[1][j] - xi1, d2 = k.x[2][j] - xi2;
+      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+      const double e0 = (k.x[0][j] + k.u[0][j]) - yi0, e1 = (k.x[1][j] + k.u[1][j]) - yi1,
+                   e2 = (k.x[2][j] + k.u[2][j]) - yi2;
+      const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+      const double raw = y - length;
+      const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
+      const double inv_y = 1.0 / (y > 0.0 ? y : 1.0);
+      const double omega = influence_of<kKind>(length, k.horizon);
+      const double vj = k.volume[j] * k.volume_weight(length);
+      const double tt = omega * (length * (pi + pq[q]) + (ai + aq[q]) * ext);
+      const double scale = intact[q] * (tt * vj * inv_y);
+      t0[q] = scale * e0;
+      t1[q] = scale * e1;
+      t2[q] = scale * e2;
+      const double ed = ext - th * length / d;
+      tw[q] = intact[q] * (omega * ed * ed * vj);
+    }
+    for (int q = 0; q < m; ++q) {  // in bond order: the same sums for any thread count
+      f0 += t0[q];
+      f1 += t1[q];
+      f2 += t2[q];
+      dev += tw[q];
+    }
+  }
+  return ForceRow{f0, f1, f2, 0.5 * k.kappa[i] * th * th + 0.5 * ai * dev};
+}
 
 // What the breaking sweep needs besides the kernel (the PMB criterion: a bond breaks once its
 // stretch exceeds s0 of its block pair, unless an end is in a no-fail set).
@@ -156,47 +265,68 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   return once;
 }
 
-// Sweep 1 over every node: θ and P per node. Returns the bonds broken now (each once).
-std::int64_t dilatation_sweep(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
-                              std::vector<double>& p) {
+// Sweep 1 over every node: θ and P per node. Returns the bonds broken now (each once). A row with
+// candidates for breaking (rare: near a crack tip) is redone by dilatation_row, exactly.
+template <Influence kKind>
+std::int64_t dilatation_sweep_of(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
+                                 std::vector<double>& p) {
   theta.assign(static_cast<std::size_t>(k.nodes), 0.0);
   p.assign(static_cast<std::size_t>(k.nodes), 0.0);
   std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
 #pragma omp parallel for schedule(static) reduction(+ : newly)
   for (std::int64_t i = 0; i < k.nodes; ++i) {
-    double th = 0.0, mi = 0.0;
-    newly += dilatation_row(k, i, br, th, mi);
+    double th = 0.0, st = 0.0, mi = 0.0;
+    std::int64_t over = 0;
+    if (br && !br->no_fail[i]) {
+      dilatation_row_fast<kKind, true>(k, i, br->s0_pair + br->block[i] * br->blocks, br->block, st, mi, over);
+    } else {
+      dilatation_row_fast<kKind, false>(k, i, nullptr, nullptr, st, mi, over);
+    }
+    if (over > 0) {
+      newly += dilatation_row(k, i, br, th, mi);
+    } else {
+      th = k.theta_of(i, st);
+      if (br && br->lost) br->lost[i] = 0.0;
+    }
     theta[static_cast<std::size_t>(i)] = th;
     p[static_cast<std::size_t>(i)] = k.p_of(i, th, mi);
   }
   return newly;
 }
 
+std::int64_t dilatation_sweep(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
+                              std::vector<double>& p) {
+  switch (k.kind) {
+    case Influence::inverse_length: return dilatation_sweep_of<Influence::inverse_length>(k, br, theta, p);
+    case Influence::gaussian: return dilatation_sweep_of<Influence::gaussian>(k, br, theta, p);
+    case Influence::one: break;
+  }
+  return dilatation_sweep_of<Influence::one>(k, br, theta, p);
+}
+
 // Sweep 2: f_i += Σ_j (t_ij + t_ji) V_j e/y, t_ij + t_ji = ω(|ξ|(P_i + P_j) + (a_i + a_j) ext); W_i.
-void force_sweep(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
-                 double* w) {
+template <Influence kKind>
+void force_sweep_of(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
+                    double* w) {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < k.nodes; ++i) {
-    const double pi = p[static_cast<std::size_t>(i)], ai = k.a[i], th = theta[static_cast<std::size_t>(i)];
-    double f0 = 0.0, f1 = 0.0, f2 = 0.0, dev = 0.0;
-    for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
-      if (k.broken[q]) continue;
-      const std::int64_t j = k.neighbour[q];
-      const LpsKernel::Bond t = k.bond(i, j);
-      const double tt = t.omega * (t.length * (pi + p[static_cast<std::size_t>(j)]) + (ai + k.a[j]) * t.ext);
-      const double scale = tt * t.vj * t.inv_y;
-      f0 += scale * t.e0;
-      f1 += scale * t.e1;
-      f2 += scale * t.e2;
-      const double ed = t.ext - th * t.length / k.d;
-      dev += t.omega * ed * ed * t.vj;
-    }
+    const ForceRow r = force_row_fast<kKind>(k, i, theta.data(), p.data());
     const auto iu = static_cast<std::size_t>(i);
-    f[0][iu] += f0;
-    f[1][iu] += f1;
-    f[2][iu] += f2;
-    if (w) w[i] = 0.5 * k.kappa[i] * th * th + 0.5 * ai * dev;
+    f[0][iu] += r.f0;
+    f[1][iu] += r.f1;
+    f[2][iu] += r.f2;
+    if (w) w[i] = r.w;
   }
+}
+
+void force_sweep(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
+                 double* w) {
+  switch (k.kind) {
+    case Influence::inverse_length: return force_sweep_of<Influence::inverse_length>(k, theta, p, f, w);
+    case Influence::gaussian: return force_sweep_of<Influence::gaussian>(k, theta, p, f, w);
+    case Influence::one: break;
+  }
+  force_sweep_of<Influence::one>(k, theta, p, f, w);
 }
 
 Breaking breaking_of(Model& m, double* lost) {
