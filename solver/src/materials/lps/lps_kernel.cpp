@@ -51,11 +51,14 @@ struct LpsKernel {
     nodes = static_cast<std::int64_t>(model.nodes.size());
   }
 
-  // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, the stretch s = (y − |ξ|)/|ξ|, the extension
-  // ext = y − |ξ| (0 where |ext| ≤ kLpsStretchZero·|ξ|: round-off), 1/y (1 for a crushed bond: its
+  // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, raw = y − |ξ| and the extension ext = raw but
+  // 0 where |raw| ≤ kLpsStretchZero·|ξ| (round-off), 1/y (1 for a crushed bond: its
   // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j.
   struct Bond {
-    double length, e0, e1, e2, y, s, ext, inv_y, omega, vj;
+    double length, e0, e1, e2, y, raw, ext, inv_y, omega, vj;
+    // The breaking criterion (PMB's s > s0, without a division): y − |ξ| > s0 |ξ|. Both copies of
+    // a bond see bitwise the same y and |ξ|, so they break in the same sweep.
+    bool over(double s0) const { return raw > s0 * length; }
   };
   Bond bond(std::int64_t i, std::int64_t j) const {
     Bond t;
@@ -67,7 +70,7 @@ struct LpsKernel {
     t.y = std::sqrt(t.e0 * t.e0 + t.e1 * t.e1 + t.e2 * t.e2);
     const double ext = t.y - t.length;
     const bool real = std::fabs(ext) > kLpsStretchZero * t.length;
-    t.s = ext / t.length;  // the breaking criterion's stretch, as PMB's
+    t.raw = ext;
     t.ext = real ? ext : 0.0;
     t.inv_y = 1.0 / (t.y > 0.0 ? t.y : 1.0);
     t.omega = influence(kind, t.length, horizon);
@@ -124,8 +127,9 @@ constexpr int kChunk = 64;
 #endif
 
 // Sweep 1, row i from the current flags: Σ ω|ξ| ext V_j and m'_i; kBreaking also counts the intact
-// bonds over s0 (candidates: no-fail ends are left to dilatation_row).
-template <Influence kKind, bool kBreaking>
+// bonds over s0 (candidates: no-fail ends are left to dilatation_row); kOneBlock skips the gather of
+// the far end's block (one s0 for every bond).
+template <Influence kKind, bool kBreaking, bool kOneBlock>
 PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const double* s0_row,
                                        const std::int32_t* block, double& sum_theta, double& m_intact,
                                        std::int64_t& over) {
@@ -141,7 +145,7 @@ PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const
     for (int q = 0; q < m; ++q) {
       jq[q] = k.neighbour[base + q];
       intact[q] = k.broken[base + q] ? 0.0 : 1.0;
-      if constexpr (kBreaking) s0q[q] = s0_row[block[jq[q]]];
+      if constexpr (kBreaking) s0q[q] = kOneBlock ? s0_row[0] : s0_row[block[jq[q]]];
     }
     for (int q = 0; q < m; ++q) {
       const std::int64_t j = jq[q];
@@ -156,7 +160,7 @@ PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const
       const double vj = k.volume[j] * k.volume_weight(length);
       ta[q] = intact[q] * (omega * length * ext * vj);
       tb[q] = intact[q] * (omega * length * length * vj);
-      if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw / length > s0q[q]);
+      if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw > s0q[q] * length);  // Bond::over
     }
     for (int q = 0; q < m; ++q) {
       st += ta[q];
@@ -245,7 +249,7 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
     const std::int64_t j = k.neighbour[q];
     if (k.broken[q] || br->no_fail[j]) continue;
-    over += k.bond(i, j).s > s0_row[br->block[j]];
+    over += k.bond(i, j).over(s0_row[br->block[j]]);
   }
   if (over == 0) {
     if (br->lost) br->lost[i] = 0.0;
@@ -255,7 +259,7 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   std::int64_t once = 0;
   for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
     const std::int64_t j = k.neighbour[q];
-    if (k.broken[q] || br->no_fail[j] || !(k.bond(i, j).s > s0_row[br->block[j]])) continue;
+    if (k.broken[q] || br->no_fail[j] || !k.bond(i, j).over(s0_row[br->block[j]])) continue;
     k.broken[q] = 1;
     once += i < j;
   }
@@ -278,9 +282,11 @@ std::int64_t dilatation_sweep_of(const LpsKernel& k, const Breaking* br, std::ve
     double th = 0.0, st = 0.0, mi = 0.0;
     std::int64_t over = 0;
     if (br && !br->no_fail[i]) {
-      dilatation_row_fast<kKind, true>(k, i, br->s0_pair + br->block[i] * br->blocks, br->block, st, mi, over);
+      const double* s0_row = br->s0_pair + br->block[i] * br->blocks;
+      if (br->blocks == 1) dilatation_row_fast<kKind, true, true>(k, i, s0_row, br->block, st, mi, over);
+      else dilatation_row_fast<kKind, true, false>(k, i, s0_row, br->block, st, mi, over);
     } else {
-      dilatation_row_fast<kKind, false>(k, i, nullptr, nullptr, st, mi, over);
+      dilatation_row_fast<kKind, false, true>(k, i, nullptr, nullptr, st, mi, over);
     }
     if (over > 0) {
       newly += dilatation_row(k, i, br, th, mi);
