@@ -11,8 +11,10 @@
 //   W_i  = (κ/2) θ_i² + (α/(2 m_i)) Σ_j ω (e^d)² V_j,  α = 15μ (3D), 8μ (2D)
 // with κ the bulk modulus K in 3D and the in-plane bulk modulus in 2D (plane strain K + μ/3 =
 // E/(2(1+ν)(1−2ν)), plane stress E/(2(1−ν))), μ = E/(2(1+ν)). For a uniform small strain ε this
-// is the continuum W = (κ/2)(tr ε)² + μ ε^d:ε^d (the 2D form of Le, Chan & Schwartz 2014, IJNME
-// 98:547, derived the same way: the in-plane deviator, averaged over the circle, gives 8μ/m).
+// is the continuum W = (κ/2)(tr ε)² + μ ε^d:ε^d: in 3D the average of (n·ε^d·n)² over the sphere is
+// (2/15) ε^d:ε^d, hence 15μ/m; in 2D over the circle it is ε^d:ε^d/4 (in-plane deviator), hence
+// 8μ/m — derived here from the energy; Le et al. 2014 (the 2D ordinary state-based model) state
+// the plane forms with the 3D dilatation, which differ from these only in how θ is named.
 //
 // The force is the exact gradient of Σ_i V_i W_i: with t_ij = ∂W_i/∂e_ij / V_j,
 //   t_ij = ω [ |ξ| P_i + a_i e ],  a_i = α_i/m_i,
