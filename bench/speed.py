@@ -65,7 +65,7 @@ def node_order_study(exe, header, side, steps, workdir):
     return rates
 
 
-def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=2):
+def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=2, models=("pmb",)):
     """LAMMPS's PERI package on the same brick (bench/lammps_brick.py), serial and with 2 MPI
     ranks, against pd_speed with 1 and 2 threads: the two codes alternate, `repeats` runs each, and
     the best run of each counts (a busy neighbour slows a run, nothing speeds it up). Rates are
@@ -80,13 +80,14 @@ def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=
     with open(out_csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
-        for workers in threads:
+        for model, workers in [(m, t) for m in models for t in threads]:
             best_ours, best_lammps = None, None
             for _ in range(repeats):
-                ours = dict(zip(header.split(","), run_speed(exe, side, workers, steps, workdir).split(",")))
+                ours = dict(zip(header.split(","), run_speed(exe, side, workers, steps, workdir,
+                                                             model=model).split(",")))
                 if best_ours is None or float(ours["loop_s"]) < float(best_ours["loop_s"]):
                     best_ours = ours
-                loop, atoms = lammps_brick.run_lammps(side, steps, workers, workdir)
+                loop, atoms = lammps_brick.run_lammps(side, steps, workers, workdir, model)
                 if atoms != int(ours["nodes"]):
                     raise RuntimeError(f"LAMMPS made {atoms} atoms, pd_speed {ours['nodes']} nodes: not the same brick")
                 best_lammps = loop if best_lammps is None else min(best_lammps, loop)
@@ -94,11 +95,11 @@ def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=
             rate = directed * steps / best_lammps
             mine = float(best_ours["bond_updates_per_s"])
             load = f"{os.getloadavg()[0]:.2f}"
-            w.writerow(dict(code="lammps peri/pmb", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
+            w.writerow(dict(code=f"lammps peri/{model}", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
                             loop_s=f"{best_lammps:.4f}", bond_updates_per_s=f"{rate:.4e}", load_average=load))
-            w.writerow(dict(code="pdsolve kernel", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
+            w.writerow(dict(code=f"pdsolve kernel {model}", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
                             loop_s=best_ours["loop_s"], bond_updates_per_s=f"{mine:.4e}", load_average=load))
-            print(f"  N = {best_ours['nodes']}, {workers} worker(s), best of {repeats}: LAMMPS peri/pmb "
+            print(f"  N = {best_ours['nodes']}, {workers} worker(s), best of {repeats}: LAMMPS peri/{model} "
                   f"({workers} MPI rank(s)) {rate:.3e} directed bond updates/s, ours ({workers} thread(s)) "
                   f"{mine:.3e}: {mine / rate:.1f}× as fast", flush=True)
     print(f"wrote {out_csv}")
@@ -201,7 +202,7 @@ def main():
     if args.lammps_side:
         against_lammps(exe, header, args.lammps_side,
                        max(2, STEPS.get(args.lammps_side, 10) // (4 if args.quick else 1)), args.threads,
-                       os.path.join(os.path.dirname(args.out), "lammps.csv"), workdir)
+                       os.path.join(os.path.dirname(args.out), "lammps.csv"), workdir, models=args.models)
 
     if args.order_side:
         node_order_study(exe, header, args.order_side,
