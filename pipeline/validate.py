@@ -305,6 +305,12 @@ def _check_materials(case: dict, checker: _Checker):
                 checker.error(("materials", name, key), f"model {model} needs {key}: {CASE['materials'].fields[key].doc}")
     if len(models) > 1:
         checker.error(("materials",), f"every block must use the same model, got {', '.join(sorted(models))}")
+    integrator = case["time"]["integrator"]
+    if "lps" in models and integrator in ("quasi_static", "mixed"):
+        # The solver's Newton solves factorise an assembled tangent; a state-based law has none
+        # (solver/src/materials/bond_model.hpp bond_tangent_row), so the run would stop at its first step.
+        checker.error(("time", "integrator"), f"{integrator} needs an assembled tangent stiffness, which the "
+                      "state-based model lps does not have; use verlet or adaptive")
     influences = {m.get("influence") or "one" for m in materials.values() if m["model"] == "lps"}
     if len(influences) > 1:
         checker.error(("materials",), f"every block must use the same influence function, got {', '.join(sorted(influences))}")

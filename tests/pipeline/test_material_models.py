@@ -74,6 +74,16 @@ def test_every_block_uses_one_model_and_one_influence_function(tmp_path):
         load_case(str(path))
 
 
+@pytest.mark.parametrize("integrator", ["quasi_static", "mixed"])
+def test_lps_with_an_integrator_that_needs_an_assembled_tangent(tmp_path, integrator):
+    path = tmp_path / "bar.yaml"
+    path.write_text(textwrap.dedent(CASE).format(
+        material="{model: lps, density: 7850, youngs_modulus: 2.1e11, poisson_ratio: 0.29}")
+        + f"  integrator: {integrator}\n")
+    with pytest.raises(CaseError, match=f"bar.yaml:9: time.integrator: {integrator} needs an assembled tangent"):
+        load_case(str(path))
+
+
 def test_an_lps_case_is_accepted_with_its_defaults(tmp_path):
     path = tmp_path / "bar.yaml"
     path.write_text(textwrap.dedent(CASE).format(
