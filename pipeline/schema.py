@@ -47,13 +47,31 @@ COMPONENT_DOC = ("per component x, y, z: a number, or a table [[t0, v0], [t1, v1
                  "interpolated linearly in time and held constant outside it")
 
 MATERIAL = {
-    "model": Key("choice", "constitutive model (bond-based prototype microelastic brittle)",
-                 default="pmb", choices=("pmb",)),
+    "model": Key("choice", "constitutive model: pmb (bond-based prototype microelastic brittle; fixes ν) or "
+                 "lps (linear peridynamic solid, ordinary state-based; any ν)",
+                 default="pmb", choices=("pmb", "lps")),
     "density": Key("number", "mass density ρ", default=REQUIRED, unit="kg/m³", above=0.0),
     "youngs_modulus": Key("number", "Young's modulus E (bond-based PMB fixes ν: 1/4 in 3D and "
                           "plane strain, 1/3 in plane stress)", default=REQUIRED, unit="Pa", above=0.0),
+    "poisson_ratio": Key("number", "Poisson's ratio ν of the isotropic solid; lps only, required there "
+                         "(−1 < ν < 1/2: K and G positive)", default=None, above=-1.0, below=0.5),
     "fracture_energy": Key("number", "critical energy release rate G0; omit for an unbreakable "
                            "material", default=None, unit="J/m²", above=0.0),
+    "influence": Key("choice", "lps only: influence function ω(|ξ|), one, inverse_length (1/|ξ|) or gaussian "
+                     "(exp(−|ξ|²/δ²)); default one, the same in every block", default=None,
+                     choices=("one", "inverse_length", "gaussian")),
+}
+
+# The material keys each model reads (besides model and density), and what a key means to a model
+# that has no such parameter: validate.py rejects such a key with this explanation, as the solver's
+# reader does (solver/src/io/case_reader.cpp read_block).
+MODEL_KEYS = {
+    "pmb": ("youngs_modulus", "fracture_energy"),
+    "lps": ("youngs_modulus", "poisson_ratio", "fracture_energy", "influence"),
+}
+MODEL_REQUIRED = {"lps": ("poisson_ratio",)}
+MODEL_NOTE = {
+    "pmb": "PMB is bond-based and fixes Poisson's ratio (1/4 in 3D and plane strain, 1/3 in plane stress)",
 }
 
 BOUNDARY_CONDITION = {
