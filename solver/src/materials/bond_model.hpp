@@ -39,6 +39,10 @@ struct MaterialParameter {
   // The reader requires lower < value < upper (strict; +inf: no upper bound).
   double lower = 0.0;
   double upper = std::numeric_limits<double>::infinity();
+  // Not empty: a text parameter, one of these names (the first is the default), not a number.
+  std::vector<std::string> choices = {};
+  // Why the range is what it is, appended to the reader's error for a value outside it.
+  std::string bounds_reason = {};
 };
 
 // Bonds broken by one call, each counted once, and the energy they held then [J].
