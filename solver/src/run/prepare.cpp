@@ -72,7 +72,9 @@ void check_decomposable(const Prepared& p, const RunOptions& opt) {
   const Case& c = p.c;
   const std::string ranks = std::to_string(world_ranks().size);
   std::string what;
-  if (c.time.integrator != "verlet") what = "time.integrator: " + c.time.integrator;
+  if (p.model.bond_model->name() != "pmb")
+    what = "blocks[].model: " + p.model.bond_model->name() + " (a state-based law needs its ghosts' dilatation too)";
+  else if (c.time.integrator != "verlet") what = "time.integrator: " + c.time.integrator;
   else if (c.time.dt_rule == "exact") what = "time.dt: exact";
   else if (p.model.contact.pairs) what = "contact";
   else if (!p.model.indenters.empty()) what = "indenters";
