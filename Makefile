@@ -2,6 +2,7 @@
 #   make case=membrane        mesh → node cloud → solve → figures and Gmsh views, in out/membrane/
 #   make figures case=X       redraw figures and Gmsh views from existing results
 #   make case=X config=Y      run cases/X/Y.yaml (a variant of case X) into out/X-Y/
+#   make case=X RANKS=R       solve on R MPI ranks (mpiexec --oversubscribe -np R; OMP_NUM_THREADS threads each)
 #   make test                 build everything and run every test (then test-asan)
 #   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
@@ -31,6 +32,20 @@ endif
 ifeq ($(wildcard cases/$(case)/),)
   $(error case=$(case): no folder cases/$(case)/; the cases are: $(CASE_NAMES))
 endif
+# RANKS: MPI ranks of the solve (issue 15). It expands in a recipe too: checked like case= (one word of
+# SAFE_NAME_CHARS), then digits only, at least 1.
+RANKS ?= 1
+ifneq ($(call unsafe_name,RANKS),)
+  $(error RANKS='$(value RANKS)' is not a number of MPI ranks: digits only, e.g. RANKS=2)
+endif
+ifneq ($(strip $(filter-out 0 1 2 3 4 5 6 7 8 9,$(subst 0,0 ,$(subst 1,1 ,$(subst 2,2 ,$(subst 3,3 ,$(subst 4,4 ,\
+        $(subst 5,5 ,$(subst 6,6 ,$(subst 7,7 ,$(subst 8,8 ,$(subst 9,9 ,$(RANKS)))))))))))) $(filter 0 00 000,$(RANKS))),)
+  $(error RANKS=$(RANKS) is not a number of MPI ranks ≥ 1: digits only, e.g. RANKS=2)
+endif
+# One rank: pdsolve alone (the serial path). More: under mpiexec; --oversubscribe lets a small machine
+# run more ranks than it has cores (for tests; a cluster's launcher places ranks itself).
+MPIRUN := $(if $(filter-out 1,$(RANKS)),mpiexec --oversubscribe -np $(RANKS))
+
 ifeq ($(origin config),undefined)
   config := $(case)
 endif
@@ -105,8 +120,8 @@ $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
 	  echo "$(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
 	  exec '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
 	else \
-	  echo "$(SOLVER) $(OUT)/case.json"; \
-	  exec '$(SOLVER)' '$(OUT)/case.json'; \
+	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json"; \
+	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json'; \
 	fi
 	@touch '$@'
 
