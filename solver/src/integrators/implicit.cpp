@@ -125,12 +125,17 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
     const double res = residual(start, s, h, scale);
     if (!std::isfinite(res)) return false;
     // Converged: two of the three signs — the last correction below newton_tol, the residual below
-    // its tolerance, the residual no longer falling. The last is the round-off floor of the stretches
-    // (about 1e-16/strain of the force): there the corrections are noise, and at a small amplitude
-    // and a short step they stay above newton_tol relative to the step's small motion.
+    // its tolerance, the residual no longer falling — or no longer falling with a tangent made in
+    // this step after two corrections. A residual that a fresh tangent cannot lower is at the
+    // round-off floor of the stretches (about 1e-16/strain of the bond forces): there the corrections
+    // are noise, and at a small amplitude, a short step or in a pre-stressed body at rest (the drum
+    // before it moves: bond forces of ε0 that cancel, a motion of nearly nothing) neither the
+    // correction relative to the step's motion nor the residual relative to the net force gets below
+    // its tolerance.
     const bool small_correction = omega <= settings_.newton_tol, small_residual = res <= settings_.residual_tol * scale,
                stalled = res >= 0.5 * previous;
-    if (k > 1 && (small_correction ? small_residual || stalled : small_residual && stalled)) return true;
+    if (k > 1 && (small_correction ? small_residual || stalled : stalled && (small_residual || (fresh && k >= 3))))
+      return true;
     if (res == 0.0) return omega = 0.0, true;  // the predictor is the solution (nothing moves or loads)
     // Reuse the factorisation while Δt is the one it was made for and it keeps the residual falling
     // fast; else assemble and factorise at the current iterate — once per step: a tangent made in
@@ -176,7 +181,8 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
   }
   double scale = 0.0;
   const double res = residual(start, s, h, scale);
-  return res <= settings_.residual_tol * scale && (omega <= settings_.newton_tol || res >= 0.5 * previous);
+  const bool stalled = res >= 0.5 * previous;
+  return (omega <= settings_.newton_tol || stalled) && (res <= settings_.residual_tol * scale || stalled);
 }
 
 void Implicit::step(State& state, double& t, double& dt) {
@@ -212,7 +218,12 @@ void Implicit::step(State& state, double& t, double& dt) {
         e2 += e * e;
         m2 += motion * motion;
       }
-      eta = m2 > 0.0 ? std::sqrt(e2 / m2) : 0.0;
+      // Motions below kMotionFloor × dx per dof are not measured against themselves: a body at rest
+      // (round-off noise) or the first instants of a load that starts smoothly from zero (force ∝ t²:
+      // the first step's relative error is O(1) at any Δt) would otherwise be cut down to dt_min.
+      const double floor = kMotionFloor * op_.model().nodes.grid_spacing * std::sqrt(static_cast<double>(dofs_.size()));
+      const double motion = std::max(std::sqrt(m2), floor);
+      eta = motion > 0.0 ? std::sqrt(e2) / motion : 0.0;
       if (eta <= settings_.tol) {
         for (std::size_t q = 0; q < dofs_.size(); ++q) {
           const auto i = static_cast<std::size_t>(dofs_.node[q]);

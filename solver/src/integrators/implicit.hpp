@@ -42,7 +42,8 @@
 //     e_{n+1} = (β − 1/6 + (α_m − α_f)/2) Δt² (a_{n+1} − a_n) = (β − γ/2 + 1/12) Δt² (a_{n+1} − a_n),
 //   Z&X's estimate at ρ∞ = 1 (coefficient 1/12). Measured like eq. 2.6 against the step's motion,
 //   η = ‖e‖/‖u_{n+1} − u_n‖ ≈ C (ωΔt)² for a motion of frequency ω: about the relative phase error the
-//   step adds. η > tol rejects the step and redoes it from t_n with Δt·max(0.2, 0.9 (tol/η)^{1/2});
+//   step adds (the motion taken as at least 1e-9 dx per dof, kMotionFloor: a body at rest or a load
+//   starting smoothly from zero is not measured against its own round-off). η > tol rejects the step and redoes it from t_n with Δt·max(0.2, 0.9 (tol/η)^{1/2});
 //   an accepted step proposes 0.9 (tol/η)^{1/2} Δt (η ∝ Δt²). Lowering tol lowers the error in
 //   proportion.
 // The proposal is capped at 2× and kept equal to Δt while the step was accepted and would grow by
@@ -107,6 +108,8 @@ class Implicit : public Integrator {
   double residual(const State& start, const State& s, double h, double& scale);
   bool factorize_at(const State& s, double t1, double h, bool definite);
   double mass_coefficient(double h) const;  // the bracket multiplying m in K_eff
+  // The motion the local error is measured against is at least this × dx per dof (implicit.cpp).
+  static constexpr double kMotionFloor = 1e-9;
 
   ForceOperator& op_;
   ImplicitSettings settings_;
