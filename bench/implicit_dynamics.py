@@ -108,12 +108,12 @@ def error(run_dir: str, reference: list[np.ndarray]) -> float:
     return (num / den) ** 0.5
 
 
-def schemes(dt_stable: float):
+def schemes(factors: list[float], rhos: list[float], tols: list[float]):
     """(scheme, parameter, time section, implicit section) of every run."""
-    for f in (0.8, 0.4, 0.2):
+    for f in factors:
         yield "verlet", f, {"integrator": "verlet", "dt": "stable", "safety_factor": f}, None
-    for rho in (1.0, 0.8):
-        for tol in (1e-2, 1e-3, 1e-4, 1e-5):
+    for rho in rhos:
+        for tol in tols:
             yield (f"implicit-rho{rho:g}", tol, {"integrator": "implicit", "dt": "stable", "safety_factor": 0.8},
                    {"rho_infinity": rho, "tol": tol})
 
@@ -134,7 +134,8 @@ def bench_load(args, load: str) -> list[dict]:
     dt_stable = stable_dt(reference_run["log"])
 
     rows = []
-    for scheme, parameter, time, implicit in schemes(dt_stable):
+    numbers = lambda text: [float(v) for v in text.split(",")]  # noqa: E731
+    for scheme, parameter, time, implicit in schemes(numbers(args.verlet), numbers(args.rho), numbers(args.tols)):
         name = f"{scheme}-{parameter:g}"
         path = write_case(directory, problem, name, time, implicit)
         result = run(args.solver, path, args.threads, args.repeat)
@@ -162,6 +163,9 @@ def main(argv=None) -> int:
     parser.add_argument("--span", type=int, default=30, help="free span in grid spacings (cases/drum: 100)")
     parser.add_argument("--periods", type=float, default=2.0, help="length of the run in fundamental periods")
     parser.add_argument("--loads", default="blow,pulse", help="blow (cases/drum's), pulse (smooth), or both")
+    parser.add_argument("--verlet", default="0.8,0.4,0.2", help="Verlet's steps as fractions of eq. 2.5")
+    parser.add_argument("--rho", default="1,0.8", help="implicit.rho_infinity values")
+    parser.add_argument("--tols", default="1e-2,1e-3,1e-4,1e-5", help="implicit.tol values")
     parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
     args = parser.parse_args(argv)
     rows = []
