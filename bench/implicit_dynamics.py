@@ -14,6 +14,17 @@ time is in the wall time).
 
 Writes out/bench/implicit.csv (a row per run) and prints a table.
 
+Measured once (2 Dec 2026, 1 thread, the 2-core machine at load 11–15 from other jobs; span 30 dx =
+1369 nodes, 2 periods): Verlet at 0.8 × eq. 2.5 has error 6.1e-5 (blow) and 1.1e-5 (pulse) in
+2440 evaluations, 1.6–1.9 s. Implicit (ρ∞ = 1) at tol 1e-2 / 1e-3 / 1e-4: blow 571 / 1424 / 3756
+evaluations, error 4.5e-2 / 5.4e-3 / 5.5e-4, 14–18 s; pulse 365 / 881 / 2408 evaluations, error
+3.9e-2 / 4.3e-3 / 4.8e-4, 18–31 s (mean Δt 21 / 7.7 / 2.6 × eq. 2.5). At span 60 (4489 nodes, pulse,
+1 period): Verlet 2440 evaluations, 1.7e-6, 4.4 s; implicit tol 1e-2: 286 evaluations (Δt 28 ×
+eq. 2.5), 1.9e-2, 130 s. Fewer force evaluations, but each CHOLMOD factorisation (78 of them in the
+span-30 pulse run at tol 1e-3; 45 % of its time in dsyrk/dgemm/dtrsm of Debian's reference BLAS, the
+force 2.5 %) costs hundreds of force evaluations, and Verlet at its limit is already far more
+accurate than the slow motion needs: implicit does not win here.
+
     /usr/bin/python3 -m bench.implicit_dynamics [--solver build/solver/pdsolve] [--threads 1]
         [--repeat 3] [--span 30] [--periods 2]
 """
