@@ -9,6 +9,7 @@
 #   make fuzz                 libFuzzer on the solver's readers, FUZZ_SECONDS (60) each (clang)
 #   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
 #   make bench-accuracy       error against run time, Verlet vs adaptive → out/bench/accuracy.csv (docs/accuracy.md)
+#   make bench-implicit       implicit dynamics vs Verlet on a drum lattice → out/bench/implicit.csv
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
@@ -75,7 +76,7 @@ PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
 POST_SOURCES   := $(wildcard postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
 
-.PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench bench-accuracy validate
+.PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
 .DELETE_ON_ERROR:
 
 all: run
@@ -192,6 +193,12 @@ bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
 ACCURACY_ARGS ?=
 bench-accuracy: $(SOLVER) | $(DEPS)
 	$(PY) -m bench.accuracy --solver $(SOLVER) --out out/bench $(ACCURACY_ARGS)
+
+# Implicit dynamics (issue 13): Verlet at several steps and time.integrator: implicit over a sweep of
+# implicit.tol on a drum lattice, struck (cases/drum's blow) and pushed by a smooth pulse, error of u_z
+# against a fine Verlet run versus wall time and force evaluations (bench/implicit_dynamics.py).
+bench-implicit: $(SOLVER) | $(DEPS)
+	$(PY) -m bench.implicit_dynamics --solver $(SOLVER) --out out/bench $(IMPLICIT_ARGS)
 
 # The full cases and validation/models/ runs with quantitative checks (validation/README.md):
 # out/validate/report.md, a PNG per check and convergence.png.
