@@ -14,8 +14,19 @@ import re
 from .schema import CASE, REQUIRED, Key
 from .yaml_lines import CaseError
 
+MAX_TEXT = 200  # characters in a text value (title, set name)
 NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 COMPONENTS = ("x", "y", "z")
+
+
+def yaml11_hint(value) -> str:
+    """A hint for the YAML 1.1 number forms that YAML 1.2 (pipeline/yaml_lines.py) reads as text."""
+    if isinstance(value, str) and re.fullmatch(r"[-+]?(0b[01_]+|[0-9][0-9_]*(\.[0-9_]*)?([eE][-+]?[0-9]+)?)",
+                                               value):
+        return " (YAML 1.2 reads this as text: write the number without '_' or 0b, e.g. 1000)"
+    if isinstance(value, str) and value.lower() in ("yes", "no", "on", "off", "y", "n"):
+        return " (YAML 1.2 reads this as text; write true or false where a switch is meant)"
+    return ""
 
 
 class _Checker:
@@ -37,7 +48,7 @@ class _Checker:
     # -- scalar kinds -------------------------------------------------------
     def number(self, value, keypath: tuple, key: Key):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}")
+            self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}{yaml11_hint(value)}")
             return None
         value = float(value)
         if not math.isfinite(value):
@@ -96,12 +107,19 @@ class _Checker:
             if not isinstance(value, str) or not value:
                 self.error(keypath, f"expected a non-empty text, got {value!r}")
                 return None
+            # A name or a one-line title: it is drawn in every figure and written into case.json,
+            # run.log and the VTK files, so it is one line of at most MAX_TEXT characters.
+            if len(value) > MAX_TEXT or "\n" in value or "\r" in value:
+                self.error(keypath, f"expected one line of at most {MAX_TEXT} characters, got "
+                           f"{len(value)} characters{' on several lines' if chr(10) in value else ''}; "
+                           "shorten it")
+                return None
             return value
         if kind == "choice":
             return self.choice(value, keypath, key)
         if kind == "boolean":
             if not isinstance(value, bool):
-                self.error(keypath, f"expected true or false, got {value!r}")
+                self.error(keypath, f"expected true or false, got {value!r}{yaml11_hint(value)}")
                 return None
             return value
         if kind == "number_or_choice":
