@@ -137,12 +137,13 @@ def _read_text(path: str) -> str:
 
 
 def _compose(text: str, path: str):
-    loader = _BoundedLoader(text, path)
+    loader = None
     try:
+        loader = _BoundedLoader(text, path)  # the reader checks every character here
         return loader.get_single_node()
     except yaml.reader.ReaderError as err:
         line = text.count("\n", 0, err.position) + 1
-        raise CaseError(f"{path}:{line}: character #x{ord(err.character):04x} is not allowed in "
+        raise CaseError(f"{path}:{line}: character #x{err.character:04x} is not allowed in "
                         "YAML text; remove it") from None
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
@@ -152,7 +153,8 @@ def _compose(text: str, path: str):
         problem = f"{context}, {problem}" if context else problem
         raise CaseError(f"{where}: not valid YAML: {problem}") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def load_with_lines(path: str):

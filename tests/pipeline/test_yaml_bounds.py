@@ -132,3 +132,11 @@ def test_anchors_and_aliases_of_whole_values_still_work(tmp_path):
     case = load_case(str(path))
     assert case["materials"]["ring"] == case["materials"]["plate"]
     assert case["materials"]["ring"]["youngs_modulus"] == 1.0e9
+
+
+def test_a_control_character_names_its_line(tmp_path):
+    """Found by pipeline/fuzz_case.py: PyYAML's reader refuses control characters in its constructor."""
+    path = tmp_path / "plate.yaml"
+    path.write_text(MINIMAL.replace("time:", "ti\x0bme:"))
+    with pytest.raises(CaseError, match=r"plate\.yaml:9: character #x000b is not allowed in YAML text"):
+        load_case(str(path))
