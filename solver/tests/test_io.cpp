@@ -308,3 +308,26 @@ TEST(CaseFile, OutputFormatKeysAreCheckedAndDefaultToTheCompactFrames) {
   EXPECT_FALSE(f.float32);
   EXPECT_FALSE(f.zlib);
 }
+
+// A fresh run rewrites frames.pvd (listing no frame) before it deletes the frames of the earlier
+// run, so a run killed in between (kill -9) never leaves a .pvd listing deleted frames (issue 17,
+// item 5). Before, the old .pvd stayed until the new run's first frame.
+TEST(Frames, FreshRunEmptiesThePvdBeforeDeletingOldFrames) {
+  const fs::path dir = temp_dir("fresh_pvd");
+  fs::create_directories(dir / "frames");
+  std::string old_pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\">\n  <Collection>\n";
+  for (int k = 0; k < 3; ++k) {
+    const std::string name = "frames/frame_00000" + std::to_string(k) + ".vtu";
+    spit(dir / name, "old frame");
+    old_pvd += "    <DataSet timestep=\"" + std::to_string(k) + "\" file=\"" + name + "\"/>\n";
+  }
+  spit(dir / "frames.pvd", old_pvd + "  </Collection>\n</VTKFile>\n");
+  {
+    const pd::OutputWriter out(dir);
+    EXPECT_FALSE(fs::exists(dir / "frames" / "frame_000000.vtu"));
+    const std::string pvd = slurp(dir / "frames.pvd");
+    EXPECT_EQ(pvd.find("DataSet"), std::string::npos) << pvd;
+    EXPECT_NE(pvd.find("<Collection>"), std::string::npos) << pvd;
+  }
+  fs::remove_all(dir);
+}

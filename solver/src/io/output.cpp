@@ -155,6 +155,10 @@ OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<s
       frames_.emplace_back(resume->frame_times[k], frame_file(k));
     }
   }
+  // frames.pvd first, listing only the frames kept (none in a fresh run), then the other frames go:
+  // a run killed between the two (kill -9) leaves a .pvd that lists no deleted frame (issue 17,
+  // item 5). Before, a fresh run rewrote it only with its first frame.
+  write_pvd();
   // Frames of an earlier, longer run (or written after the checkpoint) would otherwise sit next to
   // the new ones.
   static const std::regex frame_name("frame_([0-9]{6})\\.vtu(\\.part)?");
@@ -171,7 +175,6 @@ OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<s
         ::lseek(history_fd_, 0, SEEK_END) < 0)
       throw Error(history.string() + ": cannot cut back to the checkpoint: " + std::strerror(errno));
     history_bytes_ = resume->history_bytes;
-    write_pvd();
   } else {
     history_fd_ = ::open(history.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (history_fd_ < 0) throw Error(history.string() + ": cannot open for writing: " + std::strerror(errno));
