@@ -17,7 +17,7 @@ import os
 import sys
 import warnings
 
-from .atomic import write_atomically
+from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
 from .resolve import resolve
 from .stability import check_discretized_case
@@ -126,6 +126,9 @@ def main(argv=None) -> int:
     except CaseError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    except WriteError as err:  # a full disk: its own exit code, as in the solver
+        print(f"error: {err}", file=sys.stderr)
+        return DISK_FULL_EXIT
     except Exception as err:  # preprocess errors carry the file name in their message
         if type(err).__name__ == "PreprocessError":
             print(f"error: {err}", file=sys.stderr)

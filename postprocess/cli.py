@@ -15,6 +15,8 @@ import os
 import re
 import sys
 
+from pipeline.atomic import DISK_FULL_EXIT, WriteError
+
 from .casefile import load_case_settings
 from .errors import PostprocessError
 from .history import read_history
@@ -172,4 +174,7 @@ def main(argv=None) -> int:
     except PostprocessError as error:
         print(f"postprocess: error: {error}", file=sys.stderr)
         return 1
+    except WriteError as error:  # a full disk: its own exit code, as in the solver
+        print(f"postprocess: error: {error}", file=sys.stderr)
+        return DISK_FULL_EXIT
     return 0
