@@ -61,6 +61,27 @@ PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
 POST_SOURCES   := $(wildcard postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
 
+# One make at a time per case output folder (issue 17, item 8): two `make case=X` in one tree drew
+# each other's frames in progress and read half-written history rows. A goal that writes out/<case>/
+# re-runs make under flock(1) (util-linux) on $(OUT)/.lock, held until that make ends; a second
+# make fails at once saying who holds it, or waits LOCK_WAIT seconds for it (LOCK_WAIT=600).
+UNLOCKED_GOALS := test test-asan fuzz solver deps check clean bench bench-accuracy validate
+LOCKED_GOALS   := $(filter-out $(UNLOCKED_GOALS),$(or $(MAKECMDGOALS),all))
+LOCK_WAIT      ?= 0
+DRY_RUN        := $(findstring n,$(firstword -$(MAKEFLAGS)))# make -n writes nothing: no lock
+ifneq ($(and $(LOCKED_GOALS),$(if $(PD_CASE_LOCK)$(DRY_RUN),,locked)),)
+.PHONY: $(or $(MAKECMDGOALS),all) pd-case-lock
+$(or $(MAKECMDGOALS),all): pd-case-lock ; @:
+pd-case-lock:
+	@mkdir -p '$(OUT)'
+	+@flock -w '$(LOCK_WAIT)' -E 75 '$(OUT)/.lock' true || { \
+	  echo "error: $(OUT)/ is in use by another make ($$(cat '$(OUT)/.lock' 2>/dev/null || echo unknown)); wait \
+	for it to finish (or stop it: its Ctrl-C writes a checkpoint), or give LOCK_WAIT=<seconds> to wait" >&2; exit 75; }
+	+@PD_CASE_LOCK=1 exec flock -w '$(LOCK_WAIT)' -E 75 '$(OUT)/.lock' sh -c \
+	    'echo "pid $$$$, make $(MAKECMDGOALS) case=$(case) config=$(config), since $$(date +%T)" > "$$1"; shift; exec "$$@"' \
+	    sh '$(OUT)/.lock' $(MAKE) --no-print-directory $(MAKECMDGOALS)
+else
+
 .PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench bench-accuracy validate
 .DELETE_ON_ERROR:
 
@@ -189,3 +210,5 @@ clean-case:
 	rm -rf -- '$(OUT)'
 clean:
 	rm -rf build out
+
+endif  # PD_CASE_LOCK
