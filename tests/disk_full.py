@@ -11,11 +11,13 @@ import subprocess
 import pytest
 
 
-def run_on_small_disk(folder, command, size_kb=64, timeout=300, cwd=None, env=None):
+def run_on_small_disk(folder, command, size_kb=64, timeout=300, cwd=None, env=None, keep=None):
     """Run `command` (a list) with `folder` a fresh tmpfs of size_kb; return (code, stdout, stderr,
-    the names left in folder)."""
+    the names left in folder). With `keep`, a folder: what the command left is copied there."""
+    copy = f"cp -a {shlex.quote(str(folder))}/. {shlex.quote(str(keep))}/\n" if keep else ""
     script = (f"mount -t tmpfs -o size={size_kb}k pdtest {shlex.quote(str(folder))} || exit 97\n"
-              f"{shlex.join(command)}\ncode=$?\necho '--left--'\nls -A {shlex.quote(str(folder))}\nexit $code\n")
+              f"{shlex.join(command)}\ncode=$?\n{copy}echo '--left--'\nls -A {shlex.quote(str(folder))}\n"
+              "exit $code\n")
     result = subprocess.run(["unshare", "--map-root-user", "--mount", "sh", "-c", script], cwd=cwd, env=env,
                             capture_output=True, text=True, timeout=timeout)
     if result.returncode == 97 or "unshare:" in result.stderr:

@@ -274,7 +274,20 @@ void OutputWriter::flush_history() {
   while (done < history_buffer_.size()) {
     const ssize_t w = ::write(history_fd_, history_buffer_.data() + done, history_buffer_.size() - done);
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) throw Error(file + ": write failed (disk full?): " + std::strerror(errno));
+    if (w <= 0) {
+      // A write cut short (a full disk) is cut back to the rows on disk before it, so history.csv
+      // always ends with a whole row; the rows not written are dropped, not retried at exit.
+      const int error_number = w == 0 ? ENOSPC : errno;
+      const std::size_t lost = history_buffer_.size();
+      history_buffer_.clear();
+      if (::ftruncate(history_fd_, static_cast<off_t>(history_bytes_)) != 0 ||
+          ::lseek(history_fd_, 0, SEEK_END) < 0) {
+        ::close(history_fd_);
+        history_fd_ = -1;
+        throw Error(file + ": write failed and cannot cut back to whole rows: " + std::strerror(errno));
+      }
+      throw_write_error(file, "write failed", error_number, lost);
+    }
     done += static_cast<std::size_t>(w);
   }
   history_bytes_ += history_buffer_.size();
@@ -286,9 +299,9 @@ void OutputWriter::finish() {
   if (finished_) return;
   finished_ = true;
   flush_history();
-  if (history_fd_ >= 0 && ::close(history_fd_) != 0)
-    throw Error((dir_ / "history.csv").string() + ": write failed (disk full?): " + std::strerror(errno));
+  const int fd = history_fd_;
   history_fd_ = -1;
+  if (fd >= 0 && ::close(fd) != 0) throw_write_error(dir_ / "history.csv", "write failed", errno, 0);
 }
 
 RunLog::RunLog(std::filesystem::path path, bool quiet, bool append) : path_(std::move(path)), quiet_(quiet) {
