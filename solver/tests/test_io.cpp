@@ -331,3 +331,22 @@ TEST(Frames, FreshRunEmptiesThePvdBeforeDeletingOldFrames) {
   }
   fs::remove_all(dir);
 }
+
+// Not a file, or a coordinate no distance can be computed from (issue 17, item 9): a clear error
+// naming the file, not "basic_filebuf::underflow", an endless read of /dev/zero or "max_size()".
+TEST(NodeFile, DirectoryDeviceAndFarCoordinatesAreRefused) {
+  const fs::path dir = temp_dir("not_a_file");
+  expect_node_error(dir, {dir.string() + ": a directory, not the VTK file; give the path of the file"});
+  expect_node_error("/dev/zero", {"/dev/zero: not a regular file, not the VTK file"});
+  pd::Nodes n = sample_nodes();
+  n.x[0][4] = 1e300;
+  pd::write_node_file(dir / "far.vtu", n);
+  expect_node_error(dir / "far.vtu", {"far.vtu: point 4 has coordinate x = 1e+300 m, beyond ±1e+150 m"});
+  EXPECT_THROW(pd::read_case(dir), pd::Error);
+  try {
+    pd::read_case(dir);
+  } catch (const pd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("a directory, not the case file"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
