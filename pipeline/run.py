@@ -19,6 +19,7 @@ import warnings
 
 from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
+from .conditions import check_condition_overlaps
 from .resolve import resolve
 from .stability import check_discretized_case
 
@@ -88,7 +89,7 @@ def cmd_preprocess(args):
     resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
                        nodes_file="nodes.vtu")
     # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.
-    for warning in check_discretized_case(case, resolved, cloud):
+    for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud):
         print(f"warning: {warning}", file=sys.stderr)
     os.makedirs(args.out_dir, exist_ok=True)
     write_node_file(os.path.join(args.out_dir, "nodes.vtu"), cloud)
