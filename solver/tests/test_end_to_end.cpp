@@ -195,3 +195,33 @@ TEST(EndToEnd, NonFiniteStateStopsTheRunNamingTheStep) {
   EXPECT_NE(log.find("above the stability limit"), std::string::npos) << log;
   fs::remove_all(dir);
 }
+
+// A step above eq. 2.5 is judged at set-up against the exact limit 2/ω_max (issue 17, item 12):
+// safety_factor 5 is above it ("will blow up", before any step), 1.05 is above eq. 2.5 only.
+TEST(EndToEnd, StepAboveTheStableStepIsJudgedAtSetUpAgainstTheExactLimit) {
+  const fs::path dir = temp_dir("safety");
+  write_plate_case(dir);
+  const std::string base = slurp(dir / "case.json");
+  auto with_factor = [&](const std::string& factor) {
+    std::string text = base;
+    const std::string from = "\"safety_factor\": 0.8";
+    text.replace(text.find(from), from.size(), "\"safety_factor\": " + factor);
+    std::ofstream(dir / "case.json") << text;
+  };
+  with_factor("5");
+  run_solver((dir / "case.json").string() + " --max-steps 1", dir / "log.txt");
+  std::string log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("warning: dt "), std::string::npos) << log;
+  EXPECT_NE(log.find(" s (safety factor 5) is "), std::string::npos) << log;
+  EXPECT_NE(log.find(" × the exact stability limit 2/ω_max = "), std::string::npos) << log;
+  EXPECT_NE(log.find(" s: the run will blow up; use time.safety_factor ≤ 1"), std::string::npos) << log;
+  with_factor("1.05");
+  run_solver((dir / "case.json").string() + " --max-steps 1", dir / "log.txt");
+  log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("(safety factor 1.05) exceeds the stable time step of thesis eq. 2.5"), std::string::npos) << log;
+  EXPECT_NE(log.find("but not the exact limit 2/ω_max"), std::string::npos) << log;
+  with_factor("0.8");
+  run_solver((dir / "case.json").string() + " --max-steps 1", dir / "log.txt");
+  EXPECT_EQ(slurp(dir / "out" / "run.log").find("warning: dt"), std::string::npos);
+  fs::remove_all(dir);
+}
