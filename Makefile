@@ -2,6 +2,8 @@
 #   make case=membrane        mesh → node cloud → solve → figures and Gmsh views, in out/membrane/
 #   make figures case=X       redraw figures and Gmsh views from existing results
 #   make case=X config=Y      run cases/X/Y.yaml (a variant of case X) into out/X-Y/
+#   make FORCE=1 case=X       run even when preprocess's work plan is above its limits (> 1 h, or
+#                             more than half the free memory or disk: pipeline/cost.py)
 #   make test                 build everything and run every test (then test-asan)
 #   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)

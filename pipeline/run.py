@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import json
+import math
 import os
 import sys
 import warnings
@@ -20,6 +21,7 @@ import warnings
 from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
+from .cost import check_cost
 from .resolve import resolve
 from .stability import check_discretized_case
 
@@ -65,6 +67,26 @@ def missing_block_error(case: dict, mesh: str, err) -> CaseError:
     return CaseError("\n".join(messages))
 
 
+def run_cost(case: dict, resolved: dict, cloud) -> dict:
+    """The estimate of pipeline/cost.py for this case: bonds counted on a sample, eq. 2.5's step."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    from .cost import estimate, mean_bonds
+    from .stability import BOND_SLACK, case_stable_time_step
+
+    points = np.asarray(cloud.points)
+    tree = cKDTree(points)
+    time = case["time"]
+    if isinstance(time["dt"], str):
+        dt_stable, _ = case_stable_time_step(case, resolved, cloud, tree)
+        dt = dt_stable * float(time["safety_factor"])   # "exact" is larger: this is an upper bound
+    else:
+        dt = float(time["dt"])
+    bonds = mean_bonds(points, tree, float(resolved["horizon"]), BOND_SLACK) * len(points)
+    return estimate(case, cloud, bonds, dt if dt > 0 and math.isfinite(dt) else float(time["end"]))
+
+
 def cmd_preprocess(args):
     from preprocess import PreprocessError, build_node_cloud
     from preprocess.node_file import write_node_file
@@ -91,11 +113,13 @@ def cmd_preprocess(args):
     # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.
     for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud):
         print(f"warning: {warning}", file=sys.stderr)
+    plan = check_cost(case, run_cost(case, resolved, cloud), args.out_dir)  # stops a huge run unless FORCE=1
     os.makedirs(args.out_dir, exist_ok=True)
     write_node_file(os.path.join(args.out_dir, "nodes.vtu"), cloud)
     write_atomically(os.path.join(args.out_dir, "case.json"), json.dumps(resolved, indent=1) + "\n")
     print(f"{args.case}: {len(cloud.volume)} nodes, dx = {cloud.grid_spacing:.6g} m, "
           f"horizon = {resolved['horizon']:.6g} m, node sets: {', '.join(resolved['node_sets'])}")
+    print(f"{args.case}: {plan}")
 
 
 def main(argv=None) -> int:
