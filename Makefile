@@ -8,7 +8,8 @@
 #   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
 #   make fuzz                 libFuzzer on the solver's readers, then the case-file loader's mutation
-#                             fuzzer (pipeline/fuzz_case.py), FUZZ_SECONDS (60) each (clang)
+#                             fuzzer (pipeline/fuzz_case.py) and pdsolve's command line
+#                             (pipeline/fuzz_cli.py), FUZZ_SECONDS (60) each (clang)
 #   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
 #   make bench-accuracy       error against run time, Verlet vs adaptive → out/bench/accuracy.csv (docs/accuracy.md)
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
@@ -160,13 +161,14 @@ test-asan: | $(DEPS)
 # libFuzzer (clang) on the solver's readers, FUZZ_SECONDS each; a crash leaves its input in
 # $(FUZZ_DIR)/artifacts/: fix the reader and add the input to solver/fuzz/regressions/<target>/.
 # Then the Python case-file loader (pipeline/fuzz_case.py): a traceback or a hang leaves its input
-# in the same folder as pd_fuzz_case_yaml-N.yaml: fix the loader and add a test.
+# in the same folder as pd_fuzz_case_yaml-N.yaml: fix the loader and add a test. Last, pdsolve's
+# command line (pipeline/fuzz_cli.py): every run ends with a documented exit code, no signal.
 # The binary checkpoint has no dictionary: its few constants are in the seeds, and libFuzzer
 # picks up the ones the reader compares against.
 FUZZ_DIR     := build/solver-fuzz
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case pd_fuzz_checkpoint
-fuzz: | $(DEPS)
+fuzz: $(SOLVER) | $(DEPS)
 	cmake -S solver -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DPD_FUZZ=ON -DPD_BUILD_TESTS=OFF \
 	    -DCMAKE_BUILD_TYPE=RelWithDebInfo
 	cmake --build $(FUZZ_DIR) -j$(JOBS) --target pd_fuzz
@@ -184,6 +186,7 @@ fuzz: | $(DEPS)
 	    grep '^Done' $(FUZZ_DIR)/$$t.log; \
 	done
 	$(PY) -m pipeline.fuzz_case --seconds $(FUZZ_SECONDS) --artifacts $(FUZZ_DIR)/artifacts
+	$(PY) -m pipeline.fuzz_cli --seconds $(FUZZ_SECONDS) --solver $(SOLVER)
 
 # A benchmark, not a timed test: bricks of 64,000, ~10⁵ and 10⁶ nodes with 1 and 2 threads
 # (BENCH_SIDES to change), then the cost of output in the built cases. Prints the load average.
