@@ -225,3 +225,31 @@ TEST(EndToEnd, StepAboveTheStableStepIsJudgedAtSetUpAgainstTheExactLimit) {
   EXPECT_EQ(slurp(dir / "out" / "run.log").find("warning: dt"), std::string::npos);
   fs::remove_all(dir);
 }
+
+// The frames written while the energy grew ×1.5 a step show the instability, not the physics: a
+// blown-up run keeps only the frames before the growth began (issue 17, item 12: the kept "last
+// valid" frame had max|v| = 1.2·10⁹ m/s). Here dt is 10 × too large: the watch, which compares each
+// step's energy with the step before, sees the growth from step 2 on.
+TEST(EndToEnd, BlownUpRunKeepsOnlyFramesBeforeTheGrowth) {
+  const fs::path dir = temp_dir("blowup_frames");
+  write_plate_case(dir);
+  std::string text = slurp(dir / "case.json");
+  auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+  replace("\"dt\": \"stable\"", "\"dt\": 1e-5");
+  replace("\"fracture_energy\": 3.8", "\"fracture_energy\": null");
+  replace("\"every_time\": 1e-6", "\"every_time\": 1e-5");  // a frame every step
+  std::ofstream(dir / "case.json") << text;
+  EXPECT_EQ(run_solver((dir / "case.json").string() + " --end-time 1e-2", dir / "log.txt"), 3);
+  const std::string log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("removed "), std::string::npos) << log;
+  EXPECT_NE(log.find(" frame(s) written from step 2 on, while the energy grew ×1.5 a step; the last frame kept, at "
+                     "t = 1e-05 s, is the last before the growth"),
+            std::string::npos)
+      << log;
+  const std::string pvd = slurp(dir / "out" / "frames.pvd");
+  EXPECT_NE(pvd.find("frames/frame_000001.vtu"), std::string::npos) << pvd;
+  EXPECT_EQ(pvd.find("frames/frame_000002.vtu"), std::string::npos) << pvd;
+  EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "frame_000001.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "frames" / "frame_000002.vtu"));
+  fs::remove_all(dir);
+}

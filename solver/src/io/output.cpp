@@ -211,6 +211,21 @@ void OutputWriter::frame(const Model& model, const State& state, double time, st
   flush_history();
 }
 
+int OutputWriter::drop_frames_after(double time) {
+  std::vector<std::string> dropped;
+  while (!frames_.empty() && frames_.back().first > time) {
+    dropped.push_back(frames_.back().second);
+    frames_.pop_back();
+  }
+  if (dropped.empty()) return 0;
+  write_pvd();  // first: the .pvd never lists a removed frame
+  for (const auto& file : dropped) {
+    std::error_code ignored;
+    std::filesystem::remove(dir_ / file, ignored);
+  }
+  return static_cast<int>(dropped.size());
+}
+
 std::vector<double> OutputWriter::frame_times() const {
   std::vector<double> times;
   for (const auto& frame : frames_) times.push_back(frame.first);
