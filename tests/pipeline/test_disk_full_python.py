@@ -24,9 +24,14 @@ def test_preprocess_on_a_full_disk(tmp_path):
     assert made.returncode == 0, made.stderr
     out = tmp_path / "out"
     out.mkdir()
-    code, _, err, left = run_on_small_disk(
-        out, [PY, "-m", "pipeline.run", "preprocess", str(case / "membrane.yaml"), str(mesh), str(out)],
-        size_kb=16, cwd=ROOT, env=env)
+    command = [PY, "-m", "pipeline.run", "preprocess", str(case / "membrane.yaml"), str(mesh), str(out)]
+    # The work plan sees the disk is too small for the run's frames and stops before writing ...
+    code, _, err, left = run_on_small_disk(out, command, size_kb=16, cwd=ROOT, env=env)
+    assert code == 2 and "Traceback" not in err, err
+    assert f"MB of disk, " in err and f"; it writes about 10 MB, more than half of the 0 MB free in {out}" in err
+    assert left == []
+    # ... and with FORCE=1 the node file itself does not fit.
+    code, _, err, left = run_on_small_disk(out, command, size_kb=16, cwd=ROOT, env=dict(env, FORCE="1"))
     assert "Traceback" not in err, err
     assert code == 3, err
     assert f"error: disk full writing {out}/nodes.vtu: 0 MB free in {out}; free some space and run make again" in err
