@@ -49,7 +49,29 @@ def cmd_mesh(args):
     from preprocess.gmsh_mesh import mesh_geo
 
     case = load_case(args.case)
+    check_parameters_used(case, args.geo)
     mesh_geo(args.geo, args.out, case["dimension"], case["geometry"]["parameters"])
+
+
+def check_parameters_used(case: dict, geo: str):
+    """A gmsh parameter that the .geo never names is ignored by gmsh: an error at its line."""
+    from preprocess.geo_guard import geo_identifiers
+
+    parameters = case["geometry"]["parameters"]
+    if not parameters:
+        return
+    names = geo_identifiers(geo)
+    lines = case["_lines"]
+    errors = []
+    for name in parameters:
+        if name not in names:
+            close = difflib.get_close_matches(name, sorted(names), n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            line = lines.get(("geometry", "parameters", name), lines.get(("geometry",), 1))
+            errors.append(f"{case['_path']}:{line}: geometry.parameters.{name}: {geo} never uses '{name}', so gmsh "
+                          f"would ignore it{hint}; give only the names the .geo defines")
+    if errors:
+        raise CaseError("\n".join(errors))
 
 
 def missing_block_error(case: dict, mesh: str, err) -> CaseError:

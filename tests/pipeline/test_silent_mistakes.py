@@ -94,3 +94,25 @@ def test_conditions_on_different_components_and_sets_still_pass(tmp_path):
         """))
     case = load_case(str(path))
     assert len(case["boundary_conditions"]) == 3 and len(case["initial_conditions"]) == 2
+
+
+def test_a_gmsh_parameter_the_geo_never_uses(tmp_path):
+    """gmsh ignores `-setnumber` for a name the .geo does not read: the mesh stage says so first."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    folder = tmp_path / "membrane"
+    folder.mkdir()
+    shutil.copy(os.path.join(root, "cases", "membrane", "membrane.geo"), folder)
+    text = open(os.path.join(root, "cases", "membrane", "membrane.yaml"), encoding="utf-8").read()
+    (folder / "membrane.yaml").write_text(text.replace("{L: 0.05, r: 0.006, lc: 0.002}",
+                                                       "{L: 0.05, radius: 0.006, lc: 0.002}"))
+    result = subprocess.run([sys.executable, "-m", "pipeline.run", "mesh", str(folder / "membrane.yaml"),
+                             str(folder / "membrane.geo"), str(tmp_path / "mesh.msh")], cwd=root,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert (f"membrane.yaml:10: geometry.parameters.radius: {folder / 'membrane.geo'} never uses 'radius', so "
+            "gmsh would ignore it") in result.stderr
+    assert not (tmp_path / "mesh.msh").exists()
