@@ -3,10 +3,14 @@
 #   make figures case=X       redraw figures and Gmsh views from existing results
 #   make case=X config=Y      run cases/X/Y.yaml (a variant of case X) into out/X-Y/
 #   make case=X RANKS=R       solve on R MPI ranks (mpiexec --oversubscribe -np R; OMP_NUM_THREADS threads each)
+#   make FORCE=1 case=X       run even when preprocess's work plan is above its limits (> 1 h, or
+#                             more than half the free memory or disk: pipeline/cost.py)
 #   make test                 build everything and run every test (then test-asan)
 #   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
-#   make fuzz                 libFuzzer on the solver's readers, FUZZ_SECONDS (60) each (clang)
+#   make fuzz                 libFuzzer on the solver's readers, then the case-file loader's mutation
+#                             fuzzer (pipeline/fuzz_case.py) and pdsolve's command line
+#                             (pipeline/fuzz_cli.py), FUZZ_SECONDS (60) each (clang)
 #   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
 #   make bench-accuracy       error against run time, Verlet vs adaptive → out/bench/accuracy.csv (docs/accuracy.md)
 #   make bench-implicit       implicit dynamics vs Verlet on a drum lattice → out/bench/implicit.csv
@@ -75,6 +79,27 @@ MESH       := $(if $(GIVEN_MESH),$(GIVEN_MESH),$(OUT)/mesh.msh)
 PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
 POST_SOURCES   := $(wildcard postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
+
+# One make at a time per case output folder (issue 17, item 8): two `make case=X` in one tree drew
+# each other's frames in progress and read half-written history rows. A goal that writes out/<case>/
+# re-runs make under flock(1) (util-linux) on $(OUT)/.lock, held until that make ends; a second
+# make fails at once saying who holds it, or waits LOCK_WAIT seconds for it (LOCK_WAIT=600).
+UNLOCKED_GOALS := test test-asan fuzz solver deps check clean bench bench-accuracy bench-implicit validate
+LOCKED_GOALS   := $(filter-out $(UNLOCKED_GOALS),$(or $(MAKECMDGOALS),all))
+LOCK_WAIT      ?= 0
+DRY_RUN        := $(findstring n,$(firstword -$(MAKEFLAGS)))# make -n writes nothing: no lock
+ifneq ($(and $(LOCKED_GOALS),$(if $(PD_CASE_LOCK)$(DRY_RUN),,locked)),)
+.PHONY: $(or $(MAKECMDGOALS),all) pd-case-lock
+$(or $(MAKECMDGOALS),all): pd-case-lock ; @:
+pd-case-lock:
+	@mkdir -p '$(OUT)'
+	+@flock -w '$(LOCK_WAIT)' -E 75 '$(OUT)/.lock' true || { \
+	  echo "error: $(OUT)/ is in use by another make ($$(cat '$(OUT)/.lock' 2>/dev/null || echo unknown)); wait \
+	for it to finish (or stop it: its Ctrl-C writes a checkpoint), or give LOCK_WAIT=<seconds> to wait" >&2; exit 75; }
+	+@PD_CASE_LOCK=1 exec flock -w '$(LOCK_WAIT)' -E 75 '$(OUT)/.lock' sh -c \
+	    'echo "pid $$$$, make $(MAKECMDGOALS) case=$(case) config=$(config), since $$(date +%T)" > "$$1"; shift; exec "$$@"' \
+	    sh '$(OUT)/.lock' $(MAKE) --no-print-directory $(MAKECMDGOALS)
+else
 
 .PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
 .DELETE_ON_ERROR:
@@ -153,12 +178,15 @@ test-asan: | $(DEPS)
 
 # libFuzzer (clang) on the solver's readers, FUZZ_SECONDS each; a crash leaves its input in
 # $(FUZZ_DIR)/artifacts/: fix the reader and add the input to solver/fuzz/regressions/<target>/.
+# Then the Python case-file loader (pipeline/fuzz_case.py): a traceback or a hang leaves its input
+# in the same folder as pd_fuzz_case_yaml-N.yaml: fix the loader and add a test. Last, pdsolve's
+# command line (pipeline/fuzz_cli.py): every run ends with a documented exit code, no signal.
 # The binary checkpoint has no dictionary: its few constants are in the seeds, and libFuzzer
 # picks up the ones the reader compares against.
 FUZZ_DIR     := build/solver-fuzz
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case pd_fuzz_checkpoint
-fuzz: | $(DEPS)
+fuzz: $(SOLVER) | $(DEPS)
 	cmake -S solver -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DPD_FUZZ=ON -DPD_BUILD_TESTS=OFF \
 	    -DCMAKE_BUILD_TYPE=RelWithDebInfo
 	cmake --build $(FUZZ_DIR) -j$(JOBS) --target pd_fuzz
@@ -175,6 +203,8 @@ fuzz: | $(DEPS)
 	    || { tail -n 40 $(FUZZ_DIR)/$$t.log; echo "$$t: failure, input in $(FUZZ_DIR)/artifacts/"; exit 1; }; \
 	    grep '^Done' $(FUZZ_DIR)/$$t.log; \
 	done
+	$(PY) -m pipeline.fuzz_case --seconds $(FUZZ_SECONDS) --artifacts $(FUZZ_DIR)/artifacts
+	$(PY) -m pipeline.fuzz_cli --seconds $(FUZZ_SECONDS) --solver $(SOLVER)
 
 # A benchmark, not a timed test: bricks of 64,000, ~10⁵ and 10⁶ nodes with 1 and 2 threads
 # (BENCH_SIDES to change), then the cost of output in the built cases. Prints the load average.
@@ -209,3 +239,5 @@ clean-case:
 	rm -rf -- '$(OUT)'
 clean:
 	rm -rf build out
+
+endif  # PD_CASE_LOCK

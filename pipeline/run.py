@@ -13,12 +13,15 @@ from __future__ import annotations
 import argparse
 import difflib
 import json
+import math
 import os
 import sys
 import warnings
 
-from .atomic import write_atomically
+from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
+from .conditions import check_condition_overlaps
+from .cost import check_cost
 from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
 
@@ -68,7 +71,29 @@ def cmd_mesh(args):
     from preprocess.gmsh_mesh import mesh_geo
 
     case = load_case(args.case)
+    check_parameters_used(case, args.geo)
     mesh_geo(args.geo, args.out, case["dimension"], case["geometry"]["parameters"])
+
+
+def check_parameters_used(case: dict, geo: str):
+    """A gmsh parameter that the .geo never names is ignored by gmsh: an error at its line."""
+    from preprocess.geo_guard import geo_identifiers
+
+    parameters = case["geometry"]["parameters"]
+    if not parameters:
+        return
+    names = geo_identifiers(geo)
+    lines = case["_lines"]
+    errors = []
+    for name in parameters:
+        if name not in names:
+            close = difflib.get_close_matches(name, sorted(names), n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            line = lines.get(("geometry", "parameters", name), lines.get(("geometry",), 1))
+            errors.append(f"{case['_path']}:{line}: geometry.parameters.{name}: {geo} never uses '{name}', so gmsh "
+                          f"would ignore it{hint}; give only the names the .geo defines")
+    if errors:
+        raise CaseError("\n".join(errors))
 
 
 def missing_block_error(case: dict, mesh: str, err) -> CaseError:
@@ -84,6 +109,26 @@ def missing_block_error(case: dict, mesh: str, err) -> CaseError:
                         f"names the physical group holding its nodes, and the mesh's "
                         f"{case['dimension']}D groups are: {', '.join(err.top_groups) or 'none'}")
     return CaseError("\n".join(messages))
+
+
+def run_cost(case: dict, resolved: dict, cloud) -> dict:
+    """The estimate of pipeline/cost.py for this case: bonds counted on a sample, eq. 2.5's step."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    from .cost import estimate, mean_bonds
+    from .stability import BOND_SLACK, case_stable_time_step
+
+    points = np.asarray(cloud.points)
+    tree = cKDTree(points)
+    time = case["time"]
+    if isinstance(time["dt"], str):
+        dt_stable, _ = case_stable_time_step(case, resolved, cloud, tree)
+        dt = dt_stable * float(time["safety_factor"])   # "exact" is larger: this is an upper bound
+    else:
+        dt = float(time["dt"])
+    bonds = mean_bonds(points, tree, float(resolved["horizon"]), BOND_SLACK) * len(points)
+    return estimate(case, cloud, bonds, dt if dt > 0 and math.isfinite(dt) else float(time["end"]))
 
 
 def cmd_preprocess(args):
@@ -110,13 +155,15 @@ def cmd_preprocess(args):
     resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
                        nodes_file="nodes.vtu")
     # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.
-    for warning in check_discretized_case(case, resolved, cloud):
+    for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud):
         print(f"warning: {warning}", file=sys.stderr)
+    plan = check_cost(case, run_cost(case, resolved, cloud), args.out_dir)  # stops a huge run unless FORCE=1
     os.makedirs(args.out_dir, exist_ok=True)
     write_node_file(os.path.join(args.out_dir, "nodes.vtu"), cloud)
     write_atomically(os.path.join(args.out_dir, "case.json"), json.dumps(resolved, indent=1) + "\n")
     print(f"{args.case}: {len(cloud.volume)} nodes, dx = {cloud.grid_spacing:.6g} m, "
           f"horizon = {resolved['horizon']:.6g} m, node sets: {', '.join(resolved['node_sets'])}")
+    print(f"{args.case}: {plan}")
 
 
 def main(argv=None) -> int:
@@ -149,6 +196,9 @@ def main(argv=None) -> int:
     except CaseError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    except WriteError as err:  # a full disk: its own exit code, as in the solver
+        print(f"error: {err}", file=sys.stderr)
+        return DISK_FULL_EXIT
     except Exception as err:  # preprocess errors carry the file name in their message
         if type(err).__name__ == "PreprocessError":
             print(f"error: {err}", file=sys.stderr)

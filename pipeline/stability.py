@@ -26,6 +26,7 @@ SAMPLE = 20000
 BOND_SLACK = 1.0 + 1e-12
 # Densities [kg/m³] and moduli [Pa] below these look like g/cm³ and MPa/GPa: warned about only,
 # since foams and gels are real.
+MIN_HORIZON_RATIO = 2.0   # horizon / spacing below which a warning says the model is a lattice
 LOW_DENSITY = 50.0
 LOW_MODULUS = 1.0e5
 # partial_volume rule → (family extension beyond δ in units of dx, shell weight ν on the outer
@@ -231,6 +232,15 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
                         f"within the horizon {horizon:.6g} m), e.g. node {first} at {_fmt(points[first])}; "
                         f"no force acts on them: refine the mesh there or enlarge the horizon")
 
+    # A horizon of about one spacing leaves a node 4 (2D) or 6 (3D) bonds: a lattice of springs,
+    # not the peridynamic continuum (thesis §2.1 uses δ ≈ 3·dx; issue 17, item 10).
+    if horizon < MIN_HORIZON_RATIO * dx:
+        sample = np.linspace(0, len(points) - 1, min(len(points), 5000)).astype(np.int64)
+        bonds = tree.query_ball_point(points[sample], horizon * BOND_SLACK, return_length=True) - 1
+        warnings.append(f"{_where(case, *horizon_key)}: the horizon {horizon:.6g} m is {horizon / dx:.3g} × the node "
+                        f"spacing: {float(np.mean(bonds)):.3g} bonds per node on average; the peridynamic model "
+                        f"needs a horizon of about 3 × the spacing (thesis §2.1): use horizon_factor: 3.015")
+
     dt_stable, node = case_stable_time_step(case, resolved, cloud, tree)
     if node < 0:  # no sampled node has a bond; the isolated-node warning says so
         return warnings
@@ -254,6 +264,14 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
     if not fixed and end < dt_stable:
         errors.append(f"{_where(case, 'time', 'end')}: time.end = {end:g} s is shorter than one stable time "
                       f"step: {origin}; nothing can happen in such a run; {units}")
+    if time["dt"] == "exact" and float(time["safety_factor"]) > 1.0:
+        warnings.append(f"{_where(case, 'time', 'safety_factor')}: {float(time['safety_factor']):g} > 1 with "
+                        "time.dt: exact makes the step larger than the exact stability limit 2/ω_max: the run "
+                        "will blow up; use a safety_factor of at most 1")
+    elif not fixed and float(time["safety_factor"]) > 1.0:
+        warnings.append(f"{_where(case, 'time', 'safety_factor')}: {float(time['safety_factor']):g} > 1 makes the step "
+                        f"{dt:.3g} s larger than the stable step of eq. 2.5: {origin}; the run may blow up "
+                        "(the exact limit is time.dt: exact): use a safety_factor of at most 1")
     if fixed and dt > dt_stable:
         warnings.append(f"{_where(case, 'time', 'dt')}: {dt:g} s exceeds the stable step: {origin}; the run "
                         f"will likely blow up; use dt: stable")

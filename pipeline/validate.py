@@ -14,8 +14,20 @@ import re
 from .schema import CASE, MODEL_KEYS, MODEL_NOTE, MODEL_REQUIRED, REQUIRED, Key
 from .yaml_lines import CaseError
 
+MAX_INTEGER = 2 ** 53
+MAX_TEXT = 200  # characters in a text value (title, set name)
 NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 COMPONENTS = ("x", "y", "z")
+
+
+def yaml11_hint(value) -> str:
+    """A hint for the YAML 1.1 number forms that YAML 1.2 (pipeline/yaml_lines.py) reads as text."""
+    if isinstance(value, str) and re.fullmatch(r"[-+]?(0b[01_]+|[0-9][0-9_]*(\.[0-9_]*)?([eE][-+]?[0-9]+)?)",
+                                               value):
+        return " (YAML 1.2 reads this as text: write the number without '_' or 0b, e.g. 1000)"
+    if isinstance(value, str) and value.lower() in ("yes", "no", "on", "off", "y", "n"):
+        return " (YAML 1.2 reads this as text; write true or false where a switch is meant)"
+    return ""
 
 
 class _Checker:
@@ -37,7 +49,7 @@ class _Checker:
     # -- scalar kinds -------------------------------------------------------
     def number(self, value, keypath: tuple, key: Key):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}")
+            self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}{yaml11_hint(value)}")
             return None
         value = float(value)
         if not math.isfinite(value):
@@ -46,6 +58,12 @@ class _Checker:
         return self.bounds(value, keypath, key)
 
     def integer(self, value, keypath: tuple, key: Key):
+        # Whole numbers up to 2^53, the range where a double (1e30 in YAML is one) is an exact
+        # integer and the solver's int64 holds it: `max_steps: 1e30` passed here before and was
+        # refused by the solver naming case.json (issue 17, item 10).
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
+            self.error(keypath, f"{value!r} is too large: a whole number is at most 2^53 = {MAX_INTEGER}")
+            return None
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         if isinstance(value, bool) or not isinstance(value, int):
@@ -73,11 +91,19 @@ class _Checker:
         return f" [{key.unit}]" if key.unit else ""
 
     def choice(self, value, keypath: tuple, key: Key):
-        if value in key.choices and not isinstance(value, bool):
-            return value
+        # The choice itself, of its own type: `dimension: 2.0` equals 2 in Python but reached gmsh
+        # as "-2.0" (issue 17, item 10).
+        for option in key.choices:
+            if value == option and type(value) is type(option):
+                return option
         options = ", ".join(repr(c) for c in key.choices)
-        hint = self.closest(str(value), [str(c) for c in key.choices])
-        self.error(keypath, f"{value!r} is not one of {options}{hint}")
+        same_text = [c for c in key.choices if str(c) == str(value) or (not isinstance(value, (str, bool)) and c == value)]
+        if same_text:
+            option = same_text[0]
+            how = "without quotes" if isinstance(value, str) else "as a whole number"
+            self.error(keypath, f"{value!r} is not one of {options}: write {option!r} {how}")
+        else:
+            self.error(keypath, f"{value!r} is not one of {options}{self.closest(str(value), [str(c) for c in key.choices])}")
         return None
 
     @staticmethod
@@ -96,12 +122,19 @@ class _Checker:
             if not isinstance(value, str) or not value:
                 self.error(keypath, f"expected a non-empty text, got {value!r}")
                 return None
+            # A name or a one-line title: it is drawn in every figure and written into case.json,
+            # run.log and the VTK files, so it is one line of at most MAX_TEXT characters.
+            if len(value) > MAX_TEXT or "\n" in value or "\r" in value:
+                self.error(keypath, f"expected one line of at most {MAX_TEXT} characters, got "
+                           f"{len(value)} characters{' on several lines' if chr(10) in value else ''}; "
+                           "shorten it")
+                return None
             return value
         if kind == "choice":
             return self.choice(value, keypath, key)
         if kind == "boolean":
             if not isinstance(value, bool):
-                self.error(keypath, f"expected true or false, got {value!r}")
+                self.error(keypath, f"expected true or false, got {value!r}{yaml11_hint(value)}")
                 return None
             return value
         if kind == "number_or_choice":
@@ -279,6 +312,7 @@ def _check_context(case: dict, checker: _Checker):
     for i, ic in enumerate(case["initial_conditions"]):
         if not ic["velocity"] and not ic["displacement"] and not ic["strain"]:
             checker.error(("initial_conditions", i), "give velocity, displacement or strain")
+    _check_conflicts(case, checker)
     names = set()
     for i, ind in enumerate(case["indenters"]):
         _check_indenter(ind, i, dim, names, checker)
@@ -290,6 +324,10 @@ def _check_context(case: dict, checker: _Checker):
             checker.error(("adaptive", low), f"{low} {adaptive[low]:g} s is larger than {high} "
                           f"{adaptive[high]:g} s")
     out = case["output"]
+    if out["every_time"] is not None and out["every_time"] > case["time"]["end"]:
+        checker.error(("output", "every_time"), f"{out['every_time']:g} s is longer than the run (time.end = "
+                      f"{case['time']['end']:g} s): only the first and the last frame would be written; "
+                      "use at most time.end")
     if out["every_time"] is not None and out["every_steps"] is not None:
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
@@ -325,6 +363,40 @@ def _check_materials(case: dict, checker: _Checker):
     influences = {m.get("influence") or "one" for m in materials.values() if m["model"] == "lps"}
     if len(influences) > 1:
         checker.error(("materials",), f"every block must use the same influence function, got {', '.join(sorted(influences))}")
+
+
+def _check_conflicts(case: dict, checker: _Checker):
+    """Two conditions on one set and component, where the solver would silently apply the last
+    (issue 17, item 10: a clamped edge moved 1 mm). Overlaps of different sets are checked once
+    the node sets exist (pipeline/stability.py, check_discretized_case)."""
+    prescribed: dict[tuple, tuple] = {}   # (set, component) → (index, kind) of the first condition
+    for i, bc in enumerate(case["boundary_conditions"]):
+        for kind in ("displacement", "velocity"):
+            for comp in sorted(bc[kind] or {}):
+                first = prescribed.setdefault((bc["set"], comp), (i, kind))
+                if first[0] != i:
+                    where = ("boundary_conditions", first[0], first[1], comp)
+                    checker.error(("boundary_conditions", i, kind, comp),
+                                  f"set '{bc['set']}' component {comp} is already given a {first[1]} by "
+                                  f"boundary_conditions[{first[0]}] (line {checker.line_of(where)}); only one "
+                                  "would act: keep one")
+    initial: dict[tuple, int] = {}
+    for i, ic in enumerate(case["initial_conditions"]):
+        for kind in ("velocity", "displacement"):
+            for comp in sorted(ic[kind] or {}):
+                first = initial.setdefault((ic["set"], kind, comp), i)
+                if first != i:
+                    where = ("initial_conditions", first, kind, comp)
+                    checker.error(("initial_conditions", i, kind, comp),
+                                  f"set '{ic['set']}' is given an initial {kind} {comp} twice (also "
+                                  f"initial_conditions[{first}], line {checker.line_of(where)}); keep one")
+                if kind == "velocity" and (ic["set"], comp) in prescribed:
+                    j, bc_kind = prescribed[(ic["set"], comp)]
+                    checker.error(("initial_conditions", i, kind, comp),
+                                  f"set '{ic['set']}' component {comp} has a prescribed {bc_kind} "
+                                  f"(boundary_conditions[{j}], line "
+                                  f"{checker.line_of(('boundary_conditions', j, bc_kind, comp))}): the initial "
+                                  "velocity would be ignored there; remove one")
 
 
 def _check_crack(crack: dict, i: int, dim: int, checker: _Checker):

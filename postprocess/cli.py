@@ -18,6 +18,8 @@ import sys
 
 import numpy as np
 
+from pipeline.atomic import DISK_FULL_EXIT, WriteError
+
 from .casefile import load_case_settings
 from .errors import PostprocessError
 from .history import read_history
@@ -202,4 +204,7 @@ def main(argv=None) -> int:
     except PostprocessError as error:
         print(f"postprocess: error: {error}", file=sys.stderr)
         return 1
+    except WriteError as error:  # a full disk: its own exit code, as in the solver
+        print(f"postprocess: error: {error}", file=sys.stderr)
+        return DISK_FULL_EXIT
     return 0

@@ -42,6 +42,13 @@ from .mesh import Mesh, element_dimension
 METHODS = ("lattice", "mesh-nodes")
 
 
+# Beyond this a squared distance overflows (the solver's node-file reader has the same limit), and a
+# lattice box of more cells than MAX_LATTICE_CELLS is no case a machine here could run (issue 17,
+# item 9: a 1e300 coordinate ended in a numpy traceback).
+MAX_COORDINATE = 1e150      # m
+MAX_LATTICE_CELLS = 1e10
+
+
 def default_lattice_layer(dx: float, dimension: int, group_dim: int) -> float:
     """Distance that takes the first row of cell-centred nodes around a group (module docstring)."""
     return 0.5 * dx * np.sqrt(dimension - group_dim) * (1 + 1e-6)
@@ -92,6 +99,12 @@ def _check_points(mesh: Mesh, dimension: int) -> np.ndarray:
         i = int(np.nonzero(bad)[0][0])
         raise PreprocessError(f"{path}: {int(bad.sum())} node(s) have NaN or infinite coordinates "
                               f"(first: node index {i}); fix the mesh")
+    far = np.abs(points) > MAX_COORDINATE
+    if np.any(far):
+        i = int(np.nonzero(np.any(far, axis=1))[0][0])
+        raise PreprocessError(f"{path}: {int(np.any(far, axis=1).sum())} node(s) lie beyond ±{MAX_COORDINATE:g} m "
+                              f"(first: node index {i} at {_fmt(points[i])}); coordinates are in metres: "
+                              "fix the mesh")
     top = mesh.top_dimension()
     if top > dimension:
         raise PreprocessError(f"{path}: the mesh has {top}D elements but the case is {dimension}D; "
@@ -186,6 +199,11 @@ def _lattice(mesh, points, top, dimension, dx, thickness, elem_block):
     path = mesh.path
     used = np.unique(np.concatenate([c.ravel() for c in top.values()]))
     lo, hi = points[used].min(axis=0), points[used].max(axis=0)
+    cells = float(np.prod(np.floor((hi[:dimension] - lo[:dimension]) / dx) + 1.0))
+    if not cells <= MAX_LATTICE_CELLS:
+        raise PreprocessError(f"{path}: the lattice with dx = {dx:g} m over the mesh's bounding box {_fmt(lo)} to "
+                              f"{_fmt(hi)} would have {cells:.3g} cells, more than {MAX_LATTICE_CELLS:.0e}; "
+                              "use a larger dx, or check the mesh for a node far from the others")
     origin, shape = lattice_axes(lo[:dimension], hi[:dimension], dx)
     origin = np.concatenate([origin, np.zeros(3 - dimension)])
     conn, owner_type, owner_index, types = simplices(top, dimension)

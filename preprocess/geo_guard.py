@@ -197,3 +197,17 @@ def _check_read(command, target, path, line, case_dir, scanned, depth):
     if depth >= MAX_INCLUDE_DEPTH:
         raise PreprocessError(f"{where}: files included more than {MAX_INCLUDE_DEPTH} deep; include fewer")
     _scan(resolved, case_dir, scanned, depth + 1)
+
+
+def geo_identifiers(geo_path: str) -> set[str]:
+    """Every identifier of the .geo and of the files it Includes (after check_geo: those are the
+    case's own files): a gmsh parameter of the case file that is none of them is ignored by gmsh
+    (`-setnumber` on a name the .geo never reads), a mistake to report (issue 17, item 10)."""
+    names: set[str] = set()
+    for path in check_geo(geo_path):
+        if not path.endswith(".geo"):
+            continue
+        with open(path, "rb") as stream:
+            text = stream.read().decode("utf-8")
+        names.update(value for kind, value, _ in tokens(text, path) if kind == "ident")
+    return names

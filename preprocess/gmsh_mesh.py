@@ -5,7 +5,7 @@ import os
 import shutil
 import subprocess
 
-from pipeline.atomic import atomic_path
+from pipeline.atomic import WriteError, atomic_path, disk_full_message, free_megabytes
 
 from .errors import PreprocessError
 from .geo_guard import check_geo
@@ -71,3 +71,22 @@ def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[
                                   + "\n  ".join(shown) + more)
         if os.path.getsize(tmp) == 0:
             raise PreprocessError(f"{geo_path}: gmsh wrote an empty mesh")
+        check_complete_msh(tmp, out_msh_path)
+
+
+def check_complete_msh(tmp: str, out_msh_path: str):
+    """gmsh exits 0 even when the disk fills while it writes (issue 17, item 6): a whole .msh
+    starts with $MeshFormat and ends with the $End line of its last section; anything else is cut
+    short and is not kept (the atomic writer removes it)."""
+    with open(tmp, "rb") as stream:
+        head = stream.read(11)
+        stream.seek(max(0, os.path.getsize(tmp) - 256))
+        tail = stream.read().rstrip(b"\r\n\0 ").rsplit(b"\n", 1)[-1]
+    if head == b"$MeshFormat" and tail.startswith(b"$End"):
+        return
+    directory = os.path.dirname(os.path.abspath(out_msh_path))
+    if free_megabytes(directory) < 1.0:
+        raise WriteError(disk_full_message(out_msh_path))
+    raise PreprocessError(f"{out_msh_path}: gmsh wrote an incomplete mesh (it ends with "
+                          f"{tail[-40:].decode('ascii', 'replace')!r}, not an $End line); "
+                          "the file was not kept: check the disk and run make again")

@@ -1,4 +1,5 @@
 // pdsolve: the command-line front end of the solver library (see run.hpp for the work itself).
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -51,11 +52,13 @@ const char* const kUsage =
     "                  (pipeline/formats.md §6)\n"
     "\n"
     "SIGINT (Ctrl-C) or SIGTERM: the run finishes its step, writes output_dir/checkpoint.bin and\n"
-    "stops (a second signal kills it at once); so does output.restart_every_time / _steps, without\n"
-    "stopping.\n"
+    "stops; more signals within 2 s are the same request (make forwards a SIGTERM sent to its\n"
+    "process group), a signal after that kills it at once. output.restart_every_time / _steps\n"
+    "write a checkpoint without stopping.\n"
     "\n"
     "Exit codes: 0 done; 1 bad input (reported before any output file is written); 2 bad command\n"
-    "line; 3 the run failed (e.g. the state became non-finite; the last valid frame is kept);\n"
+    "line; 3 the run failed (e.g. the state became non-finite, or the disk is full: \"disk full\n"
+    "writing FILE: free N MB and run make again\"; the frames and rows written before are whole);\n"
     "130 / 143 interrupted by SIGINT / SIGTERM after writing the checkpoint.\n";
 
 #ifdef _OPENMP
@@ -116,6 +119,21 @@ long long parse_integer(const std::string& option, const std::string& text) {
   return value;
 }
 
+// More threads than max(64, 4 × the processors) only slow a run down, and 100000 OpenMP threads
+// crashed the runtime (issue 17, item 9): refused with the limit.
+int parse_threads(const std::string& option, const std::string& text) {
+  const long long threads = parse_integer(option, text);
+#ifdef _OPENMP
+  const long long limit = std::max(64, 4 * omp_get_num_procs());
+#else
+  const long long limit = 64;  // ignored without OpenMP
+#endif
+  if (threads > limit)
+    usage_error(option + " " + text + ": at most " + std::to_string(limit) + " threads here (max(64, 4 × the " +
+                "processors)); the default uses every core");
+  return static_cast<int>(threads);
+}
+
 // --stable-dt: eq. 2.5 on the model built exactly as run() builds it (read_case, read_node_file,
 // build_model), so that pipeline/stability.py can be tested against the solver's own number.
 int print_stable_dt(const std::filesystem::path& case_file, bool exact) {
@@ -163,7 +181,7 @@ int main(int argc, char** argv) {
       print_version();
       return pd::kOk;
     } else if (arg == "--threads") {
-      options.threads = static_cast<int>(parse_integer(arg, value()));
+      options.threads = parse_threads(arg, value());
     } else if (arg == "--end-time") {
       options.end_time = parse_number(arg, value());
     } else if (arg == "--max-steps") {

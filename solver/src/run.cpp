@@ -2,7 +2,11 @@
 // run/ (pipeline/formats.md §3–4).
 #include "run.hpp"
 
+#include <iostream>
+#include <memory>
+
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "run/history_columns.hpp"
 #include "run/loop.hpp"
 #include "run/prepare.hpp"
@@ -12,6 +16,40 @@
 
 namespace pd {
 
+namespace {
+
+// From the first output file on: an error (a full disk, a failed rename) is a failed run, not bad
+// input (exit 3, --help), and it goes to run.log too when run.log can still be written; the frames
+// and history rows written so far stay whole (issue 17, item 6).
+// On a decomposed run rank 0 writes every file; the other ranks have no writer (out is null) and a
+// silent log.
+int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryColumns& columns, OutputWriter* out) {
+  std::unique_ptr<RunLog> log;
+  try {
+    // A checkpoint of an earlier run would not match the frames this run writes.
+    if (!s.restarting && out) std::filesystem::remove(checkpoint_path(p.c));
+    log = std::make_unique<RunLog>(out ? p.c.output_dir / "run.log" : std::filesystem::path(), opt.quiet,
+                                   s.restarting);
+    log_title(*log, opt, p);
+    if (s.restarting) log->line(restart_line(opt, s));
+    log_setup(*log, p);
+    const LoopEnd end = run_loop(opt, p, s, columns, out, *log);
+    return report(opt, p, s.loop, end, out ? out->frames_written() : 0, *log);
+  } catch (const Error& e) {
+    const std::string message = std::string("pdsolve: error during the run: ") + e.what() +
+                                "; the frames and history rows written before it are complete";
+    if (!log) std::cerr << message << "\n";
+    try {
+      if (log) log->error(message);  // prints it, then writes run.log
+    } catch (const Error&) {
+      // run.log cannot be written either (the same full disk): the message is on stderr already.
+    }
+    return kRunFailed;
+  }
+}
+
+}  // namespace
+
 int run(const RunOptions& opt) {
   const SignalGuard signals;  // from the start: a signal while reading is seen after the first step
   // Every input error is thrown by these two, before any output exists.
@@ -19,25 +57,14 @@ int run(const RunOptions& opt) {
   Prepared& p = *prepared;
   Start s = start_or_restore(opt, p);
 
-  // Output starts here.
+  // Output starts here. open_output refuses a restart whose history.csv or frames do not match the
+  // checkpoint (bad input, exit 1, before it changes a file); a full disk there is a failed run.
   const HistoryColumns columns(p.model, p.c, p.integrator.get());
-  // On a decomposed run rank 0 writes every file; the other ranks have no writer and a silent log.
-  const std::unique_ptr<OutputWriter> out = open_output(opt, p, s, columns);
-  // A checkpoint of an earlier run would not match the frames this run writes.
-  if (!s.restarting && out) std::filesystem::remove(checkpoint_path(p.c));
-  RunLog log(out ? p.c.output_dir / "run.log" : std::filesystem::path(), opt.quiet, s.restarting);
-  log_title(log, opt, p);
-  if (s.restarting) log.line(restart_line(opt, s));
-  log_setup(log, p);
-
-  // From here on output files exist: an error (a full disk, a failed rename) is a failed run, not
-  // bad input (exit 3, --help), and it goes to run.log too; the frames written so far stay valid.
   try {
-    const LoopEnd end = run_loop(opt, p, s, columns, out.get(), log);
-    return report(opt, p, s.loop, end, out ? out->frames_written() : 0, log);
-  } catch (const Error& e) {
-    log.error(std::string("pdsolve: error during the run: ") + e.what() +
-              "; the frames and history rows written before it are complete");
+    const std::unique_ptr<OutputWriter> out = open_output(opt, p, s, columns);
+    return run_with_output(opt, p, s, columns, out.get());
+  } catch (const DiskFull& e) {
+    std::cerr << "pdsolve: error: " << e.what() << "\n";
     return kRunFailed;
   }
 }

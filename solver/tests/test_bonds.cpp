@@ -99,3 +99,19 @@ TEST(Material, UnknownAnalysisListsTheRegistry) {
     EXPECT_NE(std::string(e.what()).find("known: 3d, plane_strain, plane_stress"), std::string::npos) << e.what();
   }
 }
+
+// A node 1e150 m from the others (the largest coordinate the node file accepts): the cell grid
+// grows its bins in double arithmetic instead of overflowing an integer count (issue 17, item 9:
+// "internal error … max_size()"); the far node has no bond, the others keep theirs.
+TEST(Bonds, AFarNodeDoesNotOverflowTheCellGrid) {
+  const double dx = 1e-3;
+  pd::Nodes nodes = pdtest::cubic_lattice(4, 4, 1, dx, 2, 1e-3);
+  const pd::BondList near = pd::build_bonds(nodes.x, 1.5 * dx);
+  for (std::size_t d = 0; d < 3; ++d) nodes.x[d].push_back(d == 0 ? 1e150 : 0.0);
+  const pd::BondList b = pd::build_bonds(nodes.x, 1.5 * dx);
+  ASSERT_EQ(b.nodes(), nodes.x[0].size());
+  EXPECT_EQ(b.offsets[b.nodes()] - b.offsets[b.nodes() - 1], 0);  // the far node: no bond
+  EXPECT_EQ(b.directed(), near.directed());
+  EXPECT_EQ(std::vector<std::int32_t>(b.neighbour.begin(), b.neighbour.end()),
+            std::vector<std::int32_t>(near.neighbour.begin(), near.neighbour.end()));
+}

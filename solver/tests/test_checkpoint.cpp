@@ -425,3 +425,24 @@ TEST(Checkpoint, AdaptiveIntegratorStateCarriesItsProposal) {
 }
 
 }  // namespace
+
+// A directory or a device given as the checkpoint (issue 17, item 9): a clear error, without the
+// advice to delete it; /dev/zero was read until memory ran out, a directory was
+// "internal error: basic_filebuf::underflow".
+TEST(Checkpoint, ADirectoryOrADeviceIsNoCheckpoint) {
+  const fs::path dir = temp_dir("not_a_file");
+  write_case(dir, "verlet", false);
+  const std::vector<std::pair<fs::path, std::string>> cases = {
+      {dir, dir.string() + ": a directory, not the checkpoint; give the path of the file"},
+      {"/dev/zero", "/dev/zero: not a regular file, not the checkpoint; give the path of the file"}};
+  for (const auto& [restart, expected] : cases) {
+    try {
+      run(dir / "case.json", {}, restart);
+      ADD_FAILURE() << "no error for " << restart;
+    } catch (const pd::Error& e) {
+      EXPECT_EQ(std::string(e.what()), expected);
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir / "out" / "history.csv"));  // refused before any output
+  fs::remove_all(dir);
+}

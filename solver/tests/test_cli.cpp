@@ -88,3 +88,11 @@ TEST(CommandLine, BadOptionsAreUsageErrors) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("no case file given"), std::string::npos) << r.out;
 }
+
+// 100000 OpenMP threads crashed the runtime (exit 139, issue 17, item 9): a usage error now.
+TEST(CommandLine, TooManyThreadsIsAUsageError) {
+  const Result r = run_solver("case.json --threads 100000");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--threads 100000: at most "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" threads here (max(64, 4 × the processors))"), std::string::npos) << r.out;
+}

@@ -195,3 +195,61 @@ TEST(EndToEnd, NonFiniteStateStopsTheRunNamingTheStep) {
   EXPECT_NE(log.find("above the stability limit"), std::string::npos) << log;
   fs::remove_all(dir);
 }
+
+// A step above eq. 2.5 is judged at set-up against the exact limit 2/ω_max (issue 17, item 12):
+// safety_factor 5 is above it ("will blow up", before any step), 1.05 is above eq. 2.5 only.
+TEST(EndToEnd, StepAboveTheStableStepIsJudgedAtSetUpAgainstTheExactLimit) {
+  const fs::path dir = temp_dir("safety");
+  write_plate_case(dir);
+  const std::string base = slurp(dir / "case.json");
+  auto with_factor = [&](const std::string& factor) {
+    std::string text = base;
+    const std::string from = "\"safety_factor\": 0.8";
+    text.replace(text.find(from), from.size(), "\"safety_factor\": " + factor);
+    std::ofstream(dir / "case.json") << text;
+  };
+  with_factor("5");
+  run_solver((dir / "case.json").string() + " --max-steps 1", dir / "log.txt");
+  std::string log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("warning: dt "), std::string::npos) << log;
+  EXPECT_NE(log.find(" s (safety factor 5) is "), std::string::npos) << log;
+  EXPECT_NE(log.find(" × the exact stability limit 2/ω_max = "), std::string::npos) << log;
+  EXPECT_NE(log.find(" s: the run will blow up; use time.safety_factor ≤ 1"), std::string::npos) << log;
+  with_factor("1.05");
+  run_solver((dir / "case.json").string() + " --max-steps 1", dir / "log.txt");
+  log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("(safety factor 1.05) exceeds the stable time step of thesis eq. 2.5"), std::string::npos) << log;
+  EXPECT_NE(log.find("but not the exact limit 2/ω_max"), std::string::npos) << log;
+  with_factor("0.8");
+  run_solver((dir / "case.json").string() + " --max-steps 1", dir / "log.txt");
+  EXPECT_EQ(slurp(dir / "out" / "run.log").find("warning: dt"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// The frames written while the energy grew ×1.5 a step show the instability, not the physics: a
+// blown-up run keeps only the frames before the growth began (issue 17, item 12: the kept "last
+// valid" frame had max|v| = 1.2·10⁹ m/s). Here dt is 10 × too large: the watch, which compares each
+// step's energy with the step before, sees the growth from step 2 on.
+TEST(EndToEnd, BlownUpRunKeepsOnlyFramesBeforeTheGrowth) {
+  const fs::path dir = temp_dir("blowup_frames");
+  write_plate_case(dir);
+  std::string text = slurp(dir / "case.json");
+  auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+  replace("\"dt\": \"stable\"", "\"dt\": 1e-5");
+  replace("\"fracture_energy\": 3.8", "\"fracture_energy\": null");
+  replace("\"every_time\": 1e-6", "\"every_time\": 1e-5");  // a frame every step
+  std::ofstream(dir / "case.json") << text;
+  EXPECT_EQ(run_solver((dir / "case.json").string() + " --end-time 1e-2", dir / "log.txt"), 3);
+  const std::string log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("removed "), std::string::npos) << log;
+  EXPECT_NE(log.find(" frame(s) written from step 2 on, while the energy grew ×1.5 a step; the last frame kept, at "
+                     "t = 1e-05 s, is the last before the growth"),
+            std::string::npos)
+      << log;
+  const std::string pvd = slurp(dir / "out" / "frames.pvd");
+  EXPECT_NE(pvd.find("frames/frame_000001.vtu"), std::string::npos) << pvd;
+  EXPECT_EQ(pvd.find("frames/frame_000002.vtu"), std::string::npos) << pvd;
+  EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "frame_000001.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "frames" / "frame_000002.vtu"));
+  fs::remove_all(dir);
+}

@@ -323,3 +323,45 @@ TEST(CaseFile, OutputFormatKeysAreCheckedAndDefaultToTheCompactFrames) {
   EXPECT_FALSE(f.float32);
   EXPECT_FALSE(f.zlib);
 }
+
+// A fresh run rewrites frames.pvd (listing no frame) before it deletes the frames of the earlier
+// run, so a run killed in between (kill -9) never leaves a .pvd listing deleted frames (issue 17,
+// item 5). Before, the old .pvd stayed until the new run's first frame.
+TEST(Frames, FreshRunEmptiesThePvdBeforeDeletingOldFrames) {
+  const fs::path dir = temp_dir("fresh_pvd");
+  fs::create_directories(dir / "frames");
+  std::string old_pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\">\n  <Collection>\n";
+  for (int k = 0; k < 3; ++k) {
+    const std::string name = "frames/frame_00000" + std::to_string(k) + ".vtu";
+    spit(dir / name, "old frame");
+    old_pvd += "    <DataSet timestep=\"" + std::to_string(k) + "\" file=\"" + name + "\"/>\n";
+  }
+  spit(dir / "frames.pvd", old_pvd + "  </Collection>\n</VTKFile>\n");
+  {
+    const pd::OutputWriter out(dir);
+    EXPECT_FALSE(fs::exists(dir / "frames" / "frame_000000.vtu"));
+    const std::string pvd = slurp(dir / "frames.pvd");
+    EXPECT_EQ(pvd.find("DataSet"), std::string::npos) << pvd;
+    EXPECT_NE(pvd.find("<Collection>"), std::string::npos) << pvd;
+  }
+  fs::remove_all(dir);
+}
+
+// Not a file, or a coordinate no distance can be computed from (issue 17, item 9): a clear error
+// naming the file, not "basic_filebuf::underflow", an endless read of /dev/zero or "max_size()".
+TEST(NodeFile, DirectoryDeviceAndFarCoordinatesAreRefused) {
+  const fs::path dir = temp_dir("not_a_file");
+  expect_node_error(dir, {dir.string() + ": a directory, not the VTK file; give the path of the file"});
+  expect_node_error("/dev/zero", {"/dev/zero: not a regular file, not the VTK file"});
+  pd::Nodes n = sample_nodes();
+  n.x[0][4] = 1e300;
+  pd::write_node_file(dir / "far.vtu", n);
+  expect_node_error(dir / "far.vtu", {"far.vtu: point 4 has coordinate x = 1e+300 m, beyond ±1e+150 m"});
+  EXPECT_THROW(pd::read_case(dir), pd::Error);
+  try {
+    pd::read_case(dir);
+  } catch (const pd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("a directory, not the case file"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}

@@ -63,3 +63,75 @@ def test_an_exception_leaves_no_temporary_file_and_the_old_file_intact(tmp_path,
             raise Boom
     assert sorted(p.name for p in tmp_path.iterdir()) == ["results.msh"]
     assert target.read_text() == "old"
+
+
+# -- signals and dead writers (issue 17, item 7) --------------------------------------------------
+import signal  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+WRITER = """
+import sys, time
+sys.path.insert(0, {root!r})
+from pipeline.atomic import atomic_path
+with atomic_path({target!r}) as tmp:
+    with open(tmp, "w") as stream:
+        stream.write("half of a 90 MB node file")
+    print("writing", flush=True)
+    time.sleep(60)
+"""
+
+
+def start_writer(target):
+    process = subprocess.Popen([sys.executable, "-c", WRITER.format(root=ROOT, target=str(target))],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert process.stdout.readline() == "writing\n"
+    return process
+
+
+def test_sigterm_while_writing_removes_the_temporary_file(tmp_path):
+    target = tmp_path / "nodes.vtu"
+    process = start_writer(target)
+    assert len(list(tmp_path.iterdir())) == 1   # the temporary file, under way
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=30)
+    assert process.returncode == 128 + signal.SIGTERM, err
+    assert "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []       # neither the file nor its temporary
+
+
+def test_a_killed_writers_temporary_file_goes_with_the_next_write(tmp_path):
+    target = tmp_path / "nodes.vtu"
+    process = start_writer(target)
+    process.kill()                               # kill -9: no handler runs
+    process.wait(timeout=30)
+    left = [p.name for p in tmp_path.iterdir()]
+    assert len(left) == 1 and left[0].startswith(f".tmp-{process.pid}-") and left[0].endswith("-nodes.vtu")
+    (tmp_path / ".tmp-1-keep-other.vtu").write_text("another file's temporary")
+    write_atomically(str(target), "new")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".tmp-1-keep-other.vtu", "nodes.vtu"]
+    assert target.read_text() == "new"
+
+
+def test_a_running_writers_temporary_file_is_left_alone(tmp_path):
+    target = tmp_path / "nodes.vtu"
+    process = start_writer(target)
+    try:
+        write_atomically(str(target), "other writer")
+        assert len([p for p in tmp_path.iterdir() if p.name.startswith(f".tmp-{process.pid}-")]) == 1
+    finally:
+        process.kill()
+        process.wait(timeout=30)
+
+
+def test_the_callers_sigterm_handler_is_restored(tmp_path):
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+    with atomic_path(str(tmp_path / "a")) as tmp:
+        assert signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL
+        with atomic_path(str(tmp_path / "b")) as inner:
+            open(inner, "w").close()
+        assert signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL
+        open(tmp, "w").close()
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL

@@ -62,7 +62,7 @@ no_fail: [left]
 boundary_conditions:
   - {set: left, displacement: {x: 0}, velocity: {y: [[0, 0], [1, 1]]}, body_force: {z: 1}}
 initial_conditions:
-  - {set: left, velocity: {x: 1}, displacement: {y: 0}, strain: {x: 0.001}}
+  - {set: left, velocity: {z: 1}, displacement: {y: 0}, strain: {x: 0.001}}
 cracks:
   - {from: [0, 0], to: [1, 0]}
 damping: 1

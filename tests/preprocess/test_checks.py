@@ -109,3 +109,19 @@ def test_command_line(meshes, tmp_path):
                             cwd=ROOT, capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.startswith(f"error: {meshes['plate']}: block 'steel' is not a physical group")
+
+
+@pytest.mark.parametrize("method", ["mesh-nodes", "lattice"])
+def test_a_far_node_is_refused_naming_it(method):
+    """A 1e300 coordinate ended in a numpy traceback (issue 17, item 9)."""
+    points = SQUARE.copy()
+    points[2] = [1e300, 1, 0]
+    with pytest.raises(PreprocessError, match=r"^sq.msh: 1 node\(s\) lie beyond ±1e\+150 m \(first: node index 2 "):
+        run(square(points), method=method)
+
+
+def test_a_lattice_too_large_for_any_machine_is_refused():
+    points = SQUARE * 1e6   # a 1000 km square at dx = 0.1 m: 10^14 cells
+    with pytest.raises(PreprocessError, match=r"^sq.msh: the lattice with dx = 0.1 m over the mesh's bounding box "
+                                              r".* would have 1e\+14 cells, more than 1e\+10; use a larger dx"):
+        run(square(points), method="lattice")

@@ -13,14 +13,21 @@ CellGrid make_cell_grid(const double* const x[3], std::size_t n, double cutoff) 
   // Bins of edge ≥ cut-off, so every partner lies in the 27 bins around a node.
   grid.edge = cutoff;
   const double max_bins = 2.0 * static_cast<double>(n) + 1000.0;
+  // The counts in double first: a node far from the others (a 1e300 coordinate) must make the bins
+  // larger, not overflow the integer count (issue 17, item 9). An extent beyond what a double can
+  // hold is refused by the node-file reader, so `total` is finite here.
   for (;;) {
     double total = 1.0;
+    double count[3];
     for (int d = 0; d < 3; ++d) {
-      grid.count[d] = static_cast<std::int64_t>(std::floor((hi[d] - grid.lo[d]) / grid.edge)) + 1;
-      total *= static_cast<double>(grid.count[d]);
+      count[d] = std::floor((hi[d] - grid.lo[d]) / grid.edge) + 1.0;
+      total *= count[d];
     }
-    if (total <= max_bins) break;
-    grid.edge *= 1.5;
+    if (total <= max_bins) {
+      for (int d = 0; d < 3; ++d) grid.count[d] = static_cast<std::int64_t>(count[d]);
+      break;
+    }
+    grid.edge *= 1.5;  // the factor the bond lists of existing runs were built with
   }
   const std::int64_t bins = grid.count[0] * grid.count[1] * grid.count[2];
   std::vector<std::int64_t> node_bin(n);

@@ -1,6 +1,8 @@
 // case.json → pd::Case, with every key and value checked against pipeline/formats.md §3.
 #include "io/case_reader.hpp"
 
+#include "io/read_file.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -598,11 +600,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
 }
 
 Case read_case(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_case(text.str(), path);
+  return parse_case(read_whole_file(path, "the case file"), path);
 }
 
 }  // namespace pd

@@ -1,6 +1,8 @@
 // Writer and reader of checkpoint.bin (io/checkpoint.hpp, pipeline/formats.md §5).
 #include "io/checkpoint.hpp"
 
+#include "io/read_file.hpp"
+
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -120,9 +122,7 @@ void fields(IO& io, Checkpoint& c) {
 }  // namespace
 
 std::uint64_t file_hash(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = read_whole_file(path, "an input file");
   return fnv1a(bytes.data(), bytes.size());
 }
 
@@ -143,10 +143,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
 }
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open the checkpoint for reading");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_checkpoint(bytes, path.string());
+  return parse_checkpoint(read_whole_file(path, "the checkpoint"), path.string());
 }
 
 Checkpoint parse_checkpoint(const std::string& bytes, const std::string& file) {

@@ -2,6 +2,7 @@
 #include "io/node_file.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <regex>
 #include <string>
 
@@ -25,6 +26,14 @@ const VtuArray& require(const VtuGrid& g, const std::vector<VtuArray>& section, 
 }  // namespace
 
 namespace {
+
+constexpr double kMaxCoordinate = 1e150;  // m: its square, 1e300, is still a finite double
+
+std::string format_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
 
 Nodes nodes_of(const VtuGrid& g, const std::string& file) {
   Nodes nodes;
@@ -56,6 +65,11 @@ Nodes nodes_of(const VtuGrid& g, const std::string& file) {
       const double value = xyz[3 * i + d];
       if (!std::isfinite(value))
         throw Error(file + ": point " + std::to_string(i) + " has a non-finite coordinate");
+      // Beyond this a squared distance overflows to infinity (issue 17, item 9: a 1e300 coordinate
+      // ended in "internal error … max_size()"). Coordinates are metres: no case comes near.
+      if (std::fabs(value) > kMaxCoordinate)
+        throw Error(file + ": point " + std::to_string(i) + " has coordinate " + "xyz"[d] + " = " + format_number(value) +
+                    " m, beyond ±" + format_number(kMaxCoordinate) + " m (coordinates are in metres); fix the mesh");
       if (nodes.dimension == 2 && d == 2 && value != 0.0)
         throw Error(file + ": point " + std::to_string(i) + " has z = " + std::to_string(value) +
                     " but the file is 2D (z must be 0)");

@@ -155,6 +155,10 @@ OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<s
       frames_.emplace_back(resume->frame_times[k], frame_file(k));
     }
   }
+  // frames.pvd first, listing only the frames kept (none in a fresh run), then the other frames go:
+  // a run killed between the two (kill -9) leaves a .pvd that lists no deleted frame (issue 17,
+  // item 5). Before, a fresh run rewrote it only with its first frame.
+  write_pvd();
   // Frames of an earlier, longer run (or written after the checkpoint) would otherwise sit next to
   // the new ones.
   static const std::regex frame_name("frame_([0-9]{6})\\.vtu(\\.part)?");
@@ -171,7 +175,6 @@ OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<s
         ::lseek(history_fd_, 0, SEEK_END) < 0)
       throw Error(history.string() + ": cannot cut back to the checkpoint: " + std::strerror(errno));
     history_bytes_ = resume->history_bytes;
-    write_pvd();
   } else {
     history_fd_ = ::open(history.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (history_fd_ < 0) throw Error(history.string() + ": cannot open for writing: " + std::strerror(errno));
@@ -206,6 +209,21 @@ void OutputWriter::frame(const Model& model, const State& state, double time, st
   frames_.emplace_back(time, name);
   write_pvd();
   flush_history();
+}
+
+int OutputWriter::drop_frames_after(double time) {
+  std::vector<std::string> dropped;
+  while (!frames_.empty() && frames_.back().first > time) {
+    dropped.push_back(frames_.back().second);
+    frames_.pop_back();
+  }
+  if (dropped.empty()) return 0;
+  write_pvd();  // first: the .pvd never lists a removed frame
+  for (const auto& file : dropped) {
+    std::error_code ignored;
+    std::filesystem::remove(dir_ / file, ignored);
+  }
+  return static_cast<int>(dropped.size());
 }
 
 std::vector<double> OutputWriter::frame_times() const {
@@ -271,7 +289,20 @@ void OutputWriter::flush_history() {
   while (done < history_buffer_.size()) {
     const ssize_t w = ::write(history_fd_, history_buffer_.data() + done, history_buffer_.size() - done);
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) throw Error(file + ": write failed (disk full?): " + std::strerror(errno));
+    if (w <= 0) {
+      // A write cut short (a full disk) is cut back to the rows on disk before it, so history.csv
+      // always ends with a whole row; the rows not written are dropped, not retried at exit.
+      const int error_number = w == 0 ? ENOSPC : errno;
+      const std::size_t lost = history_buffer_.size();
+      history_buffer_.clear();
+      if (::ftruncate(history_fd_, static_cast<off_t>(history_bytes_)) != 0 ||
+          ::lseek(history_fd_, 0, SEEK_END) < 0) {
+        ::close(history_fd_);
+        history_fd_ = -1;
+        throw Error(file + ": write failed and cannot cut back to whole rows: " + std::strerror(errno));
+      }
+      throw_write_error(file, "write failed", error_number, lost);
+    }
     done += static_cast<std::size_t>(w);
   }
   history_bytes_ += history_buffer_.size();
@@ -283,9 +314,9 @@ void OutputWriter::finish() {
   if (finished_) return;
   finished_ = true;
   flush_history();
-  if (history_fd_ >= 0 && ::close(history_fd_) != 0)
-    throw Error((dir_ / "history.csv").string() + ": write failed (disk full?): " + std::strerror(errno));
+  const int fd = history_fd_;
   history_fd_ = -1;
+  if (fd >= 0 && ::close(fd) != 0) throw_write_error(dir_ / "history.csv", "write failed", errno, 0);
 }
 
 RunLog::RunLog(std::filesystem::path path, bool quiet, bool append) : path_(std::move(path)), quiet_(quiet) {

@@ -76,6 +76,9 @@ class OutputWriter {
   void flush_history();
   // Flushes and closes history.csv; called at the end (also after a failure or an interruption).
   void finish();
+  // Removes the frames later than `time` from frames.pvd (rewritten first) and from disk: those
+  // written while a run was blowing up (run/loop.cpp). Returns how many were removed.
+  int drop_frames_after(double time);
   int frames_written() const { return static_cast<int>(frames_.size()); }
   std::vector<double> frame_times() const;
   std::uint64_t history_bytes() const { return history_bytes_; }  // on disk, after flush_history()

@@ -2,6 +2,8 @@
 // vtkZLibDataCompressor blocks (io/vtk_zlib.hpp).
 #include "io/vtu.hpp"
 
+#include "io/read_file.hpp"
+
 #include <cctype>
 #include <fstream>
 #include <map>
@@ -210,10 +212,7 @@ struct PendingArray {
 
 VtuGrid read_vtu(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(file + ": cannot open for reading");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_vtu(text, file);
+  return parse_vtu(read_whole_file(path, "the VTK file"), file);
 }
 
 VtuGrid parse_vtu(const std::string& text, const std::string& file) {

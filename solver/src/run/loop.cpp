@@ -136,9 +136,11 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     columns.fill(r, HistoryInputs{st, loop.t, loop.broken_energy});
     out->history(r);
   };
+  std::vector<std::pair<std::int64_t, double>> frames_here;  // (step, t) of the frames this process wrote
   const auto frame = [&](double dt_taken) {
     const State& st = output_state();
     if (out) out->frame(model, st, loop.t, loop.step);
+    frames_here.emplace_back(loop.step, loop.t);
     history_row(dt_taken, &st);
     schedule.frame_written(loop);
   };
@@ -155,6 +157,22 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
     write_checkpoint(checkpoint_file, checkpoint_of(p, s, saved, *out));
+  };
+  // A blow-up found after a streak of energy growth: the frames written during the streak show the
+  // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,
+  // item 12). They go, so the last frame kept is the last before the growth began at `first_step`.
+  const auto drop_frames_from = [&](std::int64_t first_step) {
+    double keep_until = -1.0;
+    bool suspect = false;
+    for (const auto& [step, t] : frames_here) {
+      if (step < first_step) keep_until = t;
+      else suspect = true;
+    }
+    if (!out || !suspect || keep_until < 0.0) return;
+    if (const int dropped = out->drop_frames_after(keep_until); dropped > 0)
+      log.line("removed " + std::to_string(dropped) + " frame(s) written from step " + std::to_string(first_step) +
+               " on, while the energy grew ×" + format("%g", BlowUpWatch::kGrowthPerStep) +
+               " a step; the last frame kept, at t = " + format("%.6g", keep_until) + " s, is the last before the growth");
   };
   const auto likely_cause = [&](double h) {
     return BlowUpWatch::likely_cause(h, p.exact_limit(), p.dt_stable, integrator.explicit_step());
@@ -193,6 +211,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       if (out)
         log.error(BlowUpWatch::non_finite_message(node_text(model, bad), loop.step, loop.t,
                                                   node_text(model, fastest_node(*whole)), likely_cause(h)));
+      if (loop.growth.streak > 0) drop_frames_from(loop.step - loop.growth.streak);
       end.status = kRunFailed;
       end.state_valid = false;
       break;
@@ -203,6 +222,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       const State& st = output_state();
       if (out)
         log.error(blow_up.growth_message(energy, loop.step, loop.t, node_text(model, fastest_node(st)), likely_cause(h)));
+      drop_frames_from(loop.step - loop.growth.streak + 1);
       end.status = kRunFailed;
       end.state_valid = false;
       break;

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/stability.hpp"
@@ -34,6 +36,25 @@ void check_materials(const Prepared& p) {
                   " and critical stretch s0 = " + format("%.6g", k.critical_stretch) +
                   " (need finite c > 0 and s0 > 0): check density, youngs_modulus, fracture_energy, horizon and thickness");
   }
+}
+
+// A step above eq. 2.5 (a fixed dt, or safety_factor > 1) is judged at set-up against the exact
+// linear limit 2/ω_max (core/stability, Lanczos), computed only then: above it the run will blow up,
+// which before was found only thousands of steps later (issue 17, item 12). dt: exact with a
+// safety factor ≤ 1 is below that limit by construction.
+std::vector<std::string> step_warnings(Prepared& p) {
+  const Case& c = p.c;
+  if (!(p.dt > p.dt_stable) || (c.time.dt_rule == "exact" && c.time.safety_factor <= 1.0)) return {};
+  const std::string what = c.time.dt_rule == "fixed" ? "the fixed dt " + format("%.6g", p.dt) + " s"
+                                                      : "dt " + format("%.6g", p.dt) + " s (safety factor " +
+                                                            format("%g", c.time.safety_factor) + ")";
+  const double exact = p.exact_limit();
+  if (std::isfinite(exact) && p.dt > exact)
+    return {"warning: " + what + " is " + format("%.4g", p.dt / exact) + " × the exact stability limit 2/ω_max = " +
+            format("%.6g", exact) + " s: the run will blow up; use time.safety_factor ≤ 1 (time.dt: stable or exact)"};
+  return {"warning: " + what + " exceeds the stable time step of thesis eq. 2.5 (" + format("%.6g", p.dt_stable) +
+          " s) but not the exact limit 2/ω_max = " + format("%.6g", exact) +
+          " s: stable while the bonds stay linear; the run may blow up once they break or contact acts"};
 }
 
 // The time-step policy: time.dt "stable" is eq. 2.5 × safety_factor, "exact" the linear limit
@@ -137,6 +158,8 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
     const double dt_exact = p->exact_limit();
     if (dt_exact > 0.0 && std::isfinite(dt_exact)) p->omega2_exact = 4.0 / (dt_exact * dt_exact);
   }
+  // After configure(): the integrator sees the same dt_exact as before this check existed.
+  if (p->integrator->explicit_step() && !p->integrator->controls_step()) p->step_warnings = step_warnings(*p);
   return p;
 }
 
@@ -170,8 +193,7 @@ void log_setup(RunLog& log, const Prepared& p) {
     log.line("warning: " + std::to_string(isolated) + " of " + std::to_string(n) +
              " nodes have no bond within the horizon (isolated: only loads and contact act on them); the first is " +
              node_text(model, first));
-  if (c.time.dt_rule == "fixed" && p.dt > p.dt_stable)
-    log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
+  for (const auto& text : p.step_warnings) log.line(text);
   for (const auto& text : work_summary(*p.op, c)) log.line(text);
   if (p.decomposed) {
     const Decomposed& d = *p.decomposed;

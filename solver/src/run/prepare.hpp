@@ -2,6 +2,8 @@
 // construct the integrator; and the run.log lines that say what was prepared. Every input error is
 // thrown here or in the start phase, before any output file exists.
 #pragma once
+#include <string>
+#include <vector>
 #include <cstdint>
 #include <memory>
 
@@ -40,6 +42,7 @@ struct Prepared {
   // body from the exact limit when the step is above eq. 2.5, else 0 (eq. 2.5 alone).
   bool indenter_watch = false;
   double omega2_exact = 0.0;
+  std::vector<std::string> step_warnings;  // a step above eq. 2.5 judged against the exact limit, for run.log
 
   // The exact stability limit, computed on first use (Lanczos, about as costly as tens of force
   // evaluations): for time.dt "exact", an indenter watch above eq. 2.5, or a failed run's message.

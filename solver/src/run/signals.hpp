@@ -5,11 +5,17 @@
 
 namespace pd {
 
+// Signals that arrive within this many seconds of the first are the same request to stop: a
+// SIGTERM to a process group (timeout(1), CI runners, SLURM, systemd) reaches the solver both
+// directly and forwarded by make, and the second copy must not kill the run while it writes its
+// checkpoint (issue 17, item 4). A signal after the window means "stop now": it kills at once.
+inline constexpr double kSameRequestSeconds = 2.0;
+
 // Installs the handlers for its lifetime and restores the caller's on destruction. A signal the
 // caller ignores (SIGINT of a background job of a script, nohup) stays ignored.
 class SignalGuard {
  public:
-  SignalGuard();
+  explicit SignalGuard(double same_request_seconds = kSameRequestSeconds);
   ~SignalGuard();
   SignalGuard(const SignalGuard&) = delete;
   SignalGuard& operator=(const SignalGuard&) = delete;

@@ -13,6 +13,9 @@ namespace {
 // Every refusal of a checkpoint says how to start over instead (the Makefile resumes whenever
 // checkpoint.bin is newer than the case, so a refused one would otherwise block every `make`).
 Error start_over(const RunOptions& opt, const std::exception& e) {
+  // Deleting is the advice for a damaged or foreign checkpoint file, not for a directory or a
+  // device given by mistake (io/read_file.cpp says what to give instead).
+  if (!std::filesystem::is_regular_file(opt.restart)) return Error(e.what());
   return Error(std::string(e.what()) + "; to start the run over instead, delete " + opt.restart.string());
 }
 

@@ -1,0 +1,52 @@
+"""One make per case output folder (issue 17, item 8): a second `make case=X` while the first runs
+fails at once, saying who holds out/X/, instead of solving into the same files (before the lock one
+drew 35 frames of the other's run in progress, another read '\\0\\0\\0' from history.csv)."""
+import os
+import signal
+import subprocess
+
+import pytest
+
+from e2e_support import new_case_folder  # noqa: E402
+from make_tree import make, make_tree, start_make, wait_for_steps
+
+NAME = "lockcase"
+
+
+@pytest.fixture(scope="module")
+def tree(tmp_path_factory):
+    work, _ = new_case_folder(tmp_path_factory, "lock", "unused")
+    return make_tree(work, NAME)
+
+
+def test_a_second_make_of_the_same_case_fails_at_once_naming_the_first(tree):
+    out = tree / "out" / NAME
+    first = start_make(tree, NAME, f"out/{NAME}/.solved")
+    try:
+        wait_for_steps(out, first)
+        history_before = (out / "history.csv").stat().st_ino
+        second = start_make(tree, NAME, f"out/{NAME}/.solved")
+        try:
+            _, err = second.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(second.pid, signal.SIGKILL)
+            raise AssertionError("the second make ran instead of stopping at the lock")
+        assert second.returncode != 0
+        assert f"error: out/{NAME}/ is in use by another make (pid " in err, err
+        assert f"make out/{NAME}/.solved case={NAME} config={NAME}, since " in err
+        assert "give LOCK_WAIT=<seconds> to wait" in err
+        assert first.poll() is None                                     # the first goes on
+        assert (out / "history.csv").stat().st_ino == history_before     # its files untouched
+        # Other goals of other folders, and the unlocked ones, still run: `check` reads only.
+        assert make(tree, NAME, "check").returncode == 0
+    finally:
+        os.killpg(first.pid, signal.SIGTERM)
+        first.communicate(timeout=120)
+    assert (out / "checkpoint.bin").exists()
+
+
+def test_the_lock_is_free_again_when_make_ends(tree):
+    out = tree / "out" / NAME
+    result = make(tree, NAME, f"out/{NAME}/mesh-parameters.json")
+    assert result.returncode == 0, result.stderr
+    assert (out / ".lock").exists()

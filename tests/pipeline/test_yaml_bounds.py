@@ -1,0 +1,142 @@
+"""The case-file loader is safe and bounded (issue 17, item 3): hostile or mistaken files end in one
+clean error naming the file and line, quickly, never a Python traceback or a hang.
+
+Each file goes through the real entry point, `python3 -m pipeline.run check` (what `make check` and
+every stage run), under a time limit: before the bounded loader, the alias bomb ran for minutes and
+the others ended in tracebacks.
+"""
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+
+from pipeline.case import CaseError, load_case
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+MINIMAL = """\
+dimension: 2
+thickness: 0.001
+discretization:
+  dx: 0.001
+materials:
+  plate:
+    density: 2000
+    youngs_modulus: 1.0e9
+time:
+  end: 1.0e-3
+"""
+
+
+def check(path, timeout=30):
+    """Run `pipeline.run check` on the file; return (exit code, stderr, seconds)."""
+    start = time.monotonic()
+    result = subprocess.run([sys.executable, "-m", "pipeline.run", "check", str(path)], cwd=ROOT,
+                            capture_output=True, text=True, timeout=timeout)
+    return result.returncode, result.stderr, time.monotonic() - start
+
+
+def billion_laughs(levels=10):
+    lines = ['a0: &a0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
+    for i in range(1, levels):
+        lines.append(f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]")
+    return "\n".join(lines) + "\n"
+
+
+HOSTILE = {
+    # name: (file content, expected text in the error, expected line)
+    "python_tag": (MINIMAL + "damping: !!python/object:builtins.float 1.0\n",
+                   "the tag 'tag:yaml.org,2002:python/object:builtins.float' is not allowed", 11),
+    "custom_tag": (MINIMAL + "damping: !foo 1.0\n", "the tag '!foo' is not allowed", 11),
+    "tagged_section": (MINIMAL.replace("time:", "time: !!map"), "the tag 'tag:yaml.org,2002:map'", 9),
+    "merge_key": (MINIMAL + "base: &b {end: 1.0}\nother:\n  <<: *b\n", "merge keys ('<<') are not supported", 13),
+    "recursive_anchor": (MINIMAL + "title: &x [1, *x]\n", "a value that contains it (a cycle)", 11),
+    "billion_laughs": (billion_laughs(), "more than 100000 values once aliases (*name) are expanded", None),
+    "deep_brackets": ("title: " + "[" * 50_000 + "]" * 50_000 + "\n", "nested more than 64 levels deep", 1),
+    "sexagesimal": (MINIMAL + "damping: 5:00\n", "'5:00' is a base-60 number in YAML 1.1", 11),
+    "octal_11": (MINIMAL + "damping: 012\n", "'012' starts with 0", 11),
+    "underscore": (MINIMAL + "damping: 1_000\n",
+                   "damping: expected a number [1/s], got '1_000' (YAML 1.2 reads this as text", 11),
+    "long_line_title": (MINIMAL + "title: " + "x" * 300 + "\n",
+                        "title: expected one line of at most 200 characters, got 300 characters", 11),
+    "long_value": (MINIMAL + "title: " + "x" * 20_000 + "\n", "a value of 20000 characters", 11),
+    "two_documents": (MINIMAL + "---\n" + MINIMAL, "not valid YAML: expected a single document in the stream, but found another document", 11),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HOSTILE))
+def test_hostile_yaml_is_one_clean_error_with_the_line(tmp_path, name):
+    text, expected, line = HOSTILE[name]
+    path = tmp_path / "plate.yaml"
+    path.write_text(text)
+    code, err, seconds = check(path)
+    assert "Traceback" not in err, err[-2000:]
+    assert code == 2, err[-2000:]
+    assert err.startswith(f"error: {path}:{line or ''}"), err[:400]
+    assert expected in err, err[:400]
+    assert seconds < 20
+
+
+def test_binary_file_is_refused(tmp_path):
+    path = tmp_path / "plate.yaml"
+    path.write_bytes(b"dimension: 2\n" + bytes(range(256)) * 4)
+    code, err, _ = check(path)
+    assert code == 2 and "Traceback" not in err
+    assert f"error: {path}:2: a NUL byte: this is a binary file, not a case file" in err
+
+
+def test_latin1_file_is_refused_with_the_line(tmp_path):
+    path = tmp_path / "plate.yaml"
+    path.write_bytes(MINIMAL.encode() + "title: Pr\u00fcfk\u00f6rper\n".encode("latin-1"))
+    with pytest.raises(CaseError, match=r"plate\.yaml:11: not UTF-8 text \(byte 0xfc\)"):
+        load_case(str(path))
+
+
+def test_two_megabyte_title_is_refused_before_parsing(tmp_path):
+    path = tmp_path / "plate.yaml"
+    path.write_text(MINIMAL + "title: " + "x" * (2 << 20) + "\n")
+    code, err, _ = check(path)
+    assert code == 2 and "Traceback" not in err
+    assert f"error: {path}: larger than 1024 kB" in err
+
+
+@pytest.mark.parametrize("target", ["directory", "/dev/zero"])
+def test_a_directory_or_device_is_not_a_case_file(tmp_path, target):
+    path = str(tmp_path) if target == "directory" else target
+    with pytest.raises(CaseError) as info:
+        load_case(path)
+    assert str(info.value).startswith(f"{path}: ")
+    assert ("not a regular file" in str(info.value)) or ("cannot read" in str(info.value))
+
+
+def test_yaml_12_core_schema(tmp_path):
+    """`yes`, `on` and dates are text in YAML 1.2; 1e-3, 0x10, 0o17 and .inf are numbers."""
+    from pipeline.yaml_lines import load_with_lines
+    path = tmp_path / "values.yaml"
+    path.write_text("a: yes\nb: on\nc: 2001-12-14\nd: 1e-3\ne: 0x10\nf: 0o17\ng: -.inf\nh: ~\n"
+                    "i: TRUE\nj: '5:00'\nk: 12\n")
+    data, lines = load_with_lines(str(path))
+    assert data == {"a": "yes", "b": "on", "c": "2001-12-14", "d": 1e-3, "e": 16, "f": 15,
+                    "g": float("-inf"), "h": None, "i": True, "j": "5:00", "k": 12}
+    assert isinstance(data["d"], float) and isinstance(data["k"], int)
+    assert lines[("g",)] == 7
+
+
+def test_anchors_and_aliases_of_whole_values_still_work(tmp_path):
+    path = tmp_path / "plate.yaml"
+    path.write_text(MINIMAL.replace("    youngs_modulus: 1.0e9\n",
+                                    "    youngs_modulus: 1.0e9\n  ring: *steel\n")
+                    .replace("  plate:\n", "  plate: &steel\n"))
+    case = load_case(str(path))
+    assert case["materials"]["ring"] == case["materials"]["plate"]
+    assert case["materials"]["ring"]["youngs_modulus"] == 1.0e9
+
+
+def test_a_control_character_names_its_line(tmp_path):
+    """Found by pipeline/fuzz_case.py: PyYAML's reader refuses control characters in its constructor."""
+    path = tmp_path / "plate.yaml"
+    path.write_text(MINIMAL.replace("time:", "ti\x0bme:"))
+    with pytest.raises(CaseError, match=r"plate\.yaml:9: character #x000b is not allowed in YAML text"):
+        load_case(str(path))
