@@ -19,7 +19,7 @@ from bench import tension  # noqa: E402
 
 SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
 LINE = re.compile(r"^speedup tension: mixed ([0-9.]+) s against explicit ([0-9.]+) s \((verlet-alpha[0-9.e+]+), "
-                  r"([0-9.e+-]+) m/s\): ([0-9.]+)x, peak force ([0-9.e+-]+)$")
+                  r"([0-9.e+-]+) m/s\): ([0-9.e+]+)x, peak force ([0-9.e+-]+)$")
 
 
 def test_peak_is_the_largest_force_before_the_strip_breaks():
@@ -45,11 +45,11 @@ def test_speedup_line_takes_the_cheapest_explicit_run_as_accurate_as_asked():
     rows = [row("verlet-alpha0", 0.8, 0.1, 0.05),                    # cheaper, 5 % off: not as accurate
             row("verlet-alpha0", 0.4, 0.2, 0.01, same_crack=False),  # crack elsewhere
             row("verlet-alpha1.7e+04", 0.4, 0.3, 0.015),             # the one
-            row("verlet-alpha0", 0.2, 0.6, 0.0),
+            row("verlet-alpha1.75e+04", 0.2, 0.6, 0.0),
             row("quasi_static", 0.2, 0.01, 0.0),
             row("mixed", 0.2, 0.05, 0.004)]
     assert tension.speedup_line(rows, "tension") == ("speedup tension: mixed 0.050 s against explicit 0.300 s "
-                                                     "(verlet-alpha1.7e+04, 0.4 m/s): 6.00x, peak force 4.00e-03")
+                                                     "(verlet-alpha1.7e+04, 0.4 m/s): 6x, peak force 4.00e-03")
 
 
 @pytest.fixture(scope="module")
@@ -70,8 +70,7 @@ def test_quick_tension_ends_with_a_speedup_line_the_rows_bear_out(quick_run):
     lines, rows = quick_run
     assert {r["problem"] for r in rows} == {"tension"}
     schemes = {r["scheme"] for r in rows}
-    assert {"verlet-alpha0", "quasi_static", "mixed"} <= schemes
-    assert any(s.startswith("verlet-alpha") and s != "verlet-alpha0" for s in schemes)  # a damped row
+    assert {"verlet-alpha0", "verlet-alpha17500", "quasi_static", "mixed"} <= schemes  # undamped, ζ = 0.1
     assert sum(r["reference"] == "True" for r in rows) == 1
     found = LINE.match(lines[-1])
     assert found, lines[-1]
@@ -85,10 +84,10 @@ def test_quick_tension_ends_with_a_speedup_line_the_rows_bear_out(quick_run):
     cheapest = min(accurate, key=lambda r: float(r["wall_time"]))
     assert (cheapest["scheme"], float(cheapest["parameter"])) == (scheme, pytest.approx(float(speed), rel=1e-6))
     assert float(explicit_s) == pytest.approx(float(cheapest["wall_time"]), abs=5e-4)
-    assert float(ratio) == pytest.approx(float(cheapest["wall_time"]) / float(mixed["wall_time"]), rel=1e-2)
+    assert float(ratio) == pytest.approx(float(cheapest["wall_time"]) / float(mixed["wall_time"]), rel=6e-3)
     # The reference is an explicit run in the list, exact against itself.
     reference = next(r for r in rows if r["reference"] == "True")
-    assert reference["scheme"] == "verlet-alpha0" and float(reference["peak_error"]) == 0.0
+    assert reference["scheme"] == "verlet-alpha17500" and float(reference["peak_error"]) == 0.0
     # Every row's cost in force-evaluation equivalents is at least its force evaluations.
     for r in rows:
         if r["status"] == "ok":
