@@ -90,6 +90,16 @@ TEST(Mixed, QuasiStaticUntilTheBarSnapsThenExplicit) {
   for (std::size_t d = 0; d < 3; ++d)
     for (double u : run.state.u[d]) ASSERT_TRUE(std::isfinite(u));
   EXPECT_DOUBLE_EQ(run.mixed.explicit_dt(), run.op.stable_time_step() * 0.8);
+  // run.log's done: line gets the linear algebra's work (a benchmark weighs it against force
+  // evaluations); Verlet has none, and its done: line stays as it was.
+  const std::string summary = run.mixed.linear_algebra_summary();
+  const std::string head = std::to_string(run.mixed.factorisations_in_use()) + " factorisations in ";
+  EXPECT_EQ(summary.rfind(head, 0), 0u) << summary;
+  EXPECT_NE(summary.find(" s, "), std::string::npos) << summary;
+  EXPECT_NE(summary.find(" solves in "), std::string::npos) << summary;
+  EXPECT_GT(run.mixed.factorisations_in_use(), 0);
+  pd::VelocityVerlet verlet(run.op);
+  EXPECT_EQ(verlet.linear_algebra_summary(), "");
 }
 
 TEST(Mixed, SavedAndRestoredMidRunContinuesBitwiseInBothModes) {
