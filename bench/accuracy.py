@@ -12,10 +12,18 @@ of the difference of the final damage fields. Cost: the solver's own time-loop w
 shorter than 2 s (validation.md §4: the minimum of repeated runs), and the force evaluations
 (rejected adaptive attempts included), which do not depend on the machine.
 
+A third problem, quasi-static tension with fracture (bench/tension.py, issue 13): a notched strip
+pulled by its grips, Verlet at several grip speeds and damping values, quasi_static and mixed,
+against the explicit run whose loading rate has converged (found here by halving the speed); the
+error is that of the peak force, the csv rows add the displacement at the peak, the curve up to it,
+the crack's position and the cost in force-evaluation equivalents. The output ends with one
+`speedup <problem>: ...` line per problem that has a mixed row.
+
 Writes out/bench/accuracy.csv (a row per run) and out/bench/accuracy.png (log-log error against
 wall time and against force evaluations).
 
     /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 1] [--repeat 3] [--quick]
+                                       [--problems wave,fracture,tension]
 """
 from __future__ import annotations
 
@@ -222,7 +230,7 @@ def tension_runs(args, repeat: int, rows: list[dict]) -> None:
     # The reference: Verlet with light damping (ζ = 0.1 of critical in the strip's first axial mode),
     # the speed halved until the peak changes by < 0.5 %. Undamped runs do not settle so: every bond
     # that breaks at the notch before the peak sends out waves that never die down, and the peak
-    # wandered by about 1 % per halving down to 0.006 m/s (measured; docs/accuracy.md).
+    # moved by 1-2.4 % per halving down to 0.006 m/s (measured; docs/accuracy.md).
     reference_alpha = float(f"{2.0 * tension.REFERENCE_ZETA * tension.OMEGA_1:.3g}")
     family, dt = [], None
     speed = first_speed
