@@ -12,7 +12,7 @@
 #                             fuzzer (pipeline/fuzz_case.py) and pdsolve's command line
 #                             (pipeline/fuzz_cli.py), FUZZ_SECONDS (60) each (clang)
 #   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
-#   make bench-accuracy       error against run time, Verlet vs adaptive → out/bench/accuracy.csv (docs/accuracy.md)
+#   make bench-accuracy       error against run time: Verlet, adaptive, quasi_static, mixed → out/bench/accuracy.csv (docs/accuracy.md)
 #   make bench-implicit       implicit dynamics vs Verlet on a drum lattice → out/bench/implicit.csv
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
@@ -219,7 +219,9 @@ bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
 
 # Error against run time and force evaluations (issue 3): Verlet at several safety factors and at the
 # exact limit, the adaptive step over a sweep of TOL, on a wave and on a fracture problem, against a
-# Verlet run at 1/16 of the step; ACCURACY_ARGS=--quick for a smoke run (docs/accuracy.md).
+# Verlet run at 1/16 of the step; and (issue 13) quasi-static tension with fracture: Verlet at
+# several loading rates and damping values, quasi_static and mixed, against the rate-converged
+# Verlet run, ending with a speedup line; ACCURACY_ARGS=--quick for a smoke run (docs/accuracy.md).
 ACCURACY_ARGS ?=
 bench-accuracy: $(SOLVER) | $(DEPS)
 	$(PY) -m bench.accuracy --solver $(SOLVER) --out out/bench $(ACCURACY_ARGS)

@@ -12,10 +12,18 @@ of the difference of the final damage fields. Cost: the solver's own time-loop w
 shorter than 2 s (validation.md §4: the minimum of repeated runs), and the force evaluations
 (rejected adaptive attempts included), which do not depend on the machine.
 
+A third problem, quasi-static tension with fracture (bench/tension.py, issue 13): a notched strip
+pulled by its grips, Verlet at several grip speeds and damping values, quasi_static and mixed,
+against the explicit run whose loading rate has converged (found here by halving the speed); the
+error is that of the peak force, the csv rows add the displacement at the peak, the curve up to it,
+the crack's position and the cost in force-evaluation equivalents. The output ends with one
+`speedup <problem>: ...` line per problem that has a mixed row.
+
 Writes out/bench/accuracy.csv (a row per run) and out/bench/accuracy.png (log-log error against
 wall time and against force evaluations).
 
     /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 1] [--repeat 3] [--quick]
+                                       [--problems wave,fracture,tension]
 """
 from __future__ import annotations
 
@@ -36,6 +44,7 @@ sys.path.insert(0, ROOT)
 from postprocess.series import read_frame, read_series  # noqa: E402
 from preprocess.cloud import NodeCloud  # noqa: E402
 from preprocess.node_file import write_node_file  # noqa: E402
+from bench import tension  # noqa: E402
 
 DX = 1.0e-3
 
@@ -93,18 +102,27 @@ def hole_problem(directory: str) -> dict:
     }
 
 
-def write_case(directory: str, problem: dict, name: str, time: dict, adaptive: dict | None) -> str:
+def write_case(directory: str, problem: dict, name: str, time: dict, adaptive: dict | None,
+               sections: dict | None = None, history_every: int = 1_000_000) -> str:
+    """case.json of one run in directory/name/. `sections`: further case sections as they are
+    (quasi_static, mixed); the problem's cracks, damping and reactions go in when it has them."""
     run_dir = os.path.join(directory, name)
     os.makedirs(run_dir, exist_ok=True)
     case = {key: problem[key] for key in ("dimension", "analysis", "thickness", "grid_spacing", "horizon", "blocks",
                                           "node_sets", "boundary_conditions")}
     case.update({"format_version": 1, "case": name, "nodes_file": "../nodes.vtu", "output_dir": ".",
-                 "no_fail_sets": problem.get("no_fail_sets", []), "initial_conditions": [], "damping": 0.0,
+                 "no_fail_sets": problem.get("no_fail_sets", []), "initial_conditions": [],
+                 "damping": problem.get("damping", 0.0),
                  "time": dict(time, end=problem["end"], max_steps=10_000_000),
                  "output": {"every_time": problem["every_time"], "every_steps": None,
-                            "history_every": 1_000_000}})
+                            "history_every": history_every}})
+    if problem.get("cracks"):
+        case["cracks"] = problem["cracks"]
+    if problem.get("measure") == "tension":
+        case["output"]["reactions"] = ["right"]
     if adaptive:
         case["adaptive"] = adaptive
+    case.update(sections or {})
     path = os.path.join(run_dir, "case.json")
     with open(path, "w", encoding="utf-8") as stream:
         json.dump(case, stream, indent=1)
@@ -188,6 +206,99 @@ def schemes(quick: bool, dt_stable: float):
                     "dt_max": dt_max})
 
 
+def tension_runs(args, repeat: int, rows: list[dict]) -> None:
+    """The quasi-static tension problem (bench/tension.py): the explicit reference found by halving
+    the grip speed, explicit rows at those speeds with and without damping, quasi_static and mixed.
+    Appends a row per run to `rows`."""
+    directory = os.path.join(args.out, "tension")
+    os.makedirs(directory, exist_ok=True)
+    base = tension.problem(directory)
+    first_speed = 0.8 if not args.quick else 0.4
+    halvings = 10 if not args.quick else 1
+
+    def explicit(speed: float, damping: float, history_every: int):
+        p = tension.case(base, speed, damping)
+        name = f"verlet-alpha{damping:g}-v{speed:g}"
+        case_path = write_case(directory, p, name, {"integrator": "verlet", "dt": "stable", "safety_factor": 0.8},
+                               None, history_every=history_every)
+        r = run(args.solver, case_path, args.threads, repeat)
+        return p, os.path.dirname(case_path), r
+
+    def every(speed: float, dt: float) -> int:  # some 4000 history rows a run
+        return max(1, int(tension.end_time(speed) / dt / 4000))
+
+    # The reference: Verlet with light damping (ζ = 0.1 of critical in the strip's first axial mode),
+    # the speed halved until the peak changes by < 0.5 %. Undamped runs do not settle so: every bond
+    # that breaks at the notch before the peak sends out waves that never die down, and the peak
+    # moved by 1-2.4 % per halving down to 0.006 m/s (measured; docs/accuracy.md).
+    reference_alpha = float(f"{2.0 * tension.REFERENCE_ZETA * tension.OMEGA_1:.3g}")
+    family, dt = [], None
+    speed = first_speed
+    for _ in range(halvings + 1):
+        p, run_dir, r = explicit(speed, reference_alpha, every(speed, dt) if dt else 1)
+        if r["status"] != "ok":
+            raise SystemExit(f"tension: the explicit run at {speed:g} m/s failed: {r['status']}")
+        dt = dt or 0.8 * stable_dt(r["log"])
+        m = tension.measures(run_dir, speed, p["end"])
+        family.append((speed, p, run_dir, r, m))
+        print(f"  tension: Verlet, α = {reference_alpha:g} 1/s, at {speed:g} m/s: peak {m['peak_force']:.4g} N at "
+              f"{m['peak_displacement'] * 1e3:.4g} mm, {r['steps']} steps, {r['wall']:.3f} s", flush=True)
+        if len(family) >= 2 and abs(m["peak_force"] - family[-2][4]["peak_force"]) / m["peak_force"] < tension.PEAK_CONVERGED:
+            break
+        speed /= 2.0
+    converged = len(family) >= 2 and abs(family[-1][4]["peak_force"] - family[-2][4]["peak_force"]) \
+        / family[-1][4]["peak_force"] < tension.PEAK_CONVERGED
+    ref_speed, ref_problem, ref_dir, ref_run, reference = family[-1]
+    seconds_per_evaluation = ref_run["wall"] / ref_run["evaluations"]
+    print(f"tension: reference = Verlet, α = {reference_alpha:g} 1/s, at {ref_speed:g} m/s "
+          f"({'converged' if converged else 'NOT converged: the halvings ran out'}); peak {reference['peak_force']:.4g} N "
+          f"at {reference['peak_displacement'] * 1e3:.4g} mm, crack at x = {reference['crack_x'] * 1e3:.3g} mm "
+          f"({'cut through' if reference['cut'] else 'not cut through'}); {seconds_per_evaluation * 1e3:.3f} ms per "
+          f"force evaluation", flush=True)
+
+    def row(scheme: str, parameter: float, r: dict, run_dir: str, speed: float, end: float) -> dict:
+        m = tension.measures(run_dir, speed, end, reference) if r["status"] == "ok" else {}
+        factorisations, factor_s, solves, solve_s = tension.linear_algebra(r["log"])
+        out = {"problem": "tension", "scheme": scheme, "parameter": parameter, "wall_time": r["wall"],
+               "force_evaluations": r["evaluations"], "steps": r["steps"],
+               "mean_dt": end / r["steps"] if r["steps"] else float("nan"),
+               "error": m.get("peak_error", float("nan")), "broken_bonds": r["broken_bonds"], "status": r["status"],
+               "evaluation_equivalents": r["evaluations"] + (factor_s + solve_s) / seconds_per_evaluation,
+               "factorisations": factorisations, "factorisation_time": factor_s, "solves": solves, "solve_time": solve_s,
+               "peak_force": m.get("peak_force", float("nan")),
+               "peak_displacement": m.get("peak_displacement", float("nan")),
+               "curve_error": m.get("curve_error", float("nan")), "crack_x": m.get("crack_x", float("nan")),
+               "cut_through": m.get("cut", False), "same_crack": m.get("same_crack", False),
+               "peak_error": m.get("peak_error", float("nan"))}
+        out["reference"] = run_dir == ref_dir
+        print(f"  {scheme:16s} {parameter:<8g} {r['status'][:6]:6s} steps {r['steps']:7d}  evals {r['evaluations']:7d}  "
+              f"equiv {out['evaluation_equivalents']:9.0f}  wall {r['wall']:7.3f} s  peak {out['peak_force']:.4g} N "
+              f"({out['peak_error']:.2%})  curve {out['curve_error']:.2e}  crack x {out['crack_x'] * 1e3:.3g} mm "
+              f"{'cut' if out['cut_through'] else 'not cut'}", flush=True)
+        return out
+
+    for speed, p, run_dir, r, _ in family:
+        rows.append(row(f"verlet-alpha{reference_alpha:g}", speed, r, run_dir, speed, p["end"]))
+    # The other damping values at the same speeds: none, and ζ = 0.5 of critical (full runs only).
+    for zeta in ((0.0, 0.5) if not args.quick else (0.0,)):
+        alpha = float(f"{2.0 * zeta * tension.OMEGA_1:.3g}")
+        for speed, *_ in family:
+            p, run_dir, r = explicit(speed, alpha, every(speed, dt))
+            rows.append(row(f"verlet-alpha{alpha:g}", speed, r, run_dir, speed, p["end"]))
+    # quasi_static and mixed: load steps of 1/200 of the run (0.55 µm of grip displacement), no
+    # damping, the reference's tables (time is physical for mixed, a load parameter for quasi_static).
+    steps = {"dt_initial": ref_problem["end"] / 200, "dt_max": ref_problem["end"] / 200}
+    for scheme in ("quasi_static", "mixed"):
+        p = tension.case(base, ref_speed, 0.0)
+        sections = {"quasi_static": steps}
+        if scheme == "mixed":
+            sections["mixed"] = {"unstable_rounds": 3, "kinetic_fraction": 0.05, "arrest_steps": 200}
+        case_path = write_case(directory, p, scheme, {"integrator": scheme, "dt": "stable", "safety_factor": 0.8},
+                               None, sections, history_every=1)
+        r = run(args.solver, case_path, args.threads, repeat)
+        rows.append(row(scheme, ref_speed, r, os.path.dirname(case_path), ref_speed, p["end"]))
+
+
 def machine() -> str:
     model = platform.processor() or platform.machine()
     try:
@@ -208,7 +319,14 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="runs of a case shorter than 2 s; the fastest counts")
     parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"), help="where the csv, png and runs go")
     parser.add_argument("--quick", action="store_true", help="fewer runs, no repeats (a smoke test of the benchmark)")
+    parser.add_argument("--problems", default="wave,fracture,tension",
+                        help="comma-separated subset of wave, fracture, tension (default: all three)")
     args = parser.parse_args(argv)
+    chosen = [name.strip() for name in args.problems.split(",") if name.strip()]
+    unknown = sorted(set(chosen) - {"wave", "fracture", "tension"})
+    if unknown or not chosen:
+        parser.error(f"--problems {args.problems}: unknown {', '.join(unknown) or 'empty list'}; "
+                     "choose from wave, fracture, tension")
     if not os.path.isfile(args.solver):
         parser.error(f"{args.solver} is missing: build it with `make solver`")
     repeat = 1 if args.quick else max(1, args.repeat)
@@ -217,6 +335,8 @@ def main(argv=None) -> int:
     print(f"{machine()}; {args.threads} thread(s); load average {load:.2f} at the start", flush=True)
     rows = []
     for problem_name, make in (("wave", strip_problem), ("fracture", hole_problem)):
+        if problem_name not in chosen:
+            continue
         directory = os.path.join(args.out, problem_name)
         os.makedirs(directory, exist_ok=True)
         problem = make(directory)
@@ -244,13 +364,23 @@ def main(argv=None) -> int:
                          "broken_bonds": r["broken_bonds"], "status": r["status"]})
             print(f"  {name:32s} {r['status'][:6]:6s} steps {r['steps']:6d}  evals {r['evaluations']:6d}  "
                   f"wall {r['wall']:7.3f} s  error {e:.3g}", flush=True)
+    if "tension" in chosen:
+        tension_runs(args, repeat, rows)
+    fieldnames = []
+    for r in rows:
+        fieldnames += [key for key in r if key not in fieldnames]
     with open(os.path.join(args.out, "accuracy.csv"), "w", newline="", encoding="utf-8") as stream:
-        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(stream, fieldnames=fieldnames, restval="")
         writer.writeheader()
         writer.writerows(rows)
     plot(rows, os.path.join(args.out, "accuracy.png"), args.threads)
     print(f"wrote {args.out}/accuracy.csv and accuracy.png ({machine()}, {args.threads} thread(s), "
           f"load average {load:.2f} at the start, {os.getloadavg()[0]:.2f} at the end)")
+    # One line per problem with a mixed row: the last lines of the output.
+    for problem_name in ("tension",):
+        line = tension.speedup_line(rows, problem_name)
+        if line:
+            print(line)
     return 0
 
 
@@ -274,7 +404,8 @@ def plot(rows: list[dict], path: str, threads: int):
                     for p in pts:
                         ax.annotate(f"{p[2]:g}", (p[0], p[1]), fontsize=6, xytext=(3, 3), textcoords="offset points")
             ax.set_xlabel(xlabel)
-            ax.set_ylabel("relative L2 error of " + ("displacement" if problem == "wave" else "final damage"))
+            ax.set_ylabel({"wave": "relative L2 error of displacement", "fracture": "relative L2 error of final damage",
+                           "tension": "relative error of the peak force"}[problem])
             ax.set_title(f"{problem}: error against {xlabel.split(' [')[0]}")
             ax.grid(alpha=0.3, which="both")
             ax.legend(fontsize="small")

@@ -44,4 +44,22 @@ pd::Case lattice_case(int dimension, const std::string& analysis, double dx, dou
   return c;
 }
 
+pd::Nodes bar_with_grips(int nx, int ny, int nz, double dx) {
+  pd::Nodes nodes = cubic_lattice(nx, ny, nz, dx, 3);
+  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)}, right{"right", left.member};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    left.member[i] = nodes.x[0][i] < 1.5 * dx;
+    right.member[i] = nodes.x[0][i] > (nx - 2.5) * dx;
+  }
+  nodes.sets = {left, right};
+  return nodes;
+}
+
+void clamp_left_pull_right(pd::Case& c, double pull, double end, bool right_held_across) {
+  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
+  c.boundary_conditions.push_back({"right", "displacement", 0, {0.0, end}, {0.0, pull}});
+  if (right_held_across)
+    for (int d = 1; d < 3; ++d) c.boundary_conditions.push_back({"right", "displacement", d, {0.0}, {0.0}});
+}
+
 }  // namespace pdtest

@@ -14,6 +14,15 @@ pd::Nodes cubic_lattice(int nx, int ny, int nz, double dx, int dimension, double
 pd::Case lattice_case(int dimension, const std::string& analysis, double dx, double horizon, double youngs_modulus,
                       double density, double fracture_energy, double thickness = 1.0);
 
+// The bar of the quasi-static and mixed tests: an nx × ny × nz lattice (3D, spacing dx) with the node
+// sets "left" (the first two layers in x, x < 1.5 dx) and "right" (the last two, x > (nx − 2.5) dx).
+pd::Nodes bar_with_grips(int nx, int ny, int nz, double dx);
+
+// Its usual conditions, appended to c: "left" clamped in x, y and z; "right" displaced along x
+// linearly from 0 at t = 0 to `pull` [m] at t = `end` (a displacement table), and held in y and z as
+// well when `right_held_across`.
+void clamp_left_pull_right(pd::Case& c, double pull, double end, bool right_held_across);
+
 // Index of lattice node (i, j, k).
 inline std::size_t node_index(int i, int j, int k, int nx, int ny) {
   return static_cast<std::size_t>((k * ny + j) * nx + i);

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/error.hpp"
+#include "core/time_step_rule.hpp"
 #include "integrators/mixed.hpp"
 #include "lattice.hpp"
 
@@ -21,16 +23,8 @@ constexpr double kEnd = 1e-3;  // s: the right end is pulled to 4e-3 of the bar'
 // the right two pulled along x at 0.044 m/s.
 pd::Model breakable_bar() {
   pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
-  pd::Nodes nodes = pdtest::cubic_lattice(kNx, kNy, kNz, kDx, 3);
-  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)}, right{"right", left.member};
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    left.member[i] = nodes.x[0][i] < 1.5 * kDx;
-    right.member[i] = nodes.x[0][i] > (kNx - 2.5) * kDx;
-  }
-  nodes.sets = {left, right};
-  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
-  c.boundary_conditions.push_back({"right", "displacement", 0, {0.0, kEnd}, {0.0, 4e-3 * (kNx - 1) * kDx}});
-  for (int d = 1; d < 3; ++d) c.boundary_conditions.push_back({"right", "displacement", d, {0.0}, {0.0}});
+  pd::Nodes nodes = pdtest::bar_with_grips(kNx, kNy, kNz, kDx);
+  pdtest::clamp_left_pull_right(c, 4e-3 * (kNx - 1) * kDx, kEnd, true);
   return pd::build_model(c, std::move(nodes));
 }
 
@@ -96,6 +90,16 @@ TEST(Mixed, QuasiStaticUntilTheBarSnapsThenExplicit) {
   for (std::size_t d = 0; d < 3; ++d)
     for (double u : run.state.u[d]) ASSERT_TRUE(std::isfinite(u));
   EXPECT_DOUBLE_EQ(run.mixed.explicit_dt(), run.op.stable_time_step() * 0.8);
+  // run.log's done: line gets the linear algebra's work (a benchmark weighs it against force
+  // evaluations); Verlet has none, and its done: line stays as it was.
+  const std::string summary = run.mixed.linear_algebra_summary();
+  const std::string head = std::to_string(run.mixed.factorisations_in_use()) + " factorisations in ";
+  EXPECT_EQ(summary.rfind(head, 0), 0u) << summary;
+  EXPECT_NE(summary.find(" s, "), std::string::npos) << summary;
+  EXPECT_NE(summary.find(" solves in "), std::string::npos) << summary;
+  EXPECT_GT(run.mixed.factorisations_in_use(), 0);
+  pd::VelocityVerlet verlet(run.op);
+  EXPECT_EQ(verlet.linear_algebra_summary(), "");
 }
 
 TEST(Mixed, SavedAndRestoredMidRunContinuesBitwiseInBothModes) {
@@ -120,4 +124,71 @@ TEST(Mixed, SavedAndRestoredMidRunContinuesBitwiseInBothModes) {
     }
     EXPECT_EQ(a.model.bonds.broken, b.model.bonds.broken);
   }
+}
+
+TEST(Mixed, AFailedLoadStepLeavesTheForceOfTheLastEquilibrium) {
+  // What the switch to explicit relies on (it evaluates no force): when a quasi-static load step
+  // fails, the state is the last equilibrium's, and once the bonds broken in the attempt are
+  // restored its force and energy density are exactly those a fresh evaluation gives.
+  pd::Model model = breakable_bar();
+  pd::ForceOperator op(model);
+  pd::QuasiStatic qs(op);
+  qs.configure(mixed_case());
+  qs.limit(3, kEnd / 1000);
+  pd::State state(model.nodes.size());
+  double t = 0.0, dt = kEnd / 40;
+  qs.initialize(state, t);
+  bool failed = false;
+  for (int k = 0; k < 200 && !failed && t < kEnd * (1 - 1e-12); ++k) {
+    const std::vector<std::uint8_t> before = model.bonds.broken;
+    double h = std::min(dt, kEnd - t);
+    try {
+      qs.step(state, t, h);
+      dt = qs.last_step().next_dt;
+    } catch (const pd::StepFailed&) {
+      failed = true;
+      ASSERT_FALSE(qs.failure_reason().empty());
+      EXPECT_NE(model.bonds.broken, before);  // the attempt broke bonds: restoring them is a real change
+      model.bonds.broken = before;
+    }
+  }
+  ASSERT_TRUE(failed) << "the bar never snapped";
+  EXPECT_GT(t, 0.0);
+  pd::State fresh = state;
+  op.evaluate(fresh, t);
+  EXPECT_TRUE(same_bits(state.f, fresh.f));
+  EXPECT_EQ(0, std::memcmp(state.w.data(), fresh.w.data(), state.w.size() * sizeof(double)));
+}
+
+TEST(TimeStepRule, StableExactAndFixedAndTheErrorWithoutBonds) {
+  // The one rule run/prepare.cpp and the mixed integrator's explicit phase both apply.
+  pd::Case c = mixed_case();
+  c.file = "rule.json";
+  c.time.safety_factor = 0.5;
+  int lanczos = 0;
+  const auto exact = [&lanczos] { return ++lanczos, 3.0; };
+  c.time.dt_rule = "stable";
+  EXPECT_EQ(pd::explicit_time_step(c, 2.0, exact), 1.0);
+  EXPECT_EQ(lanczos, 0);  // the exact limit is not computed when not asked for
+  c.time.dt_rule = "exact";
+  EXPECT_EQ(pd::explicit_time_step(c, 2.0, exact), 1.5);
+  EXPECT_EQ(lanczos, 1);
+  c.time.dt_rule = "fixed";
+  c.time.dt_value = 0.25;
+  EXPECT_EQ(pd::explicit_time_step(c, 2.0, exact), 0.25);
+  c.time.dt_rule = "stable";
+  try {
+    pd::explicit_time_step(c, HUGE_VAL, exact);
+    FAIL() << "no error";
+  } catch (const pd::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("rule.json: time.dt: \"stable\" needs bonds"), std::string::npos) << e.what();
+  }
+  // The mixed integrator's explicit step with dt: exact is the exact limit × safety factor.
+  BarRun run;
+  pd::Case m = mixed_case();
+  m.time.dt_rule = "exact";
+  m.time.safety_factor = 0.9;
+  pd::Mixed mixed(run.op);
+  mixed.configure(m);
+  EXPECT_EQ(mixed.explicit_dt(), run.op.exact_time_step() * 0.9);
 }

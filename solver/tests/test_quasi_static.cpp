@@ -19,20 +19,9 @@ constexpr int kNx = 12, kNy = 4, kNz = 4;
 // to strain·L at t = 1 (a displacement table), unless `held` is false (then nothing holds it).
 pd::Model bar(double strain, bool held = true) {
   pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0);
-  pd::Nodes nodes = pdtest::cubic_lattice(kNx, kNy, kNz, kDx, 3);
-  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)}, right{"right", left.member};
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    left.member[i] = nodes.x[0][i] < 1.5 * kDx;
-    right.member[i] = nodes.x[0][i] > (kNx - 2.5) * kDx;
-  }
-  nodes.sets = {left, right};
-  const double pull = strain * (kNx - 1) * kDx;
-  if (held) {
-    for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
-    c.boundary_conditions.push_back({"right", "displacement", 0, {0.0, 1.0}, {0.0, pull}});
-  } else {
-    c.boundary_conditions.push_back({"right", "body_force", 0, {0.0}, {1e6}});
-  }
+  pd::Nodes nodes = pdtest::bar_with_grips(kNx, kNy, kNz, kDx);
+  if (held) pdtest::clamp_left_pull_right(c, strain * (kNx - 1) * kDx, 1.0, false);
+  else c.boundary_conditions.push_back({"right", "body_force", 0, {0.0}, {1e6}});
   c.time.integrator = "quasi_static";
   return pd::build_model(c, std::move(nodes));
 }

@@ -76,6 +76,10 @@ class Integrator {
   virtual std::optional<int> step_mode() const { return std::nullopt; }
   // Lines for run.log that the last step produced (a mixed scheme's switches), handed over once.
   virtual std::vector<std::string> take_log_lines() { return {}; }
+  // What the run's linear algebra cost, appended to run.log's done: line (quasi_static and mixed:
+  // factorisations and solves with their wall time, so that a benchmark can weigh them against
+  // force evaluations). Empty for a scheme without a linear solver: the done: line is unchanged.
+  virtual std::string linear_algebra_summary() const { return {}; }
   // ---- end of what the run asks
 
  protected:

@@ -6,15 +6,16 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "core/time_step_rule.hpp"
 #include "integrators/messages.hpp"
 
 namespace pd {
 
 void Mixed::configure(const Case& c, double dt_exact) {
   settings_ = c.mixed;
-  if (c.time.dt_rule == "stable") dt_explicit_ = op_.stable_time_step() * c.time.safety_factor;
-  else if (c.time.dt_rule == "exact") dt_explicit_ = (dt_exact > 0.0 ? dt_exact : op_.exact_time_step()) * c.time.safety_factor;
-  else dt_explicit_ = c.time.dt_value;
+  // The explicit phase's step: time.dt's rule, as the run's set-up applies it (run/prepare.cpp).
+  dt_explicit_ = explicit_time_step(c, op_.stable_time_step(),
+                                    [this, dt_exact] { return dt_exact > 0.0 ? dt_exact : op_.exact_time_step(); });
   if (!(dt_explicit_ > 0.0) || !std::isfinite(dt_explicit_))
     throw Error(c.file.string() + ": time.dt: the mixed scheme's explicit step is not a positive number (" +
                 message_number(dt_explicit_) + " s): the body needs bonds");
@@ -69,17 +70,15 @@ void Mixed::step(State& state, double& t, double& dt) {
     } catch (const StepFailed&) {
       // A failure the explicit scheme cannot help with (no tangent, a body not held) has no reason.
       if (static_.failure_reason().empty()) throw;
-      // Back to the last equilibrium: the state is that of t (step() leaves it so), the bonds
-      // broken in the attempt heal, and the tangent they were in is forgotten.
+      // Back to the last equilibrium: the state is that of t (step() works on a copy and leaves it
+      // so), the bonds broken in the attempt heal, and the tangent they were in is forgotten. The
+      // state's force is already that of this state with these bonds (evaluated when the step that
+      // reached it ended), so Verlet's first half kick needs no new evaluation.
       op_.model().bonds.broken = broken_before_;
       static_.forget_factorisation();
       evaluations = static_.last_step().force_evaluations;
       rejected = static_.last_step().rejected + 1;
       to_explicit(state, t, static_.failure_reason());
-      // The state's force is that of the last equilibrium with these bonds: evaluate again only to
-      // be exact about what the failed attempt left in f.
-      op_.evaluate(state, t);
-      ++evaluations;
     }
   }
   double h = std::min(dt, dt_explicit_);

@@ -50,6 +50,7 @@ class Mixed : public Integrator {
   std::optional<double> initial_dt() const override { return static_.initial_dt(); }
   std::optional<int> step_mode() const override { return step_mode_; }
   std::vector<std::string> take_log_lines() override { return std::move(log_lines_); }
+  std::string linear_algebra_summary() const override { return static_.linear_algebra_summary(); }
 
   Mode mode() const { return mode_; }  // the mode of the next step
   double explicit_dt() const { return dt_explicit_; }

@@ -3,6 +3,7 @@
 #include "integrators/quasi_static.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -87,6 +88,12 @@ void QuasiStatic::shift_diagonal(SparseMatrix& K) const {
 }
 
 bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool shifted) {
+  const auto start = std::chrono::steady_clock::now();
+  struct Timer {  // the wall time of assembling and factorising, however this returns
+    std::chrono::steady_clock::time_point start;
+    double& seconds;
+    ~Timer() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+  } timer{start, factorise_seconds_};
   SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, definite);
   if (K.rows < 0)
     throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
@@ -193,7 +200,10 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       const auto i = static_cast<std::size_t>(dofs_.node[q]);
       rhs_[q] = volume[i] * s.f[dofs_.component[q]][i];
     }
+    const auto solve_start = std::chrono::steady_clock::now();
     factor_.solve(rhs_, correction_);
+    solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
+    ++solves_;
     // Backtracking: the full step unless it raises the residual (then ½, ¼, … up to 1/32).
     double alpha = 1.0, step_norm = 0.0, motion = 0.0;
     trial_ = s;
@@ -296,6 +306,13 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     ++report_.rejected;
     h = std::max(0.5 * h, dt_min_);
   }
+}
+
+std::string QuasiStatic::linear_algebra_summary() const {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s", factorisations_,
+                factorise_seconds_, static_cast<long long>(solves_), solve_seconds_);
+  return buffer;
 }
 
 std::vector<std::string> QuasiStatic::describe(double) const {

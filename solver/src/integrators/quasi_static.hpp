@@ -45,6 +45,9 @@ class QuasiStatic : public Integrator {
 
   // Work of the whole run, for run.log and the tests.
   int factorisations() const { return factorisations_; }
+  // "N factorisations in X s, M solves in Y s" (wall time of assembling and factorising the tangent,
+  // and of the solves with its factor; this process's only: a restarted run counts from the restart).
+  std::string linear_algebra_summary() const override;
   const QuasiStaticSettings& settings() const { return settings_; }
 
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
@@ -75,6 +78,8 @@ class QuasiStatic : public Integrator {
   SparseCholesky factor_;
   bool have_factor_ = false;
   int factorisations_ = 0;
+  std::int64_t solves_ = 0;
+  double factorise_seconds_ = 0.0, solve_seconds_ = 0.0;  // wall time, for linear_algebra_summary()
   // Where the factorisation in use was assembled (for save_state): u, t, and whether the definite
   // variant and the diagonal shift were used.
   Vec3Array factor_u_;

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/stability.hpp"
+#include "core/time_step_rule.hpp"
 #include "core/work_plan.hpp"
 #include "forces/indenter.hpp"
 #include "io/case_reader.hpp"
@@ -57,25 +58,10 @@ std::vector<std::string> step_warnings(Prepared& p) {
           " s: stable while the bonds stay linear; the run may blow up once they break or contact acts"};
 }
 
-// The time-step policy: time.dt "stable" is eq. 2.5 × safety_factor, "exact" the linear limit
-// 2/ω_max × safety_factor, a number is used as given.
+// The time step: time.dt's rule (core/time_step_rule.hpp), the exact limit computed only if asked for.
 void choose_dt(Prepared& p) {
-  const Case& c = p.c;
   p.dt_stable = stable_time_step(p.model);
-  if (c.time.dt_rule == "stable") {
-    if (!std::isfinite(p.dt_stable))
-      throw Error(c.file.string() + ": time.dt: \"stable\" needs bonds, but no node has a partner within the horizon " +
-                  format("%.6g", c.horizon) + " m");
-    p.dt = p.dt_stable * c.time.safety_factor;
-  } else if (c.time.dt_rule == "exact") {
-    // The largest eigenvalue of the linearised operator (core/stability): the true linear limit.
-    if (!std::isfinite(p.exact_limit()))
-      throw Error(c.file.string() + ": time.dt: \"exact\" needs bonds, but no node has a partner within the horizon " +
-                  format("%.6g", c.horizon) + " m");
-    p.dt = p.dt_exact * c.time.safety_factor;
-  } else {
-    p.dt = c.time.dt_value;
-  }
+  p.dt = explicit_time_step(p.c, p.dt_stable, [&p] { return p.exact_limit(); });
 }
 
 // Nodes without a bond move freely: only loads and contact act on them (preprocess warns too, but

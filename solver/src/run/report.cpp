@@ -16,7 +16,8 @@ int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, cons
            std::to_string(loop.step) + " steps to t = " + format("%.6g", loop.t) + " s in " + format("%.3f", wall) +
            " s wall (" + format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
            std::to_string(frames_written) + " frames, " + std::to_string(loop.broken) + " broken bonds, " +
-           std::to_string(loop.force_evaluations) + " force evaluations");
+           std::to_string(loop.force_evaluations) + " force evaluations" +
+           (p.integrator->linear_algebra_summary().empty() ? "" : ", " + p.integrator->linear_algebra_summary()));
   log.line("output: frames and history.csv took " + format("%.3f", end.output_seconds) + " s wall, " +
            format("%.1f", wall > 0 ? 100.0 * end.output_seconds / wall : 0.0) + " % of the time loop");
   if (model.contact.pairs)
