@@ -28,11 +28,19 @@ void QuasiStatic::configure(const Case& c, double) {
   choose_linear_solver(c);
 }
 
-// direct or cg, and why (for describe()). The 3D threshold kCgFromDofs3d is measured (see
-// solve_krylov's note and the report of issue 13): on a 3D lattice with δ = 3.015 dx CHOLMOD's
-// factor fills as N^{4/3} and ... (filled in below by the measurement). In 2D the factor stays
-// small (the traction lattice, 47,871 dofs: one factorisation serves the whole elastic range), so
-// auto keeps direct there whatever the size, unless a term has no assembled form.
+// direct or cg, and why (for describe()). The 3D threshold kCgFromDofs3d is measured with
+// bench/linear_solvers.cpp (pd_linear_solvers: a clamped bar pulled along x, δ = 3.015dx, one Newton
+// system at the start of a load step; 2 threads on a machine shared with other jobs, load ~15, so
+// CPU seconds are quoted): at 6,912 free dofs CHOLMOD's analysis + factorisation took 3.6 s CPU and
+// block-Jacobi PCG to a 1e-8 relative residual 0.32 s CPU (11×); at 27,648 dofs 87 s CPU (factor
+// 5.95e7 entries, 0.48 GB, peak 0.97 GB resident) against 1.3 s CPU (67×; 0.2 s to the first
+// Eisenstat–Walker tolerance 0.1); at 67,200 dofs PCG 7.3 s CPU. The factor's fill grew as
+// dofs^1.5 and its time as dofs^2.3: above some 20,000 dofs a factorisation costs more than the
+// Newton iterations it can serve once bonds break (every breaking round refactorises), so auto
+// takes cg; at 10⁵ nodes (3·10⁵ dofs) the factor would hold some 2·10⁹ entries, 17 GB.
+// In 2D the factor stays small (the traction lattice, 47,871 dofs, factorises in seconds and one
+// factorisation serves the elastic range): auto keeps direct whatever the size there, unless a term
+// has no assembled form.
 void QuasiStatic::choose_linear_solver(const Case& c) {
   const int dimension = op_.model().nodes.dimension;
   const std::size_t free = FreeDofs::of(op_.size(), dimension, op_.fixed()).size();

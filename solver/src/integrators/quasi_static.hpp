@@ -59,7 +59,7 @@ class QuasiStatic : public Integrator {
   std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
   int cg_solves() const { return cg_solves_; }
   // Auto picks cg at or above this many free dofs in 3D (measured: see the .cpp).
-  static constexpr std::size_t kCgFromDofs3d = 150000;
+  static constexpr std::size_t kCgFromDofs3d = 20000;
   const QuasiStaticSettings& settings() const { return settings_; }
 
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
