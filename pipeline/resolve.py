@@ -43,6 +43,8 @@ def check_set_names(case: dict, existing: list[str]):
         missing(name, ("node_sets", name))
     for i, name in enumerate(case["output"]["reactions"]):
         missing(name, ("output", "reactions", i))
+    if isinstance(case["figures"]["probe"], str):
+        missing(case["figures"]["probe"], ("figures", "probe"))
     if problems:
         raise CaseError("\n".join(problems))
 
@@ -109,6 +111,7 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "time": time,
         "adaptive": dict(case["adaptive"]),
         "quasi_static": dict(case["quasi_static"]),
+        "implicit": dict(case["implicit"]),
         "mixed": dict(case["mixed"]),
         "output": dict(case["output"]),
         "figures": figures,

@@ -19,7 +19,8 @@ class Key:
     kind: number | integer | string | choice | section | named (user-named
     sub-sections, e.g. materials) | list (of sections) | names (list of strings) | boolean
     | components (x/y/z → number or [[t, v], ...] table) | numbers (list of
-    numbers) | parameters (name → number) | number_or_choice.
+    numbers) | parameters (name → number) | number_or_choice | point_or_name (a point
+    [x, y] or [x, y, z], or a node-set name).
     """
     kind: str
     doc: str
@@ -46,13 +47,31 @@ COMPONENT_DOC = ("per component x, y, z: a number, or a table [[t0, v0], [t1, v1
                  "interpolated linearly in time and held constant outside it")
 
 MATERIAL = {
-    "model": Key("choice", "constitutive model (bond-based prototype microelastic brittle)",
-                 default="pmb", choices=("pmb",)),
+    "model": Key("choice", "constitutive model: pmb (bond-based prototype microelastic brittle; fixes ν) or "
+                 "lps (linear peridynamic solid, ordinary state-based; any ν)",
+                 default="pmb", choices=("pmb", "lps")),
     "density": Key("number", "mass density ρ", default=REQUIRED, unit="kg/m³", above=0.0),
     "youngs_modulus": Key("number", "Young's modulus E (bond-based PMB fixes ν: 1/4 in 3D and "
                           "plane strain, 1/3 in plane stress)", default=REQUIRED, unit="Pa", above=0.0),
+    "poisson_ratio": Key("number", "Poisson's ratio ν of the isotropic solid; lps only, required there "
+                         "(−1 < ν < 1/2: K and G positive)", default=None, above=-1.0, below=0.5),
     "fracture_energy": Key("number", "critical energy release rate G0; omit for an unbreakable "
                            "material", default=None, unit="J/m²", above=0.0),
+    "influence": Key("choice", "lps only: influence function ω(|ξ|), one, inverse_length (1/|ξ|) or gaussian "
+                     "(exp(−|ξ|²/δ²)); default one, the same in every block", default=None,
+                     choices=("one", "inverse_length", "gaussian")),
+}
+
+# The material keys each model reads (besides model and density), and what a key means to a model
+# that has no such parameter: validate.py rejects such a key with this explanation, as the solver's
+# reader does (solver/src/io/case_reader.cpp read_block).
+MODEL_KEYS = {
+    "pmb": ("youngs_modulus", "fracture_energy"),
+    "lps": ("youngs_modulus", "poisson_ratio", "fracture_energy", "influence"),
+}
+MODEL_REQUIRED = {"lps": ("poisson_ratio",)}
+MODEL_NOTE = {
+    "pmb": "PMB is bond-based and fixes Poisson's ratio (1/4 in 3D and plane strain, 1/3 in plane stress)",
 }
 
 BOUNDARY_CONDITION = {
@@ -128,8 +147,10 @@ CASE = {
     "node_sets": Key("named", "options of node sets (every gmsh physical group is a node set)",
                      default={}, fields={
                          "layer": Key("number", "nodes within this distance of a curve/surface group "
-                                      "belong to it (thesis §2.1: conditions act in a layer); default: "
-                                      "the first row of nodes", default=None, unit="m", minimum=0.0),
+                                      "belong to it (thesis §2.1: conditions act in a layer), measured "
+                                      "through the body (not across a notch or a hole) and to the group's "
+                                      "end points too (a round cap there); default: the first row of nodes",
+                                      default=None, unit="m", minimum=0.0),
                      }),
     "no_fail": Key("names", "node sets whose bonds never break (e.g. where loads are applied)",
                    default=[]),
@@ -165,8 +186,9 @@ CASE = {
                        "quasi_static (time is a load parameter: equilibrium by Newton at every load step, "
                        "settings in quasi_static:) or mixed (quasi-static load steps while the body is in "
                        "equilibrium, Verlet at time.dt while a crack runs, switching both ways by itself; "
-                       "settings in mixed: and quasi_static:)",
-                       default="verlet", choices=("verlet", "adaptive", "quasi_static", "mixed")),
+                       "settings in mixed: and quasi_static:) or implicit (dynamics by the generalized-α method "
+                       "solved by Newton, the step set by a local error estimate: settings in implicit:)",
+                       default="verlet", choices=("verlet", "adaptive", "quasi_static", "mixed", "implicit")),
         dt=Key("number_or_choice", "time step: 'stable' (thesis eq. 2.5, minimised over nodes, times "
                "safety_factor), 'exact' (2/ω_max, ω_max² the largest eigenvalue of the linearised PMB "
                "operator M⁻¹K, times safety_factor: about 1.7× 'stable' in 2D, 2× in 3D), or a number; "
@@ -229,6 +251,35 @@ CASE = {
                    above=0.0),
         dt_max=Key("number", "largest load step (default: end/10)", default=None, unit="s", above=0.0),
     ),
+    "implicit": section(
+        "implicit dynamics (time.integrator: implicit): the generalized-α method (Chung & Hulbert "
+        "1993) solved by Newton's method with a sparse Cholesky factorisation of the tangent plus the "
+        "lumped mass (CHOLMOD); the step is limited by accuracy, not by the explicit limit: a local "
+        "error estimate (Zienkiewicz & Xie 1991) below tol, and eq. 2.8 from the Newton iterations; "
+        "bonds break after each accepted step; damping is integrated implicitly",
+        rho_infinity=Key("number", "ρ∞: the amplification of the highest frequencies per step; 1 is "
+                         "Newmark's average acceleration (trapezoidal) rule, which conserves the energy "
+                         "of a linear system; below 1 damps the high frequencies (0.8: mildly, 0: "
+                         "strongest), the low ones barely", default=1.0, minimum=0.0, maximum=1.0),
+        tol=Key("number", "TOL on the local error estimate of a step relative to its motion (about the "
+                "relative phase error it adds); a step above it is redone with a smaller Δt",
+                default=1e-3, above=0.0, below=1.0),
+        newton_tol=Key("number", "Newton: the last correction relative to the step's motion (eq. 2.6 "
+                       "for Newton); well below tol, so that the iteration error stays under the time error",
+                       default=1e-6, above=0.0, below=1.0),
+        residual_tol=Key("number", "Newton: the out-of-balance force relative to the inertia plus the "
+                         "force", default=1e-8, above=0.0, below=1.0),
+        kd=Key("integer", "K_d: the Newton iterations a step is aimed at (eq. 2.8)", default=5,
+               minimum=1, maximum=1000),
+        p=Key("number", "exponent p of eq. 2.8", default=2.0, above=0.0),
+        max_iterations=Key("integer", "Newton iterations before the step is halved", default=20,
+                           minimum=1, maximum=100000),
+        dt_initial=Key("number", "the first step (default: from time.dt)", default=None, unit="s",
+                       above=0.0),
+        dt_min=Key("number", "smallest step; a step not accepted there stops the run (default: 1e-6 × "
+                   "eq. 2.5)", default=None, unit="s", above=0.0),
+        dt_max=Key("number", "largest step (default: end/10)", default=None, unit="s", above=0.0),
+    ),
     "mixed": section(
         "the mixed scheme (time.integrator: mixed): quasi-static load steps (the quasi_static "
         "section) while the body is in equilibrium, explicit Verlet steps of time.dt while it is not; "
@@ -280,6 +331,9 @@ CASE = {
                   "frames spread over the run)", default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
+        probe=Key("point_or_name", "where probe.png follows the displacement component: a point "
+                  "[x, y] or [x, y, z] (the node nearest to it), or a node-set name (the mean over its "
+                  "nodes); default: the node nearest the centre of the bounding box", default=None, unit="m"),
     ),
 }
 
@@ -299,6 +353,8 @@ def markdown() -> str:
         return f"`{key.default}`"
 
     def kind_text(key: Key) -> str:
+        if key.kind == "point_or_name":
+            return "point or name"
         if key.kind in ("choice", "number_or_choice"):
             extra = " or number" if key.kind == "number_or_choice" else ""
             return " \\| ".join(str(c) for c in key.choices) + extra

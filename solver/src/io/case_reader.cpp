@@ -158,6 +158,17 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
   const MaterialDefinition& law = material_registry().get(b.model);
   std::vector<std::string> allowed = {"id", "name", "model", "density"};
   for (const auto& p : law.parameters) allowed.push_back(p.name);
+  // A parameter of another model (poisson_ratio under model: pmb): say which model has it and what
+  // this one does instead, rather than only "unknown key".
+  for (const auto& item : j.items()) {
+    if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
+    for (const std::string& other : material_registry().keys())
+      for (const auto& p : material_registry().get(other).parameters)
+        if (p.name == item.key())
+          ck.fail(where + "." + item.key(), "model '" + b.model + "' has no parameter '" + item.key() + "' (" + b.model +
+                                                ": " + law.doc + "); model '" + other + "' has it (" + p.doc +
+                                                "): set model: " + other);
+  }
   ck.known_keys(j, where, allowed);
   const std::int64_t id = ck.integer(ck.required(j, "id", where + ".id"), where + ".id", 1, 1 << 30);
   if (id != static_cast<std::int64_t>(k) + 1)
@@ -168,6 +179,15 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
   for (const auto& p : law.parameters) {
     const std::string key = where + "." + p.name;
     const json* value = p.required ? &ck.required(j, p.name, key) : ck.optional(j, p.name);
+    if (!p.choices.empty()) {  // a text parameter: one of its names, the first by default
+      b.choices[p.name] = p.choices.front();
+      if (!value || value->is_null()) continue;
+      const std::string name = ck.string(*value, key);
+      if (std::find(p.choices.begin(), p.choices.end(), name) == p.choices.end())
+        ck.fail(key, "unknown name '" + name + "'" + closest(name, p.choices) + "; known: " + joined(p.choices));
+      b.choices[p.name] = name;
+      continue;
+    }
     if (!value || (!p.required && value->is_null())) continue;
     const double v = ck.number(*value, key);
     if (p.lower == 0.0 && std::isinf(p.upper)) {
@@ -176,7 +196,7 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
     }
     if (!(v > p.lower && v < p.upper))
       ck.fail(key, "must be between " + show(json(p.lower)) + " and " + show(json(p.upper)) + " (exclusive), got " +
-                       show(*value));
+                       show(*value) + (p.bounds_reason.empty() ? std::string() : ": " + p.bounds_reason));
     b.parameters[p.name] = v;
   }
   return b;
@@ -327,6 +347,36 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
   return q;
 }
 
+// The implicit section (integrators/implicit.hpp).
+ImplicitSettings read_implicit(const Checker& ck, const json& j) {
+  ck.object(j, "implicit");
+  ck.known_keys(j, "implicit", case_keys().at("implicit"));
+  ImplicitSettings m;
+  if (const json* v = ck.optional(j, "rho_infinity")) {
+    m.rho_infinity = ck.number(*v, "implicit.rho_infinity");
+    // Chung & Hulbert's family is unconditionally stable and second order for ρ∞ in [0, 1].
+    if (m.rho_infinity < 0.0 || m.rho_infinity > 1.0)
+      ck.fail("implicit.rho_infinity", "must be between 0 and 1 (1: no numerical dissipation), got " + show(*v));
+  }
+  for (auto [name, slot] : {std::pair<const char*, double*>{"tol", &m.tol}, {"newton_tol", &m.newton_tol},
+                            {"residual_tol", &m.residual_tol}})
+    if (const json* v = ck.optional(j, name)) {
+      *slot = ck.positive(*v, std::string("implicit.") + name);
+      if (!(*slot < 1.0)) ck.fail(std::string("implicit.") + name, "must be below 1 (a relative error), got " + show(*v));
+    }
+  if (const json* v = ck.optional(j, "kd")) m.kd = static_cast<int>(ck.integer(*v, "implicit.kd", 1, 1000));
+  if (const json* v = ck.optional(j, "p")) m.p = ck.positive(*v, "implicit.p");
+  if (const json* v = ck.optional(j, "max_iterations"))
+    m.max_iterations = static_cast<int>(ck.integer(*v, "implicit.max_iterations", 1, 100000));
+  for (auto [name, slot] : {std::pair<const char*, std::optional<double>*>{"dt_initial", &m.dt_initial},
+                            {"dt_min", &m.dt_min}, {"dt_max", &m.dt_max}})
+    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("implicit.") + name);
+  if (m.dt_min && m.dt_max && *m.dt_min > *m.dt_max) ck.fail("implicit.dt_min", "is larger than implicit.dt_max");
+  if (m.dt_initial && m.dt_max && *m.dt_initial > *m.dt_max) ck.fail("implicit.dt_initial", "is larger than implicit.dt_max");
+  if (m.dt_initial && m.dt_min && *m.dt_initial < *m.dt_min) ck.fail("implicit.dt_initial", "is smaller than implicit.dt_min");
+  return m;
+}
+
 // The mixed section (integrators/mixed.hpp).
 MixedSettings read_mixed(const Checker& ck, const json& j) {
   ck.object(j, "mixed");
@@ -376,7 +426,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "mixed", "output", "figures", "partial_volume", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -386,6 +436,8 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
       {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
+      {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
+                    "dt_min", "dt_max"}},
       {"mixed", {"unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
@@ -450,6 +502,13 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
       ck.fail("blocks[" + std::to_string(k) + "].model",
               "is '" + c.blocks[k].model + "' but blocks[0] is '" + c.blocks[0].model +
                   "': every block of a case must use the same material model");
+  // A text parameter (LPS's influence function) is one per case: m_i sums over both blocks of a bond.
+  for (std::size_t k = 1; k < c.blocks.size(); ++k)
+    for (const auto& [name, value] : c.blocks[k].choices)
+      if (value != c.blocks[0].choice(name, value))
+        ck.fail("blocks[" + std::to_string(k) + "]." + name, "is '" + value + "' but blocks[0] has '" +
+                                                               c.blocks[0].choice(name, value) +
+                                                               "': every block of a case must use the same " + name);
 
   if (const json* j = ck.optional(root, "no_fail_sets")) c.no_fail_sets = ck.strings(*j, "no_fail_sets");
   if (const json* j = ck.optional(root, "node_sets")) c.node_sets = ck.strings(*j, "node_sets");
@@ -496,6 +555,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
 
   if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) c.adaptive = read_adaptive(ck, *j);
   if (const json* j = ck.optional(root, "quasi_static"); j && !j->is_null()) c.quasi_static = read_quasi_static(ck, *j);
+  if (const json* j = ck.optional(root, "implicit"); j && !j->is_null()) c.implicit = read_implicit(ck, *j);
   if (const json* j = ck.optional(root, "mixed"); j && !j->is_null()) c.mixed = read_mixed(ck, *j);
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 

@@ -209,11 +209,15 @@ std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
 }
 
 std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Array& f, double* energy_density,
-                                           double* broken_energy) {
+                                           double* broken_energy, double* lost_per_node) {
   const PmbArrays a = pmb_arrays(m, u);
   if (!m.material.can_break()) {
     add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density);
     return 0;
+  }
+  if (lost_per_node) {
+    const PmbBreaking br = pmb_breaking(m, lost_per_node);
+    return add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br);
   }
   std::vector<double> lost(broken_energy ? static_cast<std::size_t>(a.nodes) : 0, 0.0);
   const PmbBreaking br = pmb_breaking(m, broken_energy ? lost.data() : nullptr);

@@ -13,9 +13,10 @@ void PmbModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, d
 }
 
 BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
-                                                bool want_energy) const {
+                                                bool want_energy, double* lost_per_node) const {
   BreakReport r;
-  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, want_energy ? &r.energy : nullptr);
+  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, want_energy && !lost_per_node ? &r.energy : nullptr,
+                                           lost_per_node);
   return r;
 }
 
