@@ -220,7 +220,7 @@ CASE = {
     "quasi_static": section(
         "the quasi-static solver (time.integrator: quasi_static): each load step is brought to "
         "equilibrium by Newton's method with a sparse Cholesky factorisation of the tangent "
-        "(CHOLMOD), bonds over their critical stretch break and the load step is solved again until "
+        "(CHOLMOD) or matrix-free preconditioned CG (linear_solver), bonds over their critical stretch break and the load step is solved again until "
         "none does; the step size follows eq. 2.8 from the Newton corrections",
         tol=Key("number", "TOL on the last Newton correction relative to the step's motion "
                 "(eq. 2.6 for Newton)", default=1e-6, above=0.0, below=1.0),
@@ -235,6 +235,15 @@ CASE = {
         max_breaking_rounds=Key("integer", "re-solves at one load while bonds keep breaking; more "
                                 "means unstable crack growth, and the run stops", default=100,
                                 minimum=1, maximum=100000000),
+        linear_solver=Key("string", "the linear solve of each Newton iteration: direct (CHOLMOD "
+                          "factorisation of the assembled tangent), cg (matrix-free conjugate "
+                          "gradients with a block-Jacobi preconditioner, solved only as far as "
+                          "Newton needs: Eisenstat–Walker), or auto (cg when a term has no "
+                          "assembled tangent, i.e. contact, or the model is large: run.log says "
+                          "which and why)", default="auto", choices=("auto", "direct", "cg")),
+        cg_max_iterations=Key("integer", "CG iterations in one Newton iteration; then Newton goes "
+                              "on with the iterate reached", default=5000, minimum=1,
+                              maximum=100000000),
         dt_initial=Key("number", "the first load step (default: end/100)", default=None, unit="s",
                        above=0.0),
         dt_min=Key("number", "smallest load step (default: 1e-6 × end: some ten halvings below "

@@ -3,11 +3,15 @@
 // Jacobian–vector product; a body that nothing holds is refused with a message that says why.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
+#include <cstring>
 
 #include "integrators/quasi_static.hpp"
 #include "jacobian_check.hpp"
 #include "lattice.hpp"
+#include "one_thread.hpp"
 #include "linalg/cholesky.hpp"
 
 namespace {
@@ -215,4 +219,211 @@ TEST(QuasiStatic, DefiniteTangentLeavesOutOnlyTheCompressedBondsLateralStiffness
   for (std::size_t i = 0; i < s.size(); ++i) s.u[0][i] = 1e-3 * m.nodes.x[0][i], s.u[1][i] = 1e-3 * m.nodes.x[1][i],
                                              s.u[2][i] = 1e-3 * m.nodes.x[2][i];
   EXPECT_EQ(op.assemble_stiffness(s, 0.0, dofs).value, op.assemble_stiffness(s, 0.0, dofs, true).value);
+}
+
+// ---- The matrix-free path (quasi_static.linear_solver: cg, linalg/pcg.hpp).
+
+namespace {
+
+bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
+  for (std::size_t d = 0; d < 3; ++d)
+    if (a[d].size() != b[d].size() || std::memcmp(a[d].data(), b[d].data(), a[d].size() * sizeof(double)) != 0) return false;
+  return true;
+}
+
+// The pulled bar of PulledBarReachesEquilibriumEqualToOneDirectSolve to t = 1 with the given linear
+// solver on `threads` threads; returns the final state, and the describe() line.
+pd::State pull_bar(const std::string& solver, int threads, double strain, std::string* describe = nullptr,
+                   std::int64_t* cg_iterations = nullptr) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  pd::Model m = bar(strain);
+  pd::ForceOperator op(m);
+  pd::QuasiStatic qs(op);
+  pd::Case c = bar_case();
+  c.quasi_static.linear_solver = solver;
+  qs.configure(c);
+  if (describe) *describe = qs.describe(0.0).front();
+  pd::State s(m.nodes.size());
+  double t = 0.0, dt = 1.0;
+  qs.initialize(s, t);
+  while (t < 1.0 - 1e-12) {
+    double h = std::min(dt, 1.0 - t);
+    qs.step(s, t, h);
+    dt = qs.last_step().next_dt;
+  }
+  EXPECT_EQ(qs.uses_cg(), solver == "cg");
+  EXPECT_LT(force_norm(m, s, true), 1e-8 * force_norm(m, s, false));  // equilibrium, as with direct
+  if (cg_iterations) *cg_iterations = qs.cg_iterations();
+  omp_set_num_threads(saved);
+  return s;
+}
+
+}  // namespace
+
+TEST(QuasiStatic, CgReachesTheEquilibriumOfTheDirectSolveBitwiseOnOneAndTwoThreads) {
+  // 1e-3: geometrically nonlinear enough that Newton takes several iterations per load step.
+  const double strain = 1e-3;
+  std::string direct_line, cg_line, auto_line;
+  std::int64_t cg_iterations = 0;
+  const pd::State direct = pull_bar("direct", 1, strain, &direct_line);
+  const pd::State cg1 = pull_bar("cg", 1, strain, &cg_line, &cg_iterations);
+  const pd::State cg2 = pull_bar("cg", 2, strain);
+  pull_bar("auto", 1, strain, &auto_line);
+  double error = 0.0, scale = 0.0;
+  for (std::size_t d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < direct.size(); ++i) {
+      error = std::max(error, std::fabs(cg1.u[d][i] - direct.u[d][i]));
+      scale = std::max(scale, std::fabs(direct.u[d][i]));
+    }
+  EXPECT_LT(error, 1e-8 * scale);
+  EXPECT_TRUE(same_bits(cg1.u, cg2.u));
+  EXPECT_TRUE(same_bits(cg1.f, cg2.f));
+  EXPECT_GT(cg_iterations, 0);
+  // The choice and its reason are in the describe() line (run.log's work plan).
+  EXPECT_NE(direct_line.find("CHOLMOD (direct, as the case file asks)"), std::string::npos) << direct_line;
+  EXPECT_NE(cg_line.find("matrix-free CG"), std::string::npos) << cg_line;
+  EXPECT_NE(auto_line.find("(direct, auto: 448 free dofs, below 20000 in 3D)"), std::string::npos) << auto_line;
+  std::printf("pulled bar, strain %g: cg %.3g relative from direct, %lld CG iterations in all\n", strain, error / scale,
+              static_cast<long long>(cg_iterations));
+}
+
+namespace {
+
+// Two 8×4×4 bars along x, 4dx apart (no bond across), in two blocks (contact between them, auto):
+// the first clamped at its left two layers, the second's right two layers pushed 3.2dx towards it
+// at t = 1 and held in y and z, so that the facing layers end 0.8dx apart, inside the contact
+// distance 1.35dx.
+pd::Model pressed_bars() {
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0);
+  pd::BlockMaterial second = c.blocks[0];
+  second.name = "second";
+  c.blocks.push_back(second);
+  const int nx = 8;
+  pd::Nodes a = pdtest::cubic_lattice(nx, kNy, kNz, kDx, 3), nodes = a;
+  const double shift = (nx - 1) * kDx + 4 * kDx;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t d = 0; d < 3; ++d) nodes.x[d].push_back(a.x[d][i] + (d == 0 ? shift : 0.0));
+    nodes.volume.push_back(a.volume[i]);
+    nodes.block.push_back(2);
+  }
+  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)}, right{"right", left.member};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    left.member[i] = nodes.x[0][i] < 1.5 * kDx;
+    right.member[i] = nodes.x[0][i] > shift + (nx - 2.5) * kDx;
+  }
+  nodes.sets = {left, right};
+  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
+  c.boundary_conditions.push_back({"right", "displacement", 0, {0.0, 1.0}, {0.0, -3.2 * kDx}});
+  for (int d = 1; d < 3; ++d) c.boundary_conditions.push_back({"right", "displacement", d, {0.0}, {0.0}});
+  c.time.integrator = "quasi_static";
+  return pd::build_model(c, std::move(nodes));
+}
+
+}  // namespace
+
+TEST(QuasiStatic, ContactSolvesWithCgAndDirectIsRefusedWithTheReason) {
+  pdtest::OneThread one;
+  pd::Model m = pressed_bars();
+  ASSERT_TRUE(m.contact.pairs);
+  pd::ForceOperator op(m);
+  {
+    pd::QuasiStatic direct(op);
+    pd::Case c = bar_case();
+    c.file = "pressed.yaml";
+    c.quasi_static.linear_solver = "direct";
+    try {
+      direct.configure(c);
+      FAIL() << "no error";
+    } catch (const pd::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("pressed.yaml: quasi_static.linear_solver: direct needs an assembled tangent"),
+                std::string::npos) << e.what();
+    }
+  }
+  pd::QuasiStatic qs(op);
+  pd::Case c = bar_case();
+  c.quasi_static.residual_tol = 1e-9;
+  qs.configure(c);  // auto
+  ASSERT_TRUE(qs.uses_cg());
+  EXPECT_NE(qs.describe(0.0).front().find("auto: a term (contact) has no assembled tangent"), std::string::npos);
+  pd::State s(m.nodes.size());
+  double t = 0.0, dt = 1.0;
+  qs.initialize(s, t);
+  while (t < 1.0 - 1e-12) {
+    double h = std::min(dt, 1.0 - t);
+    qs.step(s, t, h);
+    dt = qs.last_step().next_dt;
+  }
+  // The push reaches the clamp through contact only: equal and opposite reactions in x, the free
+  // nodes in equilibrium, the contact holding energy.
+  double left = 0.0, right = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double r = m.nodes.volume[i] * s.f[0][i];
+    if (m.nodes.sets[0].member[i]) left += r;
+    if (m.nodes.sets[1].member[i]) right += r;
+  }
+  EXPECT_GT(s.contact_energy, 0.0);
+  EXPECT_GT(right, 0.0);  // the squeezed bars push the pusher back (+x) and the clamp (−x)
+  EXPECT_NEAR(left, -right, 1e-6 * std::fabs(right));
+  EXPECT_LT(force_norm(m, s, true), 1e-8 * force_norm(m, s, false));
+  // The facing layers are apart by more than half the contact distance: contact held them.
+  double gap = HUGE_VAL;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::size_t j = 0; j < s.size(); ++j)
+      if (m.block_index[i] == 0 && m.block_index[j] == 1)
+        gap = std::min(gap, (m.nodes.x[0][j] + s.u[0][j]) - (m.nodes.x[0][i] + s.u[0][i]));
+  EXPECT_GT(gap, 0.8 * kDx);
+  std::printf("pressed bars with contact (cg): reactions %.6g and %.6g N, closest layers %.3g dx, %lld CG iterations\n",
+              left, right, gap / kDx, static_cast<long long>(qs.cg_iterations()));
+}
+
+TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) {
+  pdtest::OneThread one;
+  // The pulled bar (strain 1e-3 by t = 1) with half of the cross-section at x = 5.5dx cut (its bonds
+  // broken before the start): the tangent is shifted as after damage, and the notch makes the
+  // response nonlinear in the load steps' Newton iterations.
+  struct Run {
+    pd::Model m = bar(1e-3);
+    pd::ForceOperator op{m};
+    pd::QuasiStatic qs{op};
+    pd::State s{m.nodes.size()};
+    double t = 0.0, dt = 0.0;
+    Run() {
+      for (std::size_t i = 0; i < m.nodes.size(); ++i)
+        for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+          const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+          const double xi = m.nodes.x[0][i], xj = m.nodes.x[0][j];
+          if ((xi - 5.5 * kDx) * (xj - 5.5 * kDx) < 0.0 && m.nodes.x[1][i] < 1.5 * kDx && m.nodes.x[1][j] < 1.5 * kDx)
+            m.bonds.broken[static_cast<std::size_t>(k)] = 1;
+        }
+      pd::Case c = bar_case();
+      c.quasi_static.linear_solver = "cg";
+      c.quasi_static.dt_max = 0.1;
+      qs.configure(c);
+      qs.initialize(s, 0.0);
+      dt = *qs.initial_dt();
+    }
+    void step() {
+      double h = std::min(dt, 1.0 - t);
+      qs.step(s, t, h);
+      dt = qs.last_step().next_dt;
+    }
+  };
+  Run a;
+  for (int k = 0; k < 4; ++k) a.step();
+  const std::vector<char> saved = a.qs.save_state();
+  Run b;
+  b.s = a.s;
+  b.t = a.t;
+  b.dt = a.dt;
+  b.m.bonds.broken = a.m.bonds.broken;
+  b.qs.load_state(saved);
+  int steps = 0;
+  while (a.t < 1.0 - 1e-12) a.step(), b.step(), ++steps;
+  EXPECT_GT(steps, 2);
+  EXPECT_EQ(a.t, b.t);
+  EXPECT_TRUE(same_bits(a.s.u, b.s.u));
+  EXPECT_TRUE(same_bits(a.s.f, b.s.f));
+  EXPECT_EQ(a.qs.last_step().iterations, b.qs.last_step().iterations);
+  EXPECT_LT(force_norm(a.m, a.s, true), 1e-8 * force_norm(a.m, a.s, false));
 }

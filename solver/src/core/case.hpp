@@ -54,6 +54,11 @@ struct QuasiStaticSettings {
   int max_iterations = 30;     // Newton iterations before the load step is cut
   int max_breaking_rounds = 100;  // re-solves at one load while bonds keep breaking, then unstable
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-6, end/10
+  // The linear solve of each Newton iteration (integrators/quasi_static.hpp): "direct" (CHOLMOD),
+  // "cg" (matrix-free preconditioned CG, an inexact Newton–Krylov iteration) or "auto" (cg when the
+  // scene has no assembled tangent, contact, or when it is large; direct otherwise).
+  std::string linear_solver = "auto";
+  int cg_max_iterations = 5000;  // CG iterations per Newton iteration before it takes the iterate it has
 };
 
 // implicit: dynamics by the generalized-α method solved by Newton (integrators/implicit.hpp), the

@@ -108,6 +108,33 @@ void ShortRangeForce::AddJacobianProduct(const Vec3Array& u, const Vec3Array& x,
   }
 }
 
+void ShortRangeForce::AddJacobianDiagonal(const Vec3Array& u, std::size_t i, double block[9], bool definite) const {
+  const Model& m = model_;
+  const ContactPairs& pairs = m.contact_list.pairs();
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const double factor = m.contact.stiffness_factor / m.horizon;
+  const auto& X = m.nodes.x;
+  const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
+  for (std::int64_t k = pairs.offsets[i]; k < pairs.offsets[i + 1]; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    const auto j = static_cast<std::size_t>(pairs.neighbour[ku]);
+    const double e[3] = {(X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2};
+    const double r = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    const double gap = pairs.distance[ku] - r;
+    if (!(gap > 0.0) || !(r > 0.0)) continue;
+    const double k_vj = factor * m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
+                                                              static_cast<std::size_t>(m.block_index[j])] *
+                        m.nodes.volume[j];
+    // ∂f_i/∂u_i = −k [n nᵀ − ((d − r)/r)(I − n nᵀ)] (AddJacobianProduct with δu_j = 0).
+    const double lateral = definite ? 0.0 : -k_vj * gap / r;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        const double nn = e[a] * e[b] / (r * r);
+        block[3 * a + b] -= k_vj * nn + lateral * ((a == b ? 1.0 : 0.0) - nn);
+      }
+  }
+}
+
 namespace {
 
 // Contact as a term of the operator (forces/force_term.hpp).
@@ -120,6 +147,9 @@ class ContactTerm : public ForceTerm {
     ShortRangeForce(model_).AddJacobianProduct(s.u, x, y);
   }
   bool add_tangent_diagonal(const State&, double, std::size_t, double*) const override { return false; }
+  void add_jacobian_diagonal(const State& s, double, std::size_t i, double block[9], bool definite) const override {
+    ShortRangeForce(model_).AddJacobianDiagonal(s.u, i, block, definite);
+  }
   std::vector<std::string> work_plan() const override {
     char buffer[256];
     std::snprintf(buffer, sizeof buffer, ", contact distance 2r_s %.4g m, skin %.4g m, c_s = %.4g·c",

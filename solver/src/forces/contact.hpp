@@ -47,6 +47,9 @@ class ShortRangeForce {
   // y += ∂f/∂u·x over the pairs of the current list (each pair closer than d_ij is a spring along
   // its line and, for the pressed gap, a negative lateral stiffness).
   void AddJacobianProduct(const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const;
+  // block += ∂f_i/∂u_i of the same pairs (row-major 3×3); definite: without the pressed gaps'
+  // negative lateral stiffness.
+  void AddJacobianDiagonal(const Vec3Array& u, std::size_t i, double block[9], bool definite) const;
 
  private:
   const Model& model_;

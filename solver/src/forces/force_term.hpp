@@ -27,6 +27,14 @@ class ForceTerm {
   // (indenters, body force); false for a term that couples nodes (contact): the assembled tangent
   // does not hold it, and solvers then stay matrix-free.
   virtual bool add_tangent_diagonal(const State& s, double t, std::size_t i, double block[9]) const = 0;
+  // block += ∂f_i/∂u_i at node i for every term, coupling ones included (the diagonal blocks of the
+  // matrix-free tangent: the block-Jacobi preconditioner of linalg/pcg.hpp). definite: leave out
+  // negative stiffness across a line (as BondModel::bond_tangent_row does), so that the block of a
+  // preconditioner stays positive. By default the term's add_tangent_diagonal.
+  virtual void add_jacobian_diagonal(const State& s, double t, std::size_t i, double block[9], bool definite) const {
+    (void)definite;
+    add_tangent_diagonal(s, t, i, block);
+  }
   // Lines of the work plan (run.log) for this term.
   virtual std::vector<std::string> work_plan() const = 0;
 };

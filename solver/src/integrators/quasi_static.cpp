@@ -26,6 +26,47 @@ void QuasiStatic::configure(const Case& c, double) {
   if (op_.damping() != 0.0)
     throw Error(c.file.string() + ": damping: quasi_static solves for equilibrium, where damping does nothing; "
                 "set damping: 0 (or use time.integrator: verlet)");
+  choose_linear_solver(c);
+}
+
+// direct or cg, and why (for describe()). The 3D threshold kCgFromDofs3d is measured with
+// bench/linear_solvers.cpp (pd_linear_solvers: a clamped bar pulled along x, δ = 3.015dx, one Newton
+// system at the start of a load step; 2 threads on a machine shared with other jobs, load ~15, so
+// CPU seconds are quoted): at 6,912 free dofs CHOLMOD's analysis + factorisation took 3.6 s CPU and
+// block-Jacobi PCG to a 1e-8 relative residual 0.32 s CPU (11×); at 27,648 dofs 87 s CPU (factor
+// 5.95e7 entries, 0.48 GB, peak 0.97 GB resident) against 1.3 s CPU (67×; 0.2 s to the first
+// Eisenstat–Walker tolerance 0.1); at 67,200 dofs PCG 7.3 s CPU. The factor's fill grew as
+// dofs^1.5 and its time as dofs^2.3: above some 20,000 dofs a factorisation costs more than the
+// Newton iterations it can serve once bonds break (every breaking round refactorises), so auto
+// takes cg; at 10⁵ nodes (3·10⁵ dofs) the factor would hold some 2·10⁹ entries, 17 GB.
+// In 2D the factor stays small (the traction lattice, 47,871 dofs, factorises in seconds and one
+// factorisation serves the elastic range): auto keeps direct whatever the size there, unless a term
+// has no assembled form.
+void QuasiStatic::choose_linear_solver(const Case& c) {
+  const int dimension = op_.model().nodes.dimension;
+  const std::size_t free = FreeDofs::of(op_.size(), dimension, op_.fixed()).size();
+  const bool assembled = op_.has_assembled_stiffness(State(op_.size()), 0.0);
+  const std::string& choice = settings_.linear_solver;
+  if (choice == "direct") {
+    if (!assembled)
+      throw Error(c.file.string() + ": quasi_static.linear_solver: direct needs an assembled tangent, which contact "
+                  "(or the material) does not have; use linear_solver: cg (or auto)");
+    use_cg_ = false;
+    solver_reason_ = "as the case file asks";
+  } else if (choice == "cg") {
+    use_cg_ = true;
+    solver_reason_ = "as the case file asks";
+  } else if (!assembled) {
+    use_cg_ = true;
+    solver_reason_ = "auto: a term (contact) has no assembled tangent";
+  } else if (dimension == 3 && free >= kCgFromDofs3d) {
+    use_cg_ = true;
+    solver_reason_ = "auto: " + std::to_string(free) + " free dofs in 3D, at least " + std::to_string(kCgFromDofs3d);
+  } else {
+    use_cg_ = false;
+    solver_reason_ = "auto: " + std::to_string(free) + " free dofs" +
+                     (dimension == 3 ? ", below " + std::to_string(kCgFromDofs3d) + " in 3D" : std::string(" in 2D"));
+  }
 }
 
 void QuasiStatic::initialize(State& state, double t) {
@@ -43,6 +84,67 @@ void QuasiStatic::initialize(State& state, double t) {
   }
   trial_ = State(state.size());
   report_ = StepReport{};
+  if (use_cg_) {
+    cg_x_ = make_vec3(state.size());
+    cg_y_ = make_vec3(state.size());
+  }
+}
+
+bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
+  const auto& volume = op_.model().nodes.volume;
+  if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
+    // A law without bond_tangent_row: unpreconditioned CG (identity blocks).
+    block_first_.clear();
+    for (std::size_t k = 0; k <= dofs_.size(); ++k) block_first_.push_back(static_cast<std::int64_t>(k));
+    blocks_.assign(9 * dofs_.size(), 0.0);
+    for (std::size_t k = 0; k < dofs_.size(); ++k) blocks_[9 * k] = 1.0;
+  }
+  // After bonds have broken, the same shift of the diagonal as the direct path (see
+  // solve_equilibrium): kDiagonalShift × the largest diagonal entry of K, here of its blocks.
+  double shift = 0.0;
+  if (broken_since_start_) {
+    double largest = 0.0;
+    for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
+      for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a)
+        largest = std::max(largest, std::fabs(blocks_[9 * g + static_cast<std::size_t>(4 * a)]));
+    shift = kDiagonalShift * largest;
+    for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
+      for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a) blocks_[9 * g + static_cast<std::size_t>(4 * a)] += shift;
+  }
+  preconditioner_.build(block_first_, blocks_);
+  // K x = −V ∂f/∂u·x over the free dofs (x zero at the prescribed components) + shift·x.
+  const LinearOperator K = [&](const std::vector<double>& x, std::vector<double>& y) {
+    dofs_.scatter(x, cg_x_);
+    op_.apply_jacobian(s, t1, cg_x_, cg_y_);
+    y.resize(x.size());
+    const auto n = static_cast<std::int64_t>(dofs_.size());
+#pragma omp parallel for schedule(static) if (n >= 32768)
+    for (std::int64_t k = 0; k < n; ++k) {
+      const auto q = static_cast<std::size_t>(k);
+      const auto i = static_cast<std::size_t>(dofs_.node[q]);
+      y[q] = -volume[i] * cg_y_[dofs_.component[q]][i] + shift * x[q];
+    }
+  };
+  PcgSettings settings;
+  settings.relative_tol = eta;
+  settings.absolute_tol = floor;
+  settings.max_iterations = settings_.cg_max_iterations;
+  correction_.clear();  // CG from Δu = 0
+  const PcgResult result = preconditioned_cg(K, preconditioner_, rhs_, correction_, settings);
+  cg_iterations_ += result.iterations;
+  ++cg_solves_;
+  report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
+  if (result.status == PcgResult::kIndefinite && result.iterations == 0) {
+    // Negative curvature along the first direction: the preconditioned residual, a descent
+    // direction of the energy, scaled by the line search (Steihaug's first step).
+    preconditioner_.apply(rhs_, correction_);
+    return true;
+  }
+  if (result.status == PcgResult::kNotConverged && !(result.residual < result.initial_residual)) {
+    cg_failure_ = result.message();
+    return false;
+  }
+  return true;
 }
 
 double QuasiStatic::residual_norm(const State& s) const {
@@ -156,6 +258,7 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
 
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
   double previous = HUGE_VAL;
+  double eta = kEtaMax;  // the forcing term of the matrix-free path
   for (int k = 1; k <= settings_.max_iterations; ++k) {
     op_.evaluate(s, t1);
     ++report_.force_evaluations;
@@ -169,7 +272,7 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       return true;
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew.
-    if (!have_factor_ || residual > 0.25 * previous) {
+    if (!use_cg_ && (!have_factor_ || residual > 0.25 * previous)) {
       // Once bonds have broken, a node or a fragment may hang by nothing: its rows are zero and K
       // is singular although the residual does not drive it. A shift of the diagonal by
       // kDiagonalShift × its largest entry lets it be factorised; the residual, not K, decides
@@ -192,7 +295,6 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
         return false;
       }
     }
-    previous = residual;
     // K Δu = V f at the free components.
     const auto& volume = op_.model().nodes.volume;
     rhs_.resize(dofs_.size());
@@ -200,10 +302,25 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       const auto i = static_cast<std::size_t>(dofs_.node[q]);
       rhs_[q] = volume[i] * s.f[dofs_.component[q]][i];
     }
-    const auto solve_start = std::chrono::steady_clock::now();
-    factor_.solve(rhs_, correction_);
-    solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
-    ++solves_;
+    if (use_cg_) {
+      // Eisenstat–Walker choice 2: η_k = γ (‖F_k‖/‖F_{k−1}‖)², γ = 0.9, kept ≥ γ η_{k−1}² when that is
+      // above 0.1 (so that η does not fall too fast), ≤ kEtaMax; and no tighter than half the
+      // equilibrium tolerance asks of this residual (Kelley 1995, eq. 6.20).
+      if (std::isfinite(previous)) {
+        const double ratio = residual / previous, safeguard = 0.9 * eta * eta;
+        eta = 0.9 * ratio * ratio;
+        if (safeguard > 0.1) eta = std::max(eta, safeguard);
+        eta = std::min(eta, kEtaMax);
+      }
+      const double floor = 0.5 * settings_.residual_tol * load;
+      if (!solve_krylov(s, t1, eta, floor)) return false;
+    } else {
+      const auto solve_start = std::chrono::steady_clock::now();
+      factor_.solve(rhs_, correction_);
+      solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
+      ++solves_;
+    }
+    previous = residual;
     // Backtracking: the full step unless it raises the residual (then ½, ¼, … up to 1/32).
     double alpha = 1.0, step_norm = 0.0, motion = 0.0;
     trial_ = s;
@@ -312,13 +429,19 @@ std::string QuasiStatic::linear_algebra_summary() const {
   char buffer[160];
   std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s", factorisations_,
                 factorise_seconds_, static_cast<long long>(solves_), solve_seconds_);
-  return buffer;
+  if (!use_cg_) return buffer;
+  // On the matrix-free path every CG iteration is one J·x product, about one force evaluation.
+  return std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +
+         std::to_string(cg_iterations_) + " iterations (J·x products)";
 }
 
 std::vector<std::string> QuasiStatic::describe(double) const {
   return {"quasi_static: Newton with line search to residual " + message_number(settings_.residual_tol) +
           " × the load and correction TOL " + message_number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
-          message_number(settings_.p) + "; tangent factorised by CHOLMOD; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
+          message_number(settings_.p) +
+          (use_cg_ ? "; linear solves by matrix-free CG with block-Jacobi, Eisenstat-Walker forcing (cg, "
+                   : "; tangent factorised by CHOLMOD (direct, ") +
+          solver_reason_ + "); load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
           " s, dt_max " + message_number(dt_max_) + " s"};
 }
 

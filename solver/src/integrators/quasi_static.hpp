@@ -16,11 +16,21 @@
 // Φ_K·Δt with Φ_K of eq. 2.8 (control/zohdi.hpp) from the last correction, not larger after a step
 // in which bonds broke; a step that does not converge is redone from t with Δt/2. Velocities are
 // the mean over the load step, (u_{n+1} − u_n)/Δt, so the work ledger integrates the reactions.
+//
+// quasi_static.linear_solver: cg replaces the factorisation by matrix-free preconditioned CG
+// (linalg/pcg.hpp) on K Δu = V f, K x = −V ∂f/∂u·x from ForceOperator::apply_jacobian, with the
+// block-Jacobi preconditioner of K's 3×3 node blocks: an inexact Newton–Krylov iteration. Each
+// linear solve stops at ‖V f − K Δu‖ ≤ η_k ‖V f‖ with the forcing term of Eisenstat & Walker (1996,
+// choice 2), η_k = 0.9 (‖F_k‖/‖F_{k−1}‖)², safeguarded and capped at kEtaMax, and never asked below
+// half the residual tolerance (Kelley 1995, §6.3): Newton's line search and convergence tests are
+// unchanged. It needs no assembled tangent, so contact works; a direction of negative curvature
+// (an indefinite tangent after damage) ends CG with its iterate so far (Steihaug 1983).
 #pragma once
 #include <memory>
 
 #include "integrators/integrator.hpp"
 #include "linalg/cholesky.hpp"
+#include "linalg/pcg.hpp"
 #include "linalg/sparse_matrix.hpp"
 
 namespace pd {
@@ -48,6 +58,11 @@ class QuasiStatic : public Integrator {
   // "N factorisations in X s, M solves in Y s" (wall time of assembling and factorising the tangent,
   // and of the solves with its factor; this process's only: a restarted run counts from the restart).
   std::string linear_algebra_summary() const override;
+  bool uses_cg() const { return use_cg_; }
+  std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
+  int cg_solves() const { return cg_solves_; }
+  // Auto picks cg at or above this many free dofs in 3D (measured: see the .cpp).
+  static constexpr std::size_t kCgFromDofs3d = 20000;
   const QuasiStaticSettings& settings() const { return settings_; }
 
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
@@ -87,6 +102,20 @@ class QuasiStatic : public Integrator {
   bool factor_definite_ = false, factor_shifted_ = false;
   bool factorize_at(const State& s, double t1, bool definite, bool shifted);
   std::string failure_reason_;
+  // The matrix-free path: the choice and why (configure), the correction by PCG at (s, t1) for the
+  // forcing term eta; false when CG made no progress.
+  bool use_cg_ = false;
+  std::string solver_reason_;
+  static constexpr double kEtaMax = 0.1;
+  bool solve_krylov(const State& s, double t1, double eta, double floor);
+  void choose_linear_solver(const Case& c);
+  std::string cg_failure_;
+  BlockJacobi preconditioner_;
+  std::vector<std::int64_t> block_first_;
+  std::vector<double> blocks_, cg_rhs_;
+  Vec3Array cg_x_, cg_y_;
+  std::int64_t cg_iterations_ = 0;
+  int cg_solves_ = 0;
   State trial_;
   std::vector<double> rhs_, correction_;
 };

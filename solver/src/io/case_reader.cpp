@@ -339,6 +339,13 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
                             {"dt_min", &q.dt_min}, {"dt_max", &q.dt_max}})
     if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("quasi_static.") + name);
   if (q.dt_min && q.dt_max && *q.dt_min > *q.dt_max) ck.fail("quasi_static.dt_min", "is larger than quasi_static.dt_max");
+  if (const json* v = ck.optional(j, "linear_solver")) {
+    q.linear_solver = ck.string(*v, "quasi_static.linear_solver");
+    if (q.linear_solver != "auto" && q.linear_solver != "direct" && q.linear_solver != "cg")
+      ck.fail("quasi_static.linear_solver", "unknown value '" + q.linear_solver + "'; known: auto, direct, cg");
+  }
+  if (const json* v = ck.optional(j, "cg_max_iterations"))
+    q.cg_max_iterations = static_cast<int>(ck.integer(*v, "quasi_static.cg_max_iterations", 1, 100000000));
   return q;
 }
 
@@ -429,7 +436,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"cracks[]", {"from", "to"}},
       {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
-      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "dt_initial", "dt_min",
+      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
                     "dt_min", "dt_max"}},

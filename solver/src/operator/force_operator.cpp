@@ -59,18 +59,64 @@ void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x,
   for (const auto& term : terms_) term->add_jacobian_product(s, t, x, y);
 }
 
+bool ForceOperator::has_assembled_stiffness(const State& s, double t) const {
+  const Model& m = model_;
+  if (m.nodes.size() == 0) return true;
+  std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
+  double diagonal[9] = {};
+  if (!m.bond_model->bond_tangent_row(m, s.u, 0, probe.data())) return false;
+  for (const auto& term : terms_)
+    if (!term->add_tangent_diagonal(s, t, 0, diagonal)) return false;
+  return true;
+}
+
+bool ForceOperator::stiffness_diagonal_blocks(const State& s, double t, const FreeDofs& dofs,
+                                              std::vector<std::int64_t>& first, std::vector<double>& blocks) const {
+  const Model& m = model_;
+  const std::size_t n = m.nodes.size();
+  {
+    std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
+    if (n > 0 && !m.bond_model->bond_tangent_row(m, s.u, 0, probe.data(), true)) return false;
+  }
+  // Groups: the nodes with free components, in dof order.
+  first.clear();
+  std::vector<std::int64_t> node_of;
+  for (std::size_t k = 0; k < dofs.size(); ++k)
+    if (k == 0 || dofs.node[k] != dofs.node[k - 1]) first.push_back(static_cast<std::int64_t>(k)), node_of.push_back(dofs.node[k]);
+  first.push_back(static_cast<std::int64_t>(dofs.size()));
+  const auto groups = static_cast<std::int64_t>(node_of.size());
+  blocks.assign(static_cast<std::size_t>(9 * groups), 0.0);
+  const auto& off = m.bonds.offsets;
+#pragma omp parallel
+  {
+    std::vector<double> row;
+#pragma omp for schedule(dynamic, 256)
+    for (std::int64_t g = 0; g < groups; ++g) {
+      const auto i = static_cast<std::size_t>(node_of[static_cast<std::size_t>(g)]);
+      row.assign(static_cast<std::size_t>(9 * (off[i + 1] - off[i])), 0.0);
+      m.bond_model->bond_tangent_row(m, s.u, i, row.data(), true);
+      double diagonal[9] = {};  // ∂f_i/∂u_i = −Σ_j ∂f_i/∂u_j for a bond-based law
+      for (std::size_t b = 0; b < row.size() / 9; ++b)
+        for (int q = 0; q < 9; ++q) diagonal[q] -= row[9 * b + static_cast<std::size_t>(q)];
+      for (const auto& term : terms_) term->add_jacobian_diagonal(s, t, i, diagonal, true);
+      // K's block over the node's free components: −V_i ∂f_i/∂u_i.
+      const auto at = static_cast<std::size_t>(first[static_cast<std::size_t>(g)]);
+      const auto k = static_cast<std::size_t>(first[static_cast<std::size_t>(g) + 1]) - at;
+      double* out = &blocks[9 * static_cast<std::size_t>(g)];
+      for (std::size_t a = 0; a < k; ++a)
+        for (std::size_t b = 0; b < k; ++b)
+          out[3 * a + b] = -m.nodes.volume[i] * diagonal[3 * dofs.component[at + a] + dofs.component[at + b]];
+    }
+  }
+  return true;
+}
+
 SparseMatrix ForceOperator::assemble_stiffness(const State& s, double t, const FreeDofs& dofs, bool definite) const {
   const Model& m = model_;
   const auto n = static_cast<std::int64_t>(m.nodes.size());
   SparseMatrix K;
   K.rows = -1;
-  {  // an assembled form exists only if the law and every active term have one
-    std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
-    double diagonal[9] = {};
-    if (n > 0 && !m.bond_model->bond_tangent_row(m, s.u, 0, probe.data())) return K;
-    for (const auto& term : terms_)
-      if (n > 0 && !term->add_tangent_diagonal(s, t, 0, diagonal)) return K;
-  }
+  if (!has_assembled_stiffness(s, t)) return K;  // an assembled form exists only if the law and every term have one
   const auto& off = m.bonds.offsets;
   const auto dof = [&](std::size_t node, int d) { return dofs.index[3 * node + static_cast<std::size_t>(d)]; };
   // Pass 1: the pattern. Row (i, d) has a column for every free component of i and of its bonded
