@@ -46,6 +46,13 @@ def micromodulus(analysis: str, youngs_modulus: float, horizon: float, thickness
     raise ValueError(f"unknown analysis {analysis!r}")
 
 
+def block_micromodulus(case: dict, material: dict, horizon: float) -> float:
+    """c of one material of a validated case: given directly (micromodulus), or from E (F1)."""
+    if material.get("micromodulus") is not None:
+        return float(material["micromodulus"])
+    return micromodulus(case["analysis"], material["youngs_modulus"], horizon, case["thickness"])
+
+
 def contact_stiffness_factor(resolved: dict, block: np.ndarray) -> float | None:
     """c_s/c when the solver will compute contact pairs for this case and cloud, else None
     (solver/src/core/work_plan.cpp plan_contact: on; or auto with several blocks or self_contact)."""
@@ -99,8 +106,7 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
     step the solver's run.log reports before the safety factor (`pdsolve --stable-dt`)."""
     names = list(case["materials"])
     horizon = float(resolved["horizon"])
-    c = np.array([micromodulus(case["analysis"], case["materials"][n]["youngs_modulus"], horizon,
-                               case["thickness"]) for n in names])
+    c = np.array([block_micromodulus(case, case["materials"][n], horizon) for n in names])
     c_pair = 0.5 * (c[:, None] + c[None, :])
     density = np.array([case["materials"][n]["density"] for n in names], dtype=np.float64)
     block = np.asarray(cloud.block, dtype=np.int64)
@@ -146,7 +152,7 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
         if m["density"] < LOW_DENSITY:
             warnings.append(f"{_where(case, 'materials', name, 'density')}: {m['density']:g} kg/m³ is lighter "
                             f"than most foams; was it given in g/cm³? (SI: kg/m³, e.g. 7850 for steel)")
-        if m["youngs_modulus"] < LOW_MODULUS:
+        if m["youngs_modulus"] is not None and m["youngs_modulus"] < LOW_MODULUS:
             warnings.append(f"{_where(case, 'materials', name, 'youngs_modulus')}: {m['youngs_modulus']:g} Pa "
                             f"is softer than rubber; was it given in MPa or GPa? (SI: Pa, e.g. 2.1e11 for steel)")
 
@@ -176,7 +182,8 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
     m = case["materials"][material]
     origin = (f"thesis eq. 2.5 gives a stable step of {dt_stable:.3g} s at node {node} {_fmt(points[node])}, "
               f"from material '{material}' ({_where(case, 'materials', material)}): ρ = {m['density']:g} kg/m³, "
-              f"E = {m['youngs_modulus']:g} Pa, with horizon {horizon:.6g} m")
+              + (f"E = {m['youngs_modulus']:g} Pa" if m["youngs_modulus"] is not None
+                 else f"c = {m['micromodulus']:g} N/m⁶") + f", with horizon {horizon:.6g} m")
     units = "check the units (SI: kg/m³, Pa, m, s)"
     steps = end / dt
     if steps > MAX_STEPS:

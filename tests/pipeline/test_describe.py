@@ -58,6 +58,8 @@ discretization:
 materials:
   plate: {density: 2000, youngs_modulus: 1.0e9, fracture_energy: 10}
   disk: {density: 7800, youngs_modulus: 2.0e11}
+  rod: {density: 2440, micromodulus: 3.4e21, critical_stretch: 0.001, critical_stretch_alpha: 0.25}
+breaking_order: lammps
 no_fail: [left]
 boundary_conditions:
   - {set: left, displacement: {x: 0}, velocity: {y: [[0, 0], [1, 1]]}, body_force: {z: 1}}

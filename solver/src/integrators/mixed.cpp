@@ -59,6 +59,7 @@ void Mixed::step(State& state, double& t, double& dt) {
   int evaluations = 0, rejected = 0;
   if (mode_ == kQuasiStatic) {
     broken_before_ = op_.model().bonds.broken;
+    critical_before_ = op_.model().node_critical_stretch;  // LAMMPS's per-node s0 (empty unless α > 0)
     static_dt_ = dt;
     try {
       static_.step(state, t, dt);
@@ -72,6 +73,7 @@ void Mixed::step(State& state, double& t, double& dt) {
       // Back to the last equilibrium: the state is that of t (step() leaves it so), the bonds
       // broken in the attempt heal, and the tangent they were in is forgotten.
       op_.model().bonds.broken = broken_before_;
+      op_.model().node_critical_stretch = critical_before_;
       static_.forget_factorisation();
       evaluations = static_.last_step().force_evaluations;
       rejected = static_.last_step().rejected + 1;

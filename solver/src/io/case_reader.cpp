@@ -170,6 +170,14 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
     const json* value = p.required ? &ck.required(j, p.name, key) : ck.optional(j, p.name);
     if (!value || (!p.required && value->is_null())) continue;
     const double v = ck.number(*value, key);
+    if (p.lower_inclusive) {
+      if (!(v >= p.lower && v < p.upper))
+        ck.fail(key, "must be at least " + show(json(p.lower)) +
+                         (std::isinf(p.upper) ? std::string() : " and below " + show(json(p.upper))) + ", got " +
+                         show(*value));
+      b.parameters[p.name] = v;
+      continue;
+    }
     if (p.lower == 0.0 && std::isinf(p.upper)) {
       b.parameters[p.name] = ck.positive(*value, key);
       continue;
@@ -179,6 +187,9 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
                        show(*value));
     b.parameters[p.name] = v;
   }
+  if (law.check)
+    if (const ParameterProblem problem = law.check(b); !problem.key.empty())
+      ck.fail(where + "." + problem.key, problem.message);
   return b;
 }
 
@@ -369,7 +380,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "mixed", "output", "figures", "partial_volume", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "mixed", "output", "figures", "partial_volume", "breaking_order", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -444,6 +455,13 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
               "is '" + c.blocks[k].model + "' but blocks[0] is '" + c.blocks[0].model +
                   "': every block of a case must use the same material model");
 
+  if (const json* j = ck.optional(root, "breaking_order")) {
+    c.breaking_order = ck.string(*j, "breaking_order");
+    if (c.breaking_order != "thesis" && c.breaking_order != "lammps")
+      ck.fail("breaking_order", "unknown order '" + c.breaking_order + "'; known: thesis, lammps");
+    if (c.breaking_order == "lammps" && c.blocks[0].model != "pmb")
+      ck.fail("breaking_order", "lammps is LAMMPS peri/pmb's order, for model pmb; blocks use '" + c.blocks[0].model + "'");
+  }
   if (const json* j = ck.optional(root, "no_fail_sets")) c.no_fail_sets = ck.strings(*j, "no_fail_sets");
   if (const json* j = ck.optional(root, "node_sets")) c.node_sets = ck.strings(*j, "node_sets");
   if (const json* j = ck.optional(root, "boundary_conditions"))

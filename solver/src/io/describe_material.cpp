@@ -20,7 +20,8 @@ nlohmann::json describe_material_keys() {
     for (const MaterialParameter& p : material_registry().get(model).parameters) {
       nlohmann::json& key = keys[p.name];
       if (key.is_null()) {
-        key = {{"type", "number"}, {"unit", p.unit}, {"above", p.lower}, {"models", nlohmann::json::array()}};
+        key = {{"type", "number"}, {"unit", p.unit}, {p.lower_inclusive ? "minimum" : "above", p.lower},
+               {"models", nlohmann::json::array()}};
         if (p.required) key["required"] = true;
         else key["default"] = nullptr;
         if (std::isfinite(p.upper)) key["below"] = p.upper;

@@ -20,6 +20,10 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
   Integrator& integrator = *p.integrator;
   const std::size_t n = model.nodes.size();
+  // The per-node critical stretch of LAMMPS's α rule is state a checkpoint does not hold yet.
+  if (!model.node_critical_stretch.empty())
+    throw Error(opt.restart.string() + ": a restart cannot continue a run with critical_stretch_alpha > 0 (the "
+                "per-node critical stretch is not in the checkpoint); run it from the start");
   Checkpoint checkpoint = read_checkpoint(opt.restart);
   const std::string where = opt.restart.string() + ": ";
   if (checkpoint.case_hash != s.case_hash)

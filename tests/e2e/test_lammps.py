@@ -1,0 +1,222 @@
+"""One LAMMPS peri/pmb deck reproduced side by side (docs/lammps.md): a small brick pulled apart
+at both ends, run by Debian's LAMMPS (`lmp`) and by our pipeline from the equivalent case file.
+
+The two inputs say the same thing in each code's words: a simple-cubic lattice through the origin
+(discretization.origin, LAMMPS's `lattice sc`), the horizon and LAMMPS's partial volumes
+(partial_volume: lammps), c and s00 given directly (micromodulus, critical_stretch), LAMMPS's
+critical-stretch rule (critical_stretch_alpha) and its breaking order (breaking_order: lammps),
+the end layers moving at a constant velocity (LAMMPS: velocity + fix setforce 0 0 0).
+
+- Until the first bond breaks the deformation is linear, and the positions agree to round-off:
+  LAMMPS integrates x, we integrate u = x − X, so the last bits differ.
+- Then both codes break bonds by the same rule. With breaking_order: lammps the same bonds break in
+  the same steps (on this deck through the whole fracture: no stretch lands within round-off of its
+  threshold); with the thesis order (a bond over s0 gives no force in the step it breaks) the
+  positions depart from LAMMPS's at the first break and the damage follows.
+
+Skips when the `lmp` binary is absent (Debian's `lammps` package: pipeline/install-deps.sh, which
+`make test` runs, installs it); installs nothing itself.
+"""
+import os
+import shutil
+import subprocess
+import textwrap
+
+import meshio
+import numpy as np
+import pytest
+import yaml
+
+from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
+
+LMP = shutil.which("lmp")
+pytestmark = pytest.mark.skipif(
+    LMP is None, reason="LAMMPS is not installed (no `lmp` on PATH): Debian's `lammps` package; "
+    "`sh pipeline/install-deps.sh` (run by make test) installs it")
+
+DX = 1.0e-3                      # lattice constant a [m]
+NX, NY, NZ = 16, 5, 5            # nodes per axis: LAMMPS's atoms at k·a, k = 0 … N − 1
+HORIZON = 3.0002 * DX            # δ, as in LAMMPS's PERI examples (just over 3a)
+MICROMODULUS = 3.3936e21         # c [N/m⁶] (about 12E/(πδ⁴) for E = 72 GPa)
+S00 = 1.0e-3                     # critical stretch s00
+ALPHA = 0.25                     # α of s0_i = s00 − α·min_j s_ij (LAMMPS's PERI examples)
+DENSITY = 2440.0                 # [kg/m³]
+SPEED = 1.0                      # end layers at ∓SPEED in x [m/s]
+DT = 5.0e-8                      # [s], about a quarter of a/c_wave
+STEPS = 300
+EVERY = 10                       # a frame / a dump every EVERY steps
+
+
+def lammps_deck():
+    hi = [n - 0.5 for n in (NX, NY, NZ)]
+    return textwrap.dedent(f"""\
+        units si
+        boundary s s s
+        atom_style peri
+        atom_modify map array
+        lattice sc {DX!r}
+        region box block -0.5 {hi[0]} -0.5 {hi[1]} -0.5 {hi[2]}
+        create_box 1 box
+        create_atoms 1 region box
+        pair_style peri/pmb
+        pair_coeff * * {MICROMODULUS!r} {HORIZON!r} {S00!r} {ALPHA!r}
+        set group all density {DENSITY!r}
+        set group all volume {DX ** 3!r}
+        region left block INF 0.5 INF INF INF INF
+        region right block {NX - 1.5} INF INF INF INF INF
+        group left region left
+        group right region right
+        velocity left set {-SPEED!r} 0.0 0.0 units box
+        velocity right set {SPEED!r} 0.0 0.0 units box
+        fix hold_left left setforce 0.0 0.0 0.0
+        fix hold_right right setforce 0.0 0.0 0.0
+        fix move all nve
+        neighbor {0.3 * DX!r} bin
+        neigh_modify every 1 delay 0 check yes
+        compute damage all damage/atom
+        timestep {DT!r}
+        dump positions all custom {EVERY} dump.txt id x y z c_damage
+        dump_modify positions format float %.17g sort id
+        thermo {EVERY}
+        run {STEPS}
+        """)
+
+
+def read_dump(path):
+    """{step: (positions (n, 3), damage (n,))} in atom-id order, from a LAMMPS text dump."""
+    frames, lines = {}, open(path, encoding="utf-8").read().splitlines()
+    k = 0
+    while k < len(lines):
+        assert lines[k] == "ITEM: TIMESTEP"
+        step, count = int(lines[k + 1]), int(lines[k + 3])
+        rows = np.array([[float(v) for v in line.split()] for line in lines[k + 9:k + 9 + count]])
+        frames[step] = (rows[:, 1:4], rows[:, 4])
+        k += 9 + count
+    return frames
+
+
+GEO = f"""\
+SetFactory("OpenCASCADE");
+// The brick LAMMPS's region covers: half a lattice constant beyond the outer atoms on every side.
+Box(1) = {{{-0.5 * DX!r}, {-0.5 * DX!r}, {-0.5 * DX!r}, {NX * DX!r}, {NY * DX!r}, {NZ * DX!r}}};
+e = {1e-3 * DX!r};
+Physical Volume("brick") = {{1}};
+Physical Surface("left") = Surface In BoundingBox{{{-0.5 * DX!r} - e, -1, -1, {-0.5 * DX!r} + e, 1, 1}};
+Physical Surface("right") = Surface In BoundingBox{{{(NX - 0.5) * DX!r} - e, -1, -1, {(NX - 0.5) * DX!r} + e, 1, 1}};
+Mesh.MeshSizeMax = {2 * DX!r};
+"""
+
+
+def our_case(order):
+    return {
+        "title": f"LAMMPS peri/pmb brick, breaking order {order}",
+        "dimension": 3,
+        "discretization": {"dx": DX, "horizon": HORIZON, "origin": [0.0, 0.0, 0.0], "partial_volume": "lammps"},
+        "materials": {"brick": {"density": DENSITY, "micromodulus": MICROMODULUS, "critical_stretch": S00,
+                                "critical_stretch_alpha": ALPHA}},
+        "breaking_order": order,
+        "boundary_conditions": [{"set": "left", "velocity": {"x": -SPEED, "y": 0.0, "z": 0.0}},
+                                {"set": "right", "velocity": {"x": SPEED, "y": 0.0, "z": 0.0}}],
+        "time": {"end": (STEPS + 0.5) * DT, "dt": DT, "max_steps": STEPS},
+        "output": {"every_steps": EVERY, "precision": "float64", "fields": ["displacement", "damage"],
+                   "gmsh": "none"},
+    }
+
+
+def run_ours(work, case_dir, order):
+    name = f"brick_{order}"
+    yaml_path = case_dir / f"{name}.yaml"
+    yaml_path.write_text(yaml.safe_dump(our_case(order)))
+    out = work / name
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    for args in ((PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(case_dir / "brick.geo"), str(out / "mesh.msh")),
+                 (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
+                 (SOLVER, str(out / "case.json"), "--quiet")):
+        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+    frames = {}
+    for k in range(STEPS // EVERY + 1):
+        mesh = meshio.read(out / "frames" / f"frame_{k:06d}.vtu")
+        frames[k * EVERY] = (mesh.points + mesh.point_data["displacement"], mesh.point_data["damage"].ravel(),
+                             mesh.points)
+    return frames
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    work, case_dir = new_case_folder(tmp_path_factory, "lammps", "brick")
+    (case_dir / "brick.geo").write_text(GEO)
+    lammps_dir = work / "lammps"
+    lammps_dir.mkdir()
+    (lammps_dir / "in.brick").write_text(lammps_deck())
+    result = subprocess.run([LMP, "-in", "in.brick", "-log", "log.lammps"], cwd=lammps_dir, capture_output=True,
+                            text=True, timeout=600)
+    assert result.returncode == 0, f"lmp failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    theirs = read_dump(lammps_dir / "dump.txt")
+    ours = {order: run_ours(work, case_dir, order) for order in ("lammps", "thesis")}
+    # Our nodes in LAMMPS's atom order: both sit at k·a, so the reference positions match exactly.
+    start = theirs[0][0]
+    index = {tuple(np.rint(p / DX).astype(int)): i for i, p in enumerate(start)}
+    for order, frames in ours.items():
+        reference = frames[0][2]
+        perm = np.array([index[tuple(np.rint(p / DX).astype(int))] for p in reference])
+        assert len(perm) == len(start) == NX * NY * NZ and len(set(perm)) == len(perm)
+        order_of = np.argsort(perm)  # ours[order_of] is in LAMMPS's order
+        ours[order] = {step: (y[order_of], d[order_of], x[order_of]) for step, (y, d, x) in frames.items()}
+    return theirs, ours
+
+
+def first_damage_step(frames):
+    return min(step for step, (_, damage, *rest) in frames.items() if np.any(damage > 0))
+
+
+def test_the_lattices_are_the_same_points(runs):
+    """discretization.origin puts our nodes where LAMMPS's lattice puts its atoms: bitwise k·a."""
+    theirs, ours = runs
+    assert np.array_equal(ours["lammps"][0][2], theirs[0][0])
+
+
+def test_positions_agree_to_round_off_until_bonds_break(runs):
+    theirs, ours = runs
+    first = min(first_damage_step(theirs), first_damage_step(ours["lammps"]))
+    assert first > 5 * EVERY, "bonds break too early for a linear stretch to compare"
+    length = (NX - 1) * DX
+    worst = 0.0
+    for step in sorted(theirs):
+        if step >= first:
+            break
+        worst = max(worst, float(np.max(np.abs(ours["lammps"][step][0] - theirs[step][0]))) / length)
+        # the thesis order is the same motion while nothing breaks
+        assert np.array_equal(ours["thesis"][step][0], ours["lammps"][step][0])
+    print(f"first damage at step {first}; max |Δx|/L before it: {worst:.3e}")
+    assert worst < 1e-13
+
+
+def test_with_the_lammps_order_the_whole_run_is_lammps_s(runs):
+    """breaking_order: lammps with LAMMPS's α rule: the same bonds break in the same steps, so the
+    damage is the same at every frame and the positions stay within round-off through the fracture
+    (measured: 5.9e-15 of the length at step 300, damage equal at all 31 frames)."""
+    theirs, ours = runs
+    length = (NX - 1) * DX
+    assert np.sum(theirs[STEPS][1]) > 10.0  # the brick has broken: this is a fracture, not elasticity
+    for step in sorted(theirs):
+        y, damage, _ = ours["lammps"][step]
+        assert np.max(np.abs(damage - theirs[step][1])) <= 1e-12, f"damage differs at step {step}"
+        assert np.max(np.abs(y - theirs[step][0])) / length < 1e-13, f"positions differ at step {step}"
+
+
+def test_with_the_thesis_order_the_run_departs_from_lammps_at_the_first_break(runs):
+    """breaking_order: thesis drops a bond's force in the step it breaks, a step before LAMMPS
+    does: the positions depart from LAMMPS's at the first break and the damage follows."""
+    theirs, ours = runs
+    first = first_damage_step(theirs)
+    length = (NX - 1) * DX
+    departed = {step: float(np.max(np.abs(ours["thesis"][step][0] - theirs[step][0]))) / length
+                for step in sorted(theirs)}
+    damage_differs = [step for step in sorted(theirs)
+                      if np.max(np.abs(ours["thesis"][step][1] - theirs[step][1])) > 1e-12]
+    print(f"thesis order: max |Δx|/L {departed[first]:.2e} at step {first}, {max(departed.values()):.2e} at most; "
+          f"damage differs at steps {damage_differs}")
+    assert all(departed[step] < 1e-13 for step in departed if step < first)
+    assert departed[first] > 1e-9
+    assert damage_differs and min(damage_differs) > first
