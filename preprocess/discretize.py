@@ -177,7 +177,7 @@ def _lattice(mesh, points, top, dimension, dx, thickness, elem_block, lattice_or
     lo, hi = points[used].min(axis=0), points[used].max(axis=0)
     first = None  # lattice index of cell 0 per axis, counted from lattice_origin
     if lattice_origin is not None:
-        anchor = np.asarray(lattice_origin, dtype=np.float64)[:dimension]
+        anchor = np.asarray(lattice_origin, dtype=np.float64).ravel()
         if len(anchor) != dimension:
             raise PreprocessError(f"{path}: the lattice origin needs {dimension} coordinates, got {len(anchor)}")
         # Cells of width dx centred on anchor + k·dx; cell `first` holds lo, and the cells from it
