@@ -17,6 +17,7 @@ the end layers moving at a constant velocity (LAMMPS: velocity + fix setforce 0 
 Skips when the `lmp` binary is absent (Debian's `lammps` package: pipeline/install-deps.sh, which
 `make test` runs, installs it); installs nothing itself.
 """
+import csv
 import os
 import shutil
 import subprocess
@@ -78,8 +79,24 @@ def lammps_deck():
         dump positions all custom {EVERY} dump.txt id x y z c_damage
         dump_modify positions format float %.17g sort id
         thermo {EVERY}
+        thermo_style custom step pe ke
+        thermo_modify format float %.17g
         run {STEPS}
         """)
+
+
+def read_thermo(text):
+    """{step: (pe, ke)} from LAMMPS's screen output (thermo_style custom step pe ke)."""
+    rows, on = {}, False
+    for line in text.splitlines():
+        words = line.split()
+        if words[:3] == ["Step", "PotEng", "KinEng"]:
+            on = True
+        elif on and len(words) == 3 and words[0].isdigit():
+            rows[int(words[0])] = (float(words[1]), float(words[2]))
+        else:
+            on = False
+    return rows
 
 
 def read_dump(path):
@@ -134,7 +151,9 @@ def run_ours(work, case_dir, order):
                  (SOLVER, str(out / "case.json"), "--quiet")):
         result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
         assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
-    frames = {}
+    with open(out / "history.csv", encoding="utf-8") as stream:
+        history = {int(row["step"]): row for row in csv.DictReader(stream)}
+    frames = {"history": history}
     for k in range(STEPS // EVERY + 1):
         mesh = meshio.read(out / "frames" / f"frame_{k:06d}.vtu")
         frames[k * EVERY] = (mesh.points + mesh.point_data["displacement"], mesh.point_data["damage"].ravel(),
@@ -153,7 +172,10 @@ def runs(tmp_path_factory):
                             text=True, timeout=600)
     assert result.returncode == 0, f"lmp failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     theirs = read_dump(lammps_dir / "dump.txt")
+    theirs_thermo = read_thermo(result.stdout)
     ours = {order: run_ours(work, case_dir, order) for order in ("lammps", "thesis")}
+    history = ours["lammps"].pop("history")
+    ours["thesis"].pop("history")
     # Our nodes in LAMMPS's atom order: both sit at k·a, so the reference positions match exactly.
     start = theirs[0][0]
     index = {tuple(np.rint(p / DX).astype(int)): i for i, p in enumerate(start)}
@@ -163,7 +185,7 @@ def runs(tmp_path_factory):
         assert len(perm) == len(start) == NX * NY * NZ and len(set(perm)) == len(perm)
         order_of = np.argsort(perm)  # ours[order_of] is in LAMMPS's order
         ours[order] = {step: (y[order_of], d[order_of], x[order_of]) for step, (y, d, x) in frames.items()}
-    return theirs, ours
+    return theirs, ours, (theirs_thermo, history)
 
 
 def first_damage_step(frames):
@@ -172,12 +194,12 @@ def first_damage_step(frames):
 
 def test_the_lattices_are_the_same_points(runs):
     """discretization.origin puts our nodes where LAMMPS's lattice puts its atoms: bitwise k·a."""
-    theirs, ours = runs
+    theirs, ours, _ = runs
     assert np.array_equal(ours["lammps"][0][2], theirs[0][0])
 
 
 def test_positions_agree_to_round_off_until_bonds_break(runs):
-    theirs, ours = runs
+    theirs, ours, _ = runs
     first = min(first_damage_step(theirs), first_damage_step(ours["lammps"]))
     assert first > 5 * EVERY, "bonds break too early for a linear stretch to compare"
     length = (NX - 1) * DX
@@ -196,7 +218,7 @@ def test_with_the_lammps_order_the_whole_run_is_lammps_s(runs):
     """breaking_order: lammps with LAMMPS's α rule: the same bonds break in the same steps, so the
     damage is the same at every frame and the positions stay within round-off through the fracture
     (measured: 5.9e-15 of the length at step 300, damage equal at all 31 frames)."""
-    theirs, ours = runs
+    theirs, ours, _ = runs
     length = (NX - 1) * DX
     assert np.sum(theirs[STEPS][1]) > 10.0  # the brick has broken: this is a fracture, not elasticity
     for step in sorted(theirs):
@@ -208,7 +230,7 @@ def test_with_the_lammps_order_the_whole_run_is_lammps_s(runs):
 def test_with_the_thesis_order_the_run_departs_from_lammps_at_the_first_break(runs):
     """breaking_order: thesis drops a bond's force in the step it breaks, a step before LAMMPS
     does: the positions depart from LAMMPS's at the first break and the damage follows."""
-    theirs, ours = runs
+    theirs, ours, _ = runs
     first = first_damage_step(theirs)
     length = (NX - 1) * DX
     departed = {step: float(np.max(np.abs(ours["thesis"][step][0] - theirs[step][0]))) / length
@@ -220,3 +242,18 @@ def test_with_the_thesis_order_the_run_departs_from_lammps_at_the_first_break(ru
     assert all(departed[step] < 1e-13 for step in departed if step < first)
     assert departed[first] > 1e-9
     assert damage_differs and min(damage_differs) > first
+
+
+def test_energies_are_lammps_s_thermo_times_the_node_volume(runs):
+    """LAMMPS's pe and ke sum energy densities over atoms (rmass is ρ, f a force density): times
+    V = a³ they are our strain_energy and kinetic_energy [J], step by step through the fracture
+    (measured: 7.8e-12 and 6.1e-12 relative at most; the stretch s ~ 1e-3 carries the positions'
+    round-off of ~1e-15 relative into s² at ~1e-12)."""
+    _, _, (thermo, history) = runs
+    volume = DX ** 3
+    assert sorted(thermo) == list(range(0, STEPS + 1, EVERY))
+    for step, (pe, ke) in thermo.items():
+        ours = history[step]
+        strain, kinetic = float(ours["strain_energy"]), float(ours["kinetic_energy"])
+        assert pe * volume == pytest.approx(strain, rel=1e-10, abs=1e-30), step
+        assert ke * volume == pytest.approx(kinetic, rel=1e-10), step
