@@ -14,6 +14,8 @@ the end layers moving at a constant velocity (LAMMPS: velocity + fix setforce 0 
   threshold); with the thesis order (a bond over s0 gives no force in the step it breaks) the
   positions depart from LAMMPS's at the first break and the damage follows.
 
+A second deck (two bricks colliding) holds our contact section to LAMMPS's short-range force.
+
 Skips when the `lmp` binary is absent (Debian's `lammps` package: pipeline/install-deps.sh, which
 `make test` runs, installs it); installs nothing itself.
 """
@@ -269,3 +271,112 @@ def test_a_run_with_alpha_refuses_to_restart(runs):
     assert result.returncode != 0
     assert ("none.bin: a restart cannot continue a run with critical_stretch_alpha > 0 (the per-node critical "
             "stretch is not in the checkpoint); run it from the start") in result.stderr
+
+
+# -- Contact: two bricks collide -------------------------------------------------------------------
+# LAMMPS peri/pmb's short-range force (15·c·V_j·(r − d)/δ for r < d = min(0.9·r0, 1.35a), on every
+# neighbour pair) against our contact section (stiffness_factor 15, d = 1.35dx between blocks): two
+# unbreakable 6 × 4 × 4 bricks 4a apart (more than δ: no bond between them), one flying at the
+# other at 100 m/s, closing to within 1.35a and bouncing back.
+HIT_N = 6           # layers per brick along x
+HIT_GAP = 4         # lattice constants between the facing layers
+HIT_SPEED = 100.0   # [m/s]
+HIT_STEPS = 1000
+HIT_EVERY = 20
+
+
+def collision_deck():
+    b0, b1, hi_y, hi_z = HIT_N - 1 + HIT_GAP - 0.5, 2 * HIT_N + HIT_GAP - 1.5, NY - 0.5, NZ - 0.5
+    return textwrap.dedent(f"""\
+        units si
+        boundary s s s
+        atom_style peri
+        atom_modify map array
+        lattice sc {DX!r}
+        region box block -0.5 {b1} -0.5 {hi_y} -0.5 {hi_z}
+        create_box 1 box
+        region a block -0.5 {HIT_N - 0.5} -0.5 {hi_y} -0.5 {hi_z}
+        region b block {b0} {b1} -0.5 {hi_y} -0.5 {hi_z}
+        create_atoms 1 region a
+        create_atoms 1 region b
+        pair_style peri/pmb
+        pair_coeff * * {MICROMODULUS!r} {HORIZON!r} 1.0 0.0
+        set group all density {DENSITY!r}
+        set group all volume {DX ** 3!r}
+        group b region b
+        velocity b set {-HIT_SPEED!r} 0.0 0.0 units box
+        fix move all nve
+        neighbor {0.3 * DX!r} bin
+        neigh_modify every 1 delay 0 check yes
+        compute damage all damage/atom
+        timestep {DT!r}
+        dump positions all custom {HIT_EVERY} dump.txt id x y z c_damage
+        dump_modify positions format float %.17g sort id
+        run {HIT_STEPS}
+        """)
+
+
+def collision_case():
+    return {
+        "title": "two bricks collide (LAMMPS peri/pmb short-range force)",
+        "dimension": 3,
+        "discretization": {"dx": DX, "horizon": HORIZON, "origin": [0.0, 0.0, 0.0], "partial_volume": "lammps"},
+        "materials": {"a": {"density": DENSITY, "micromodulus": MICROMODULUS},
+                      "b": {"density": DENSITY, "micromodulus": MICROMODULUS}},
+        "initial_conditions": [{"set": "b", "velocity": {"x": -HIT_SPEED}}],
+        "contact": {"enabled": "on", "stiffness_factor": 15.0},
+        "time": {"end": (HIT_STEPS + 0.5) * DT, "dt": DT, "max_steps": HIT_STEPS},
+        "output": {"every_steps": HIT_EVERY, "precision": "float64", "fields": ["displacement"], "gmsh": "none"},
+    }
+
+
+@pytest.fixture(scope="module")
+def collision(tmp_path_factory):
+    work, case_dir = new_case_folder(tmp_path_factory, "lammps_hit", "hit")
+    b0 = (HIT_N - 1 + HIT_GAP - 0.5) * DX
+    (case_dir / "hit.geo").write_text(textwrap.dedent(f"""\
+        SetFactory("OpenCASCADE");
+        Box(1) = {{{-0.5 * DX!r}, {-0.5 * DX!r}, {-0.5 * DX!r}, {HIT_N * DX!r}, {NY * DX!r}, {NZ * DX!r}}};
+        Box(2) = {{{b0!r}, {-0.5 * DX!r}, {-0.5 * DX!r}, {HIT_N * DX!r}, {NY * DX!r}, {NZ * DX!r}}};
+        Physical Volume("a") = {{1}};
+        Physical Volume("b") = {{2}};
+        Mesh.MeshSizeMax = {2 * DX!r};
+        """))
+    lammps_dir = work / "lammps"
+    lammps_dir.mkdir()
+    (lammps_dir / "in.hit").write_text(collision_deck())
+    result = subprocess.run([LMP, "-in", "in.hit", "-log", "none"], cwd=lammps_dir, capture_output=True, text=True,
+                            timeout=600)
+    assert result.returncode == 0, f"lmp failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    theirs = read_dump(lammps_dir / "dump.txt")
+    yaml_path = case_dir / "hit.yaml"
+    yaml_path.write_text(yaml.safe_dump(collision_case()))
+    out = work / "hit"
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    for args in ((PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(case_dir / "hit.geo"), str(out / "mesh.msh")),
+                 (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
+                 (SOLVER, str(out / "case.json"), "--quiet")):
+        done = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, f"{' '.join(args)} failed:\n{done.stdout}\n{done.stderr}"
+    start = theirs[0][0]
+    index = {tuple(np.rint(p / DX).astype(int)): i for i, p in enumerate(start)}
+    ours = {}
+    for k in range(HIT_STEPS // HIT_EVERY + 1):
+        mesh = meshio.read(out / "frames" / f"frame_{k:06d}.vtu")
+        perm = np.array([index[tuple(np.rint(p / DX).astype(int))] for p in mesh.points])
+        y = np.empty_like(mesh.points)
+        y[perm] = mesh.points + mesh.point_data["displacement"]
+        ours[k * HIT_EVERY] = y
+    return theirs, ours, start[:, 0] > b0
+
+
+def test_the_contact_force_is_lammps_s_short_range_force(collision):
+    theirs, ours, in_b = collision
+    length = (2 * HIT_N + HIT_GAP - 1) * DX
+    gap = {step: float(np.min(y[in_b, 0]) - np.max(y[~in_b, 0])) / DX for step, (y, _) in theirs.items()}
+    closest = min(gap, key=gap.get)
+    worst = max(float(np.max(np.abs(ours[step] - y))) / length for step, (y, _) in theirs.items())
+    print(f"collision: closest gap {gap[closest]:.3f}a at step {closest}; max |Δx|/L {worst:.2e}")
+    assert gap[closest] < 1.35  # the bricks came within LAMMPS's (and our) contact distance ...
+    assert gap[HIT_STEPS] > gap[closest] + 0.5  # ... and bounced back
+    assert worst < 1e-13  # measured 1.1e-14
