@@ -20,10 +20,6 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
   Integrator& integrator = *p.integrator;
   const std::size_t n = model.nodes.size();
-  // The per-node critical stretch of LAMMPS's α rule is state a checkpoint does not hold yet.
-  if (!model.node_critical_stretch.empty())
-    throw Error(opt.restart.string() + ": a restart cannot continue a run with critical_stretch_alpha > 0 (the "
-                "per-node critical stretch is not in the checkpoint); run it from the start");
   Checkpoint checkpoint = read_checkpoint(opt.restart);
   const std::string where = opt.restart.string() + ": ";
   if (checkpoint.case_hash != s.case_hash)
@@ -33,6 +29,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
     throw Error(where + "the checkpoint belongs to another node file (or " + p.c.nodes_file.string() +
                 " changed since it was written)");
   if (checkpoint.nodes != n || checkpoint.directed_bonds != model.bonds.directed() || checkpoint.broken_flags.size() != model.bonds.directed() ||
+      checkpoint.node_critical_stretch.size() != model.node_critical_stretch.size() ||
       checkpoint.integrator != integrator.name() ||
       (model.contact.pairs && checkpoint.contact_rebuilds > 0 && checkpoint.contact_u_build[0].size() != n))
     throw Error(where + "the checkpoint does not fit this model (" + std::to_string(checkpoint.nodes) + " nodes, " +
@@ -44,6 +41,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   integrator.initialize(s.state, checkpoint.loop.t);
   s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
   model.bonds.broken = std::move(checkpoint.broken_flags);
+  model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
   if (model.contact.pairs)
     model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
                                checkpoint.contact_seconds);
@@ -113,6 +111,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loo
   k.integrator_state = p.integrator->save_state();
   k.state = s.state;
   k.broken_flags = model.bonds.broken;
+  k.node_critical_stretch = model.node_critical_stretch;
   k.contact_rebuilds = model.contact_list.rebuilds();
   k.contact_seconds = model.contact_list.seconds();
   k.contact_u_build = model.contact_list.u_build();
