@@ -78,8 +78,10 @@ $(SOLVER): $(SOLVER_SOURCES) | $(DEPS)
 	cmake --build build/solver -j$(JOBS)
 	@touch $@
 
+# With the mesh at hand (given, or made by an earlier run), material and node-set names are checked
+# against its physical groups too: a misspelt set is caught here, not only at preprocess.
 check: | $(DEPS)
-	$(PY) -m pipeline.run check '$(YAML)'
+	$(PY) -m pipeline.run check '$(YAML)' $(if $(wildcard $(MESH)),'$(MESH)')
 
 # gmsh parameters live in the .yaml; this file changes only when they do.
 $(OUT)/mesh-parameters.json: $(YAML) $(PRE_SOURCES) | $(DEPS)

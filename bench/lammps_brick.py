@@ -1,4 +1,5 @@
-"""The reference code on the bench's brick: LAMMPS's PERI package (pair_style peri/pmb) on the same
+"""The reference code on the bench's brick: LAMMPS's PERI package (pair_style peri/pmb, or peri/lps
+for the linear peridynamic solid with the same K and ν = 1/4, G = 3K/5) on the same
 side³ simple cubic lattice as pd_speed (dx = 1 mm, δ = 3.0002·dx, free faces, the top three layers
 moving down at 0.1 m/s, the same glass-like material), serial and with 2 MPI ranks.
 
@@ -31,6 +32,7 @@ YOUNG, DENSITY, FRACTURE_ENERGY = 72e9, 2440.0, 4.0
 BULK = YOUNG / (3.0 * (1.0 - 2.0 * 0.25))                          # k = E/(3(1−2ν)), ν = 1/4
 MICROMODULUS = micromodulus("3d", YOUNG, HORIZON, None)            # c = 18k/(πδ⁴) (validation.md F1)
 CRITICAL_STRETCH = math.sqrt(5.0 * FRACTURE_ENERGY / (9.0 * BULK * HORIZON))  # s0 = √(5G0/(9kδ))
+SHEAR = YOUNG / (2.0 * (1.0 + 0.25))                               # G = E/(2(1+ν)): peri/lps
 
 
 def lattice_stable_time_step():
@@ -48,9 +50,16 @@ def lattice_stable_time_step():
 TIME_STEP = 0.8 * lattice_stable_time_step()
 
 
-def lammps_input(side, steps):
-    """A LAMMPS input for the side³ brick (lattice units of dx, nodes at 0 … side−1)."""
+def lammps_input(side, steps, model="pmb"):
+    """A LAMMPS input for the side³ brick (lattice units of dx, nodes at 0 … side−1). peri/lps takes
+    K, G, δ, s00, α (its own influence function 1/|ξ|; s0 as PMB's, which LPS's formula gives for
+    ω = 1/|ξ|: materials/lps/lps.hpp)."""
     hi = side - 0.5
+    if model == "lps":
+        pair = (f"pair_style peri/lps\npair_coeff * * {BULK:.10e} {SHEAR:.10e} {HORIZON:.10e} "
+                f"{CRITICAL_STRETCH:.10e} 0.0")
+    else:
+        pair = f"pair_style peri/pmb\npair_coeff * * {MICROMODULUS:.10e} {HORIZON:.10e} {CRITICAL_STRETCH:.10e} 0.0"
     return f"""# written by bench/lammps_brick.py
 units si
 boundary s s s
@@ -60,8 +69,7 @@ lattice sc {DX}
 region box block -0.5 {hi} -0.5 {hi} -0.5 {hi}
 create_box 1 box
 create_atoms 1 region box
-pair_style peri/pmb
-pair_coeff * * {MICROMODULUS:.10e} {HORIZON:.10e} {CRITICAL_STRETCH:.10e} 0.0
+{pair}
 set group all density {DENSITY}
 set group all volume {DX ** 3:.10e}
 region top block INF INF INF INF {side - 3.5} INF
@@ -76,11 +84,11 @@ run {steps}
 """
 
 
-def run_lammps(side, steps, ranks, workdir):
+def run_lammps(side, steps, ranks, workdir, model="pmb"):
     """Loop time [s] and atom count LAMMPS reports for the brick with `ranks` MPI ranks."""
-    path = os.path.abspath(os.path.join(workdir, f"in.brick-{side}"))
+    path = os.path.abspath(os.path.join(workdir, f"in.brick-{side}-{model}"))
     with open(path, "w") as f:
-        f.write(lammps_input(side, steps))
+        f.write(lammps_input(side, steps, model))
     cmd = ["lmp", "-in", path, "-log", "none"]
     if ranks > 1:
         cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)] + cmd
@@ -102,13 +110,14 @@ def main():
     ap.add_argument("--side", type=int, default=40)
     ap.add_argument("--steps", type=int, default=40)
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--model", choices=("pmb", "lps"), default="pmb")
     args = ap.parse_args()
     if available():
         sys.exit(f"lammps_brick.py: {available()} not found: apt-get install lammps openmpi-bin (make bench does)")
     with tempfile.TemporaryDirectory(prefix="pd-lammps-") as tmp:
         for ranks in args.ranks:
-            loop, atoms = run_lammps(args.side, args.steps, ranks, tmp)
-            print(f"LAMMPS peri/pmb, {atoms} atoms, {ranks} rank(s): loop {loop:.3f} s for {args.steps} steps")
+            loop, atoms = run_lammps(args.side, args.steps, ranks, tmp, args.model)
+            print(f"LAMMPS peri/{args.model}, {atoms} atoms, {ranks} rank(s): loop {loop:.3f} s for {args.steps} steps")
 
 
 if __name__ == "__main__":

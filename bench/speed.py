@@ -1,6 +1,7 @@
 """`make bench`: the speed benchmark of issue 6 (a benchmark, not a timed test).
 
-Runs pd_speed (solver/bench/speed.cpp) for each brick size and thread count, one process per run
+Runs pd_speed (solver/bench/speed.cpp) for each brick size, thread count and material model (PMB,
+and LPS beside it with the ratio of their rates per directed bond), one process per run
 so that peak memory is per run, three times each (the fastest counts), writes out/bench/speed.csv and prints, for 1 and 2 threads:
 directed bond updates per second, time per step against N (with its growth exponent, which must
 be ≈ 1), bytes of bond storage per directed bond and peak memory, and set-up time per node.
@@ -27,8 +28,8 @@ import tempfile
 STEPS = {40: 40, 46: 30, 100: 10}  # ~0.1–1 s of loop per run at the target rate
 
 
-def run_speed(exe, side, threads, steps, workdir, nodes=None):
-    extra = ["--nodes", nodes] if nodes else []
+def run_speed(exe, side, threads, steps, workdir, nodes=None, model="pmb"):
+    extra = (["--nodes", nodes] if nodes else []) + ["--model", model]
     out = subprocess.run([exe, "--side", str(side), "--steps", str(steps), "--threads", str(threads),
                           "--dir", workdir] + extra, check=True, capture_output=True, text=True).stdout
     return out.strip().splitlines()[-1]
@@ -64,7 +65,7 @@ def node_order_study(exe, header, side, steps, workdir):
     return rates
 
 
-def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=2):
+def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=2, models=("pmb",)):
     """LAMMPS's PERI package on the same brick (bench/lammps_brick.py), serial and with 2 MPI
     ranks, against pd_speed with 1 and 2 threads: the two codes alternate, `repeats` runs each, and
     the best run of each counts (a busy neighbour slows a run, nothing speeds it up). Rates are
@@ -79,13 +80,14 @@ def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=
     with open(out_csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
-        for workers in threads:
+        for model, workers in [(m, t) for m in models for t in threads]:
             best_ours, best_lammps = None, None
             for _ in range(repeats):
-                ours = dict(zip(header.split(","), run_speed(exe, side, workers, steps, workdir).split(",")))
+                ours = dict(zip(header.split(","), run_speed(exe, side, workers, steps, workdir,
+                                                             model=model).split(",")))
                 if best_ours is None or float(ours["loop_s"]) < float(best_ours["loop_s"]):
                     best_ours = ours
-                loop, atoms = lammps_brick.run_lammps(side, steps, workers, workdir)
+                loop, atoms = lammps_brick.run_lammps(side, steps, workers, workdir, model)
                 if atoms != int(ours["nodes"]):
                     raise RuntimeError(f"LAMMPS made {atoms} atoms, pd_speed {ours['nodes']} nodes: not the same brick")
                 best_lammps = loop if best_lammps is None else min(best_lammps, loop)
@@ -93,11 +95,11 @@ def against_lammps(exe, header, side, steps, threads, out_csv, workdir, repeats=
             rate = directed * steps / best_lammps
             mine = float(best_ours["bond_updates_per_s"])
             load = f"{os.getloadavg()[0]:.2f}"
-            w.writerow(dict(code="lammps peri/pmb", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
+            w.writerow(dict(code=f"lammps peri/{model}", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
                             loop_s=f"{best_lammps:.4f}", bond_updates_per_s=f"{rate:.4e}", load_average=load))
-            w.writerow(dict(code="pdsolve kernel", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
+            w.writerow(dict(code=f"pdsolve kernel {model}", side=side, nodes=best_ours["nodes"], workers=workers, steps=steps,
                             loop_s=best_ours["loop_s"], bond_updates_per_s=f"{mine:.4e}", load_average=load))
-            print(f"  N = {best_ours['nodes']}, {workers} worker(s), best of {repeats}: LAMMPS peri/pmb "
+            print(f"  N = {best_ours['nodes']}, {workers} worker(s), best of {repeats}: LAMMPS peri/{model} "
                   f"({workers} MPI rank(s)) {rate:.3e} directed bond updates/s, ours ({workers} thread(s)) "
                   f"{mine:.3e}: {mine / rate:.1f}× as fast", flush=True)
     print(f"wrote {out_csv}")
@@ -142,6 +144,8 @@ def main():
     ap.add_argument("--sides", type=int, nargs="+", default=[40, 46, 100])
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--out", default="out/bench/speed.csv")
+    ap.add_argument("--models", nargs="+", default=["pmb", "lps"],
+                    help="material models, each on the same bricks (lps: ν = 1/4, ω = 1)")
     ap.add_argument("--quick", action="store_true", help="a quarter of the steps")
     ap.add_argument("--lammps-side", type=int, default=40,
                     help="brick side of the comparison with LAMMPS peri/pmb (0: skip it)")
@@ -156,18 +160,17 @@ def main():
     header = subprocess.run([exe, "--header"], check=True, capture_output=True, text=True).stdout.strip()
     rows = []
     print(f"load average before: {os.getloadavg()[0]:.2f} (wall-clock numbers are only as quiet as the machine)")
-    for side in args.sides:
-        for threads in args.threads:
-            steps = max(2, STEPS.get(side, 10) // (4 if args.quick else 1))
-            # The best of `repeats` runs: on a shared machine a neighbour can only slow a run down.
-            runs = [dict(zip(header.split(","), run_speed(exe, side, threads, steps, workdir).split(",")))
-                    for _ in range(args.repeats)]
-            rows.append(min(runs, key=lambda r: float(r["loop_s"])))
-            r = rows[-1]
-            print(f"  N = {int(r['nodes']):>8}  threads {threads}, best of {args.repeats}: "
-                  f"{float(r['bond_updates_per_s']):.3e} directed bond "
-                  f"updates/s, {1e3 * float(r['step_s']):8.2f} ms/step, set-up {float(r['setup_us_per_node']):.2f} µs/node, "
-                  f"peak {float(r['peak_rss_mb']):.0f} MB", flush=True)
+    for side, threads, model in [(sd, t, m) for sd in args.sides for t in args.threads for m in args.models]:
+        steps = max(2, STEPS.get(side, 10) // (4 if args.quick else 1))
+        # The best of `repeats` runs: on a shared machine a neighbour can only slow a run down.
+        runs = [dict(zip(header.split(","), run_speed(exe, side, threads, steps, workdir, model=model).split(",")))
+                for _ in range(args.repeats)]
+        rows.append(min(runs, key=lambda r: float(r["loop_s"])))
+        r = rows[-1]
+        print(f"  {model:<4} N = {int(r['nodes']):>8}  threads {threads}, best of {args.repeats}: "
+              f"{float(r['bond_updates_per_s']):.3e} directed bond "
+              f"updates/s, {1e3 * float(r['step_s']):8.2f} ms/step, set-up {float(r['setup_us_per_node']):.2f} µs/node, "
+              f"peak {float(r['peak_rss_mb']):.0f} MB", flush=True)
     with open(args.out, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=header.split(",") + ["load_average"])
         w.writeheader()
@@ -176,14 +179,22 @@ def main():
             w.writerow({**r, "load_average": load})
     print(f"wrote {args.out}")
 
+    for side in args.sides:  # LPS beside PMB, per directed bond (issue 14: LPS ≥ 0.5× PMB)
+        for threads in args.threads:
+            pair = {r["model"]: r for r in rows if int(r["side"]) == side and int(r["threads"]) == threads}
+            if "pmb" in pair and "lps" in pair:
+                print(f"side {side}, threads {threads}: LPS/PMB directed bond updates per second "
+                      f"{float(pair['lps']['bond_updates_per_s']) / float(pair['pmb']['bond_updates_per_s']):.2f} (wall), "
+                      f"{float(pair['lps']['bond_updates_per_cpu_s']) / float(pair['pmb']['bond_updates_per_cpu_s']):.2f} (CPU)")
+    rows_pmb = [r for r in rows if r["model"] == "pmb"] or rows
     for threads in args.threads:
-        rs = sorted((r for r in rows if int(r["threads"]) == threads), key=lambda r: int(r["nodes"]))
+        rs = sorted((r for r in rows_pmb if int(r["threads"]) == threads), key=lambda r: int(r["nodes"]))
         if len(rs) >= 2:
             n0, n1 = int(rs[0]["nodes"]), int(rs[-1]["nodes"])
             t0, t1 = float(rs[0]["step_s"]), float(rs[-1]["step_s"])
             print(f"threads {threads}: time per step ∝ N^{math.log(t1 / t0) / math.log(n1 / n0):.3f} "
                   f"from N = {n0} to {n1} (1 = linear)")
-    r = rows[-1]
+    r = rows_pmb[-1]
     print(f"bond storage: {float(r['bond_bytes_per_directed_bond']):.3f} bytes per directed bond "
           f"(4 neighbour + 1 flag + offsets); a 10^7-node brick: ≈ "
           f"{float(r['peak_rss_mb']) / int(r['nodes']) * 1e7 / 1024:.1f} GB at this peak memory per node")
@@ -191,7 +202,7 @@ def main():
     if args.lammps_side:
         against_lammps(exe, header, args.lammps_side,
                        max(2, STEPS.get(args.lammps_side, 10) // (4 if args.quick else 1)), args.threads,
-                       os.path.join(os.path.dirname(args.out), "lammps.csv"), workdir)
+                       os.path.join(os.path.dirname(args.out), "lammps.csv"), workdir, models=args.models)
 
     if args.order_side:
         node_order_study(exe, header, args.order_side,

@@ -7,7 +7,7 @@
 set -eu
 PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev nlohmann-json3-dev zlib1g-dev \
 gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
-python3-pytest python3-vtk9 xvfb clang libclang-rt-14-dev libomp-14-dev lammps"
+python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev lammps"
 missing=""
 for p in $PACKAGES; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

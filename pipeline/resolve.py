@@ -43,6 +43,8 @@ def check_set_names(case: dict, existing: list[str]):
         missing(name, ("node_sets", name))
     for i, name in enumerate(case["output"]["reactions"]):
         missing(name, ("output", "reactions", i))
+    if isinstance(case["figures"]["probe"], str):
+        missing(case["figures"]["probe"], ("figures", "probe"))
     if problems:
         raise CaseError("\n".join(problems))
 

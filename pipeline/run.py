@@ -1,6 +1,6 @@
 """The driver that the Makefile calls for each Python-side stage of a case.
 
-    /usr/bin/python3 -m pipeline.run check CASE.yaml
+    /usr/bin/python3 -m pipeline.run check CASE.yaml [MESH]              # MESH: names against its groups
     /usr/bin/python3 -m pipeline.run mesh-parameters CASE.yaml OUT.json   # rewritten only on change
     /usr/bin/python3 -m pipeline.run mesh CASE.yaml GEO OUT.msh
     /usr/bin/python3 -m pipeline.run preprocess CASE.yaml MESH OUT_DIR    # nodes.vtu + case.json
@@ -19,14 +19,36 @@ import warnings
 
 from .atomic import write_atomically
 from .case import CaseError, load_case
-from .resolve import resolve
+from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
 
 
 def cmd_check(args):
+    """The case file alone; with MESH (make passes it whenever the mesh exists), also its material
+    and node-set names against the mesh's physical groups, as preprocess would check them."""
     case = load_case(args.case)
+    checked = ""
+    if args.mesh:
+        from preprocess import read_mesh
+        from preprocess.discretize import missing_blocks
+
+        mesh = read_mesh(args.mesh)
+        top = [g.name for g in mesh.groups.values() if g.dim == case["dimension"]]
+        missing = missing_blocks(mesh, case["dimension"], list(case["materials"]))
+        problems = []
+        if missing:
+            err = CaseError("")
+            err.missing_blocks, err.top_groups = missing, top
+            problems.append(str(missing_block_error(case, args.mesh, err)))
+        try:
+            check_set_names(case, list(mesh.groups))
+        except CaseError as error:
+            problems.append(str(error))
+        if problems:
+            raise CaseError("\n".join(problems))
+        checked = f"; materials and node sets match the physical groups of {args.mesh}"
     print(f"{args.case}: ok ({case['dimension']}D {case['analysis']}, "
-          f"{len(case['materials'])} block(s), end time {case['time']['end']:g} s)")
+          f"{len(case['materials'])} block(s), end time {case['time']['end']:g} s{checked})")
 
 
 def cmd_mesh_parameters(args):
@@ -102,8 +124,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="pipeline.run", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("check", help="validate a case file")
+    p = sub.add_parser("check", help="validate a case file (and its names against MESH, if given)")
     p.add_argument("case")
+    p.add_argument("mesh", nargs="?", help="the case's mesh, when it exists: its physical groups")
     p.set_defaults(func=cmd_check)
     p = sub.add_parser("mesh-parameters", help="write the gmsh parameters of a case if they changed")
     p.add_argument("case")

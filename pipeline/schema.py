@@ -19,7 +19,8 @@ class Key:
     kind: number | integer | string | choice | section | named (user-named
     sub-sections, e.g. materials) | list (of sections) | names (list of strings) | boolean
     | components (x/y/z → number or [[t, v], ...] table) | numbers (list of
-    numbers) | parameters (name → number) | number_or_choice.
+    numbers) | parameters (name → number) | number_or_choice | point_or_name (a point
+    [x, y] or [x, y, z], or a node-set name).
     """
     kind: str
     doc: str
@@ -46,22 +47,41 @@ COMPONENT_DOC = ("per component x, y, z: a number, or a table [[t0, v0], [t1, v1
                  "interpolated linearly in time and held constant outside it")
 
 MATERIAL = {
-    "model": Key("choice", "constitutive model (bond-based prototype microelastic brittle)",
-                 default="pmb", choices=("pmb",)),
+    "model": Key("choice", "constitutive model: pmb (bond-based prototype microelastic brittle; fixes ν) or "
+                 "lps (linear peridynamic solid, ordinary state-based; any ν)",
+                 default="pmb", choices=("pmb", "lps")),
     "density": Key("number", "mass density ρ", default=REQUIRED, unit="kg/m³", above=0.0),
     "youngs_modulus": Key("number", "Young's modulus E (bond-based PMB fixes ν: 1/4 in 3D and "
-                          "plane strain, 1/3 in plane stress); give it, or micromodulus", default=None,
+                          "plane strain, 1/3 in plane stress); give it, or (pmb) micromodulus", default=None,
                           unit="Pa", above=0.0),
+    "poisson_ratio": Key("number", "Poisson's ratio ν of the isotropic solid; lps only, required there "
+                         "(−1 < ν < 1/2: K and G positive)", default=None, above=-1.0, below=0.5),
     "fracture_energy": Key("number", "critical energy release rate G0, with youngs_modulus; omit for an "
                            "unbreakable material", default=None, unit="J/m²", above=0.0),
-    "micromodulus": Key("number", "the micromodulus c itself, instead of youngs_modulus (LAMMPS "
+    "influence": Key("choice", "lps only: influence function ω(|ξ|), one, inverse_length (1/|ξ|) or gaussian "
+                     "(exp(−|ξ|²/δ²)); default one, the same in every block", default=None,
+                     choices=("one", "inverse_length", "gaussian")),
+    "micromodulus": Key("number", "pmb only: the micromodulus c itself, instead of youngs_modulus (LAMMPS "
                         "pair_coeff's c; docs/lammps.md)", default=None, unit="N/m⁶", above=0.0),
-    "critical_stretch": Key("number", "the critical stretch s0 itself, with micromodulus (LAMMPS "
+    "critical_stretch": Key("number", "pmb only: the critical stretch s0 itself, with micromodulus (LAMMPS "
                             "pair_coeff's s00); omit for an unbreakable material", default=None,
                             above=0.0),
-    "critical_stretch_alpha": Key("number", "α of LAMMPS's rule s0_i = s0 − α·min_j s_ij (per node, from "
-                                  "the previous step's stretches; a bond breaks when s > min(s0_i, s0_j)); "
+    "critical_stretch_alpha": Key("number", "pmb only: α of LAMMPS's rule s0_i = s0 − α·min_j s_ij (per node, "
+                                  "from the previous step's stretches; a bond breaks when s > min(s0_i, s0_j)); "
                                   "omitted: 0, s0 stays fixed", default=None, minimum=0.0),
+}
+
+# The material keys each model reads (besides model and density), and what a key means to a model
+# that has no such parameter: validate.py rejects such a key with this explanation, as the solver's
+# reader does (solver/src/io/case_reader.cpp read_block).
+MODEL_KEYS = {
+    "pmb": ("youngs_modulus", "fracture_energy", "micromodulus", "critical_stretch", "critical_stretch_alpha"),
+    "lps": ("youngs_modulus", "poisson_ratio", "fracture_energy", "influence"),
+}
+# PMB needs youngs_modulus or micromodulus (validate.py _check_pmb_pairs).
+MODEL_REQUIRED = {"lps": ("youngs_modulus", "poisson_ratio")}
+MODEL_NOTE = {
+    "pmb": "PMB is bond-based and fixes Poisson's ratio (1/4 in 3D and plane strain, 1/3 in plane stress)",
 }
 
 BOUNDARY_CONDITION = {
@@ -140,8 +160,10 @@ CASE = {
     "node_sets": Key("named", "options of node sets (every gmsh physical group is a node set)",
                      default={}, fields={
                          "layer": Key("number", "nodes within this distance of a curve/surface group "
-                                      "belong to it (thesis §2.1: conditions act in a layer); default: "
-                                      "the first row of nodes", default=None, unit="m", minimum=0.0),
+                                      "belong to it (thesis §2.1: conditions act in a layer), measured "
+                                      "through the body (not across a notch or a hole) and to the group's "
+                                      "end points too (a round cap there); default: the first row of nodes",
+                                      default=None, unit="m", minimum=0.0),
                      }),
     "no_fail": Key("names", "node sets whose bonds never break (e.g. where loads are applied)",
                    default=[]),
@@ -287,6 +309,9 @@ CASE = {
                   "frames spread over the run)", default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
+        probe=Key("point_or_name", "where probe.png follows the displacement component: a point "
+                  "[x, y] or [x, y, z] (the node nearest to it), or a node-set name (the mean over its "
+                  "nodes); default: the node nearest the centre of the bounding box", default=None, unit="m"),
     ),
 }
 
@@ -306,6 +331,8 @@ def markdown() -> str:
         return f"`{key.default}`"
 
     def kind_text(key: Key) -> str:
+        if key.kind == "point_or_name":
+            return "point or name"
         if key.kind in ("choice", "number_or_choice"):
             extra = " or number" if key.kind == "number_or_choice" else ""
             return " \\| ".join(str(c) for c in key.choices) + extra

@@ -53,6 +53,34 @@ def block_micromodulus(case: dict, material: dict, horizon: float) -> float:
     return micromodulus(case["analysis"], material["youngs_modulus"], horizon, case["thickness"])
 
 
+def lps_moduli(analysis: str, youngs_modulus: float, poisson_ratio: float) -> tuple[float, float]:
+    """(κ, μ) of an LPS block, as solver/src/materials/lps/lps_constants.cpp: κ the bulk modulus in 3D,
+    the in-plane bulk modulus in 2D."""
+    e, nu = youngs_modulus, poisson_ratio
+    mu = e / (2.0 * (1.0 + nu))
+    if analysis == "plane_strain":
+        return e / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu)), mu
+    if analysis == "plane_stress":
+        return e / (2.0 * (1.0 - nu)), mu
+    return e / (3.0 * (1.0 - 2.0 * nu)), mu
+
+
+def influence(kind: str, length: np.ndarray, horizon: float) -> np.ndarray:
+    """ω(|ξ|) of solver/src/materials/lps/lps_constants.cpp."""
+    if kind == "inverse_length":
+        return 1.0 / length
+    if kind == "gaussian":
+        return np.exp(-(length * length) / (horizon * horizon))
+    return np.ones_like(length)
+
+
+def lps_micromodulus(analysis: str, kappa: float, horizon: float, thickness: float | None) -> float:
+    """The bond-based c of the same κ, which contact uses: 18K/(πδ⁴) (3D), 12κ/(πhδ³) (2D)."""
+    if analysis == "3d":
+        return 18.0 * kappa / (math.pi * horizon ** 4)
+    return 12.0 * kappa / (math.pi * thickness * horizon ** 3)
+
+
 def contact_stiffness_factor(resolved: dict, block: np.ndarray) -> float | None:
     """c_s/c when the solver will compute contact pairs for this case and cloud, else None
     (solver/src/core/work_plan.cpp plan_contact: on; or auto with several blocks or self_contact)."""
@@ -65,14 +93,15 @@ def contact_stiffness_factor(resolved: dict, block: np.ndarray) -> float | None:
 def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, density: np.ndarray,
                      c_pair: np.ndarray, horizon: float, tree: cKDTree | None = None, *,
                      dx: float | None = None, partial_volume: str = "none", contact: float | None = None,
-                     sample: int | None = SAMPLE) -> tuple[float, int]:
+                     sample: int | None = SAMPLE, lps: tuple | None = None) -> tuple[float, int]:
     """min over nodes of √(2ρ_i / Σ_j V_j ν_ij c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the
     node where it is reached, as solver/src/core/model.cpp stable_time_step computes it: ν of the
     `partial_volume` rule (needs the grid spacing dx unless "none"), and with contact (c_s/c given
     as `contact`, see contact_stiffness_factor) a spring V_j c_s c_ij/δ for every bond with
     |ξ| ≤ 1.35·dx. Over an evenly spread subset of `sample` nodes for larger clouds (None: all).
     block is 1-based; density[b-1] and c_pair[a-1, b-1] (the solver's arithmetic mean of the two
-    blocks' c). (inf, -1) when no sampled node has a bond. tests/pipeline/test_stability_solver.py
+    blocks' c). (inf, -1) when no sampled node has a bond. lps = (q, kind): an LPS case, whose bond
+    term is V_j ν ω(|ξ|)(q_i + q_j) with q = (d²κ + α)/m per node (LpsModel::bond_stiffness). tests/pipeline/test_stability_solver.py
     holds it equal to `pdsolve --stable-dt` on every shipped case."""
     n = len(points)
     tree = tree if tree is not None else cKDTree(points)
@@ -87,7 +116,11 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
     c = c_pair[block[i] - 1, block[cols] - 1]
     # ν = clamp((δ + dx/2 − |ξ|)/dx, 0, 1) on the outer shell (core/bonds.hpp VolumeWeight)
     nu = np.clip((horizon + 0.5 * dx - dist) * (1.0 / dx), 0.0, 1.0) if shell else 1.0
-    stiffness = volume[cols] * nu * c / dist
+    if lps is None:
+        stiffness = volume[cols] * nu * c / dist
+    else:
+        q, kind = lps
+        stiffness = volume[cols] * nu * influence(kind, dist, horizon) * (q[i] + q[cols])
     if contact is not None:
         stiffness = stiffness + np.where(dist <= CONTACT_DISTANCE * dx, volume[cols] * contact * c / horizon, 0.0)
     total = np.bincount(rows, weights=stiffness, minlength=len(sample))
@@ -106,14 +139,47 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
     step the solver's run.log reports before the safety factor (`pdsolve --stable-dt`)."""
     names = list(case["materials"])
     horizon = float(resolved["horizon"])
-    c = np.array([block_micromodulus(case, case["materials"][n], horizon) for n in names])
-    c_pair = 0.5 * (c[:, None] + c[None, :])
-    density = np.array([case["materials"][n]["density"] for n in names], dtype=np.float64)
+    materials = [case["materials"][n] for n in names]
     block = np.asarray(cloud.block, dtype=np.int64)
+    lps = None
+    if materials[0]["model"] == "lps":
+        moduli = [lps_moduli(case["analysis"], m["youngs_modulus"], m["poisson_ratio"]) for m in materials]
+        c = np.array([lps_micromodulus(case["analysis"], k, horizon, case["thickness"]) for k, _ in moduli])
+        kind = materials[0].get("influence") or "one"
+        lps = (lps_node_terms(cloud, block, moduli, case["analysis"], horizon, kind, resolved, tree), kind)
+    else:
+        c = np.array([block_micromodulus(case, m, horizon) for m in materials])
+    c_pair = 0.5 * (c[:, None] + c[None, :])
+    density = np.array([m["density"] for m in materials], dtype=np.float64)
     return stable_time_step(np.asarray(cloud.points), np.asarray(cloud.volume), block, density, c_pair,
                             horizon, tree, dx=float(resolved["grid_spacing"]),
                             partial_volume=resolved["partial_volume"],
-                            contact=contact_stiffness_factor(resolved, block), sample=sample)
+                            contact=contact_stiffness_factor(resolved, block), sample=sample, lps=lps)
+
+
+def lps_node_terms(cloud, block: np.ndarray, moduli: list, analysis: str, horizon: float, kind: str,
+                   resolved: dict, tree: cKDTree | None = None, chunk: int = SAMPLE) -> np.ndarray:
+    """q_i = (d²κ_i + α_i)/m_i per node, m_i = Σ_j ω|ξ|²ν V_j over the whole family (α = 15μ in 3D,
+    8μ in 2D), in chunks of nodes. Pre-cracks are not cut here, so m_i is never smaller than the
+    solver's and the step never smaller: "too many steps" is never a false alarm."""
+    points, volume = np.asarray(cloud.points), np.asarray(cloud.volume)
+    tree = tree if tree is not None else cKDTree(points)
+    dx = float(resolved["grid_spacing"])
+    extension, shell = PARTIAL_VOLUME[resolved["partial_volume"]]
+    cutoff = horizon + extension * dx if extension else horizon
+    m = np.zeros(len(points))
+    for start in range(0, len(points), chunk):
+        rows = np.arange(start, min(start + chunk, len(points)))
+        pairs = cKDTree(points[rows]).sparse_distance_matrix(tree, cutoff * BOND_SLACK, output_type="coo_matrix")
+        keep = pairs.data > 0
+        r, cols, dist = pairs.row[keep], pairs.col[keep], pairs.data[keep]
+        nu = np.clip((horizon + 0.5 * dx - dist) * (1.0 / dx), 0.0, 1.0) if shell else 1.0
+        m[rows] += np.bincount(r, weights=influence(kind, dist, horizon) * dist * dist * nu * volume[cols],
+                               minlength=len(rows))
+    d = 3 if analysis == "3d" else 2
+    per_block = np.array([d * d * k + (15.0 if d == 3 else 8.0) * mu for k, mu in moduli])
+    numerator = per_block[block - 1]
+    return np.divide(numerator, m, out=np.zeros_like(m), where=m > 0)
 
 
 def _where(case: dict, *keypath) -> str:
@@ -183,7 +249,9 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
     origin = (f"thesis eq. 2.5 gives a stable step of {dt_stable:.3g} s at node {node} {_fmt(points[node])}, "
               f"from material '{material}' ({_where(case, 'materials', material)}): ρ = {m['density']:g} kg/m³, "
               + (f"E = {m['youngs_modulus']:g} Pa" if m["youngs_modulus"] is not None
-                 else f"c = {m['micromodulus']:g} N/m⁶") + f", with horizon {horizon:.6g} m")
+                 else f"c = {m['micromodulus']:g} N/m⁶")
+              + (f", ν = {m['poisson_ratio']:g} (LPS)" if m.get("model") == "lps" else "")
+              + f", with horizon {horizon:.6g} m")
     units = "check the units (SI: kg/m³, Pa, m, s)"
     steps = end / dt
     if steps > MAX_STEPS:

@@ -11,7 +11,7 @@ import difflib
 import math
 import re
 
-from .schema import CASE, REQUIRED, Key
+from .schema import CASE, MODEL_KEYS, MODEL_NOTE, MODEL_REQUIRED, REQUIRED, Key
 from .yaml_lines import CaseError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -146,6 +146,14 @@ class _Checker:
             return out
         if kind == "components":
             return self.components(value, keypath, key)
+        if kind == "point_or_name":
+            if isinstance(value, str) and NAME_PATTERN.match(value):
+                return value
+            if isinstance(value, list) and len(value) in (2, 3):
+                out = [self.number(v, keypath + (i,), Key("number", "", unit=key.unit)) for i, v in enumerate(value)]
+                return None if None in out else out
+            self.error(keypath, f"expected a point [x, y] or [x, y, z]{self.unit(key)} or a node-set name, got {value!r}")
+            return None
         raise AssertionError(f"schema kind {kind!r} has no checker")
 
     def mapping(self, value, keypath: tuple, fields: dict):
@@ -236,6 +244,9 @@ def _check_context(case: dict, checker: _Checker):
     dim = case["dimension"]
     if case["analysis"] is None:
         case["analysis"] = "3d" if dim == 3 else "plane_stress"
+    probe = case["figures"]["probe"]
+    if isinstance(probe, list) and dim == 3 and len(probe) != 3:
+        checker.error(("figures", "probe"), f"a point of a 3D case has three coordinates [x, y, z], got {probe!r}")
     if dim == 3 and case["analysis"] != "3d":
         checker.error(("analysis",), f"'{case['analysis']}' is a 2D model but dimension is 3; use 3d")
     if dim == 2 and case["analysis"] == "3d":
@@ -244,6 +255,7 @@ def _check_context(case: dict, checker: _Checker):
         checker.error(("thickness",), "a 2D case needs thickness [m] (node volume = area × thickness)")
     if dim == 3 and case["thickness"] is not None:
         checker.error(("thickness",), "thickness is for 2D cases only; remove it")
+    _check_materials(case, checker)
     disc = case["discretization"]
     if disc["method"] == "lattice" and disc["dx"] is None:
         checker.error(("discretization", "dx"), "the lattice method needs dx [m], the node spacing")
@@ -262,7 +274,11 @@ def _check_context(case: dict, checker: _Checker):
             checker.error(("discretization", "origin"), f"needs {dim} coordinates (dimension {dim}), "
                           f"got {len(disc['origin'])}")
     for name, m in case["materials"].items():
-        _check_material_pairs(name, m, checker)
+        if m["model"] == "pmb":
+            _check_pmb_pairs(name, m, checker)
+    if case["breaking_order"] == "lammps" and any(m["model"] != "pmb" for m in case["materials"].values()):
+        checker.error(("breaking_order",), "lammps is LAMMPS peri/pmb's order, for model pmb; remove it or "
+                      "use model: pmb")
     for i, bc in enumerate(case["boundary_conditions"]):
         kinds = [k for k in ("displacement", "velocity", "body_force") if bc[k]]
         if not kinds:
@@ -293,7 +309,7 @@ def _check_context(case: dict, checker: _Checker):
         out["every_time"] = case["time"]["end"] / 50.0
 
 
-def _check_material_pairs(name: str, m: dict, checker: _Checker):
+def _check_pmb_pairs(name: str, m: dict, checker: _Checker):
     """PMB's constants come from one pair: E with G0 (validation.md F1) or c with s0 as given
     (a LAMMPS pair_coeff), never a mix; α only for a material that can break."""
     pairs = "give youngs_modulus (and fracture_energy) or micromodulus (and critical_stretch), not a mix"
@@ -313,6 +329,37 @@ def _check_material_pairs(name: str, m: dict, checker: _Checker):
     elif (m["critical_stretch_alpha"] or 0.0) > 0.0 and not g0 and not s0:
         checker.error(where + ("critical_stretch_alpha",), "needs a breakable material: give "
                       "fracture_energy or critical_stretch")
+
+
+def _check_materials(case: dict, checker: _Checker):
+    """Each block gives the keys of its model and no other model's (poisson_ratio under model: pmb is
+    an error that says why and which model has it); every block uses one model and one influence
+    function (a bond joins two blocks, and m_i sums over both)."""
+    materials = case["materials"]
+    models = {m["model"] for m in materials.values()}
+    for name, m in materials.items():
+        model = m["model"]
+        for key in sorted({k for keys in MODEL_KEYS.values() for k in keys} - set(MODEL_KEYS[model])):
+            if m.get(key) is None:
+                continue
+            owners = [other for other, keys in MODEL_KEYS.items() if key in keys]
+            note = MODEL_NOTE.get(model, f"model {model!r} has no parameter {key!r}")
+            checker.error(("materials", name, key), f"{note}; {key} belongs to model {' or '.join(owners)}: "
+                          f"set model: {owners[0]} (or remove {key})")
+        for key in MODEL_REQUIRED.get(model, ()):
+            if m.get(key) is None:
+                checker.error(("materials", name, key), f"model {model} needs {key}: {CASE['materials'].fields[key].doc}")
+    if len(models) > 1:
+        checker.error(("materials",), f"every block must use the same model, got {', '.join(sorted(models))}")
+    integrator = case["time"]["integrator"]
+    if "lps" in models and integrator in ("quasi_static", "mixed"):
+        # The solver's Newton solves factorise an assembled tangent; a state-based law has none
+        # (solver/src/materials/bond_model.hpp bond_tangent_row), so the run would stop at its first step.
+        checker.error(("time", "integrator"), f"{integrator} needs an assembled tangent stiffness, which the "
+                      "state-based model lps does not have; use verlet or adaptive")
+    influences = {m.get("influence") or "one" for m in materials.values() if m["model"] == "lps"}
+    if len(influences) > 1:
+        checker.error(("materials",), f"every block must use the same influence function, got {', '.join(sorted(influences))}")
 
 
 def _check_crack(crack: dict, i: int, dim: int, checker: _Checker):

@@ -21,6 +21,9 @@ class CaseSettings:
     component: int = 0              # `figures.displacement_component`: 0, 1, 2 for x, y, z
     block_names: dict = dataclasses.field(default_factory=dict)  # block id -> name, for Gmsh
     gmsh: str = "figures"           # `output.gmsh`: frames copied to gmsh/results.msh: all | figures | none
+    integrator: str | None = None   # `time.integrator`: what timestep.png shows (None: not in case.json)
+    breakable: bool = True          # some block has a fracture_energy: else no damage maps
+    probe: list | str | None = None  # `figures.probe`: a point [m], a node-set name, or None (the centre)
 
     @property
     def heading(self) -> str:
@@ -78,9 +81,21 @@ def load_case_settings(path: str) -> CaseSettings:
     gmsh = output.get("gmsh", "figures") if isinstance(output, dict) else "figures"
     if gmsh not in GMSH_CHOICES:
         fail("output.gmsh", f"expected one of {', '.join(GMSH_CHOICES)}, got {gmsh!r}")
+    probe = figures.get("probe")
+    if probe is not None and not (isinstance(probe, str) and probe) and not (
+            isinstance(probe, list) and len(probe) in (2, 3) and all(_is_number(c) for c in probe)):
+        fail("figures.probe", f"expected a point [x, y] or [x, y, z] in m or a node-set name, got {probe!r}")
+    if isinstance(probe, list):
+        probe = [float(c) for c in probe] + [0.0] * (3 - len(probe))
+    time = case.get("time") or {}
+    integrator = time.get("integrator") if isinstance(time, dict) else None
+    if integrator is not None and not isinstance(integrator, str):
+        fail("time.integrator", f"expected a name, got {integrator!r}")
     blocks = case.get("blocks") or []
     block_names = {b["id"]: b["name"] for b in blocks if isinstance(b, dict)
                    and isinstance(b.get("id"), int) and isinstance(b.get("name"), str)}
     return CaseSettings(name=name, dimension=dimension, title=title,
                         grid_spacing=None if spacing is None else float(spacing),
-                        times=times, component=int(component), block_names=block_names, gmsh=gmsh)
+                        times=times, component=int(component), block_names=block_names, gmsh=gmsh,
+                        integrator=integrator, probe=probe,
+                        breakable=any(isinstance(b, dict) and b.get("fracture_energy") is not None for b in blocks))

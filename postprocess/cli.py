@@ -3,8 +3,9 @@
     /usr/bin/python3 -m postprocess OUT_DIR [--case-json PATH] [--only figures|gmsh]
 
 Reads OUT_DIR/case.json (or PATH), OUT_DIR/history.csv and OUT_DIR/frames.pvd with its frames;
-writes OUT_DIR/figures/{energy,timestep,probe,damage_<i>,displacement_<i>}.png and
-OUT_DIR/gmsh/{results.msh,damage_final.pos}. Every frame is read once, in order.
+writes OUT_DIR/figures/{energy,timestep,probe,damage_<i>,displacement_<i>}.png,
+OUT_DIR/gmsh/{results.msh,damage_final.pos} and OUT_DIR/history.json (units of history.csv), and
+says on stderr, one line each, what it draws. Every frame is read once, in order.
 Exit status 0 on success, 1 with a message naming the file on an error, 2 on a usage error.
 """
 from __future__ import annotations
@@ -15,11 +16,14 @@ import os
 import re
 import sys
 
+import numpy as np
+
 from .casefile import load_case_settings
 from .errors import PostprocessError
 from .history import read_history
 from .series import read_frame, read_series
-from .selection import centre_node, default_times, select_frames
+from .plotting import say
+from .selection import default_times, probe_nodes, select_frames
 
 MAP_NAME = re.compile(r"(damage|displacement)_(\d+)\.png$")
 
@@ -56,11 +60,12 @@ def _check_inputs(out_dir: str, case_json: str, need_history: bool):
                                f"; {stage} first: make case={name}")
 
 
-def _remove_stale_maps(directory: str, count: int):
-    """Maps numbered ≥ count are left from an earlier run with more `figures.times`: remove them."""
+def _remove_stale_maps(directory: str, count: int, keep_damage: bool = True):
+    """Maps numbered ≥ count are left from an earlier run with more `figures.times`, and damage
+    maps from a run that could break: remove them."""
     for path in glob.glob(os.path.join(directory, "*.png")):
         match = MAP_NAME.search(os.path.basename(path))
-        if match and int(match.group(2)) >= count:
+        if match and (int(match.group(2)) >= count or (match.group(1) == "damage" and not keep_damage)):
             os.unlink(path)
 
 
@@ -88,8 +93,11 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
                 print(f"postprocess: note: figures.times {t:g} s is outside the run "
                       f"[{times[0]:g}, {times[-1]:g}] s; drawing the nearest frame", file=sys.stderr)
 
+    say(f"reading {len(series)} frames of {out_dir} (frames.pvd)"
+        + (f"; Gmsh copy of {'all of them' if case.gmsh == 'all' else 'those of the figures'}" if do_gmsh else ""))
     kept: dict = {}
-    probe: dict = {"values": [], "node": None, "position": None}
+    probe: dict = {"values": [], "nodes": None, "where": "", "position": None}
+    nodes_file = os.path.join(out_dir, "nodes.vtu")
     state: dict = {"last": None, "count": None}
 
     def frames():
@@ -98,30 +106,45 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
             frame = read_frame(path)
             if state["count"] is None:
                 state["count"] = len(frame.points)
-                probe["node"] = centre_node(frame.points)
-                probe["position"] = frame.points[probe["node"]]
+                probe["nodes"], probe["where"] = probe_nodes(frame.points, case.probe, nodes_file)
+                if len(probe["nodes"]) == 1:
+                    probe["position"] = frame.points[probe["nodes"][0]]
             elif len(frame.points) != state["count"]:
                 raise PostprocessError(f"{path}: {len(frame.points)} points, the first frame "
                                        f"{series[0][1]} has {state['count']}")
-            probe["values"].append(float(frame.displacement[probe["node"], case.component]))
+            probe["values"].append(float(np.mean(frame.displacement[probe["nodes"], case.component])))
             if index in selected:
                 kept[index] = frame
             state["last"] = (index, t, frame)
             yield index, t, frame
 
     written = []
+    history_csv = os.path.join(out_dir, "history.csv")
+    if os.path.isfile(history_csv):
+        # history.json: each column's unit and meaning, from the header (formats.md §4)
+        from .history_units import write_history_json
+
+        path = os.path.join(out_dir, "history.json")
+        content = write_history_json(history_csv, path)
+        written.append(path)
+        unknown = [name for name, column in content["columns"].items() if column["unit"] is None]
+        say(f"history.json: unit and meaning of the {len(content['columns'])} columns of history.csv"
+            + (f" ({', '.join(unknown)} not documented in formats.md §4)" if unknown else ""))
     if do_gmsh:
         from .gmsh_export import write_damage_pos, write_results_msh
 
         gmsh_dir = os.path.join(out_dir, "gmsh")
         path = os.path.join(gmsh_dir, "results.msh")
         chosen = frames() if case.gmsh == "all" else (f for f in frames() if f[0] in selected)
-        write_results_msh(path, chosen, block_names=case.block_names or None)
+        count = write_results_msh(path, chosen, block_names=case.block_names or None)
         written.append(path)
+        say(f"gmsh/results.msh: {count} of {len(series)} frames as Gmsh views"
+            + (" (output.gmsh: all)" if case.gmsh == "all" else " (those of the figures; output.gmsh: all for every one)"))
         index, t, frame = state["last"]
         path = os.path.join(gmsh_dir, "damage_final.pos")
-        write_damage_pos(path, frame, time=t, title=f"{case.heading}, frame {index}")
+        write_damage_pos(path, frame, time=t, title=f"{case.name}, frame {index}")
         written.append(path)
+        say(f"gmsh/damage_final.pos: damage and {len(frame.broken_bonds)} broken bonds of frame {index}")
     else:
         for _ in frames():
             pass
@@ -135,30 +158,37 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
 
         fig_dir = os.path.join(out_dir, "figures")
         path = os.path.join(fig_dir, "energy.png")
-        plot_energy(history, case, path)
+        say(plot_energy(history, case, path))
         written.append(path)
         path = os.path.join(fig_dir, "timestep.png")
-        plot_timestep(history, case, path)
+        say(plot_timestep(history, case, path, run_log=os.path.join(out_dir, "run.log")))
         written.append(path)
         if indenter_names(history):  # only when the case has indenters (formats.md §4)
             path = os.path.join(fig_dir, "indenter_force.png")
-            plot_indenter_forces(history, case, path)
+            say(plot_indenter_forces(history, case, path))
             written.append(path)
         from .reaction_plot import plot_reactions, reaction_sets
         if reaction_sets(history):  # only when the case lists output.reactions (formats.md §4)
             path = os.path.join(fig_dir, "reaction_force.png")
-            plot_reactions(history, case, case_json, path)
+            say(plot_reactions(history, case, case_json, path))
             written.append(path)
         shared = displacement_range([kept[i] for i in selected], case.component)
+        # Damage maps only where something can break or a pre-crack shows: an unbreakable
+        # membrane got four all-zero maps.
+        damaged = case.breakable or any(np.any(kept[i].damage != 0.0) for i in selected)
+        quantities = ("damage", "displacement") if damaged else ("displacement",)
         for number, (t_requested, index) in enumerate(zip(requested, selected)):
-            for quantity in ("damage", "displacement"):
+            for quantity in quantities:
                 path = os.path.join(fig_dir, f"{quantity}_{number}.png")
                 plot_map(kept[index], case, path, quantity=quantity, time=times[index], index=index,
                          requested=t_requested, vrange=shared if quantity == "displacement" else None)
                 written.append(path)
-        _remove_stale_maps(fig_dir, len(selected))
+        say(f"{' and '.join(q + '_<i>.png' for q in quantities)}: frames "
+            f"{', '.join(str(i) for i in selected)} (figures.times)"
+            + ("" if damaged else "; no damage maps: nothing can break (no fracture_energy) and no damage"))
+        _remove_stale_maps(fig_dir, len(selected), keep_damage=damaged)
         path = os.path.join(fig_dir, "probe.png")
-        plot_probe(times, probe["values"], case, path, node=probe["node"], position=probe["position"])
+        say(plot_probe(times, probe["values"], case, path, where=probe["where"], position=probe["position"]))
         written.append(path)
     log(f"postprocess: {case.name}: {len(series)} frames → " +
         ", ".join(os.path.relpath(p, out_dir) for p in written) + f" in {out_dir}")

@@ -1,24 +1,31 @@
-"""probe.png: the displacement history of the node nearest to the geometric centre, from the frames."""
+"""probe.png: the displacement history at the probe (figures.probe: a point, a node set, or by
+default the node nearest the centre of the box), from the frames."""
 from __future__ import annotations
 
 import numpy as np
 
 from .casefile import AXES, CaseSettings
-from .plotting import new_figure, save_figure
+from .plotting import new_figure, place_legend, plain_ticks, save_figure, short_title, si_scale, time_axis
 
 
-def plot_probe(times, values, case: CaseSettings, path: str, *, node: int, position):
-    """u_component(t) of node `node` at reference `position` [m]."""
+def plot_probe(times, values, case: CaseSettings, path: str, *, where: str, position=None) -> str:
+    """u_component(t) at the probe; `where` says which nodes, `position` [m] the one node's place."""
     axis = AXES[case.component]
+    t, t_label = time_axis(times)
+    factor, unit = si_scale(values, "m")
     fig, axes = new_figure(size=(7.5, 4.5))
     ax = axes[0, 0]
-    ax.plot(np.asarray(times), np.asarray(values), marker="." if len(times) <= 200 else None)
+    if position is not None:
+        length, length_unit = si_scale(position, "m")
+        where += " at (" + ", ".join(f"{c * length:.4g}" for c in position) + f") {length_unit}"
+    ax.plot(t, np.asarray(values) * factor, marker="." if len(times) <= 200 else None, label=where)
     ax.axhline(0.0, color="0.6", linewidth=0.6)
-    ax.set_xlabel("time t [s]")
-    ax.set_ylabel(f"displacement u_{axis} [m]")
-    where = ", ".join(f"{c:.4g}" for c in position)
-    ax.set_title(f"{case.heading}\nu_{axis} of the node nearest the centre: node {node} at ({where}) m",
-                 fontsize="medium")
+    ax.set_xlabel(t_label)
+    ax.set_ylabel(f"displacement u_{axis} [{unit}]")
+    ax.set_title(short_title(case, f"u_{axis} at the probe"))
     ax.grid(alpha=0.3)
+    plain_ticks(ax)
+    place_legend(ax, fontsize="small")
     fig.tight_layout()
     save_figure(fig, path)
+    return f"probe.png: u_{axis} of {where} over {len(times)} frames"

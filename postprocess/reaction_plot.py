@@ -9,7 +9,7 @@ import numpy as np
 
 from .casefile import CaseSettings
 from .history import vector_column_names
-from .plotting import new_figure, save_figure
+from .plotting import new_figure, place_legend, plain_ticks, save_figure, short_title, si_scale, time_axis
 
 def reaction_sets(history: dict) -> list[str]:
     """Node sets that have all three reaction columns, in column order."""
@@ -52,6 +52,7 @@ def plot_reactions(history: dict, case: CaseSettings, case_json_path: str, path:
         case_json = json.load(stream)
     names = reaction_sets(history)
     t = history["time"]
+    factor, unit = si_scale(np.concatenate([history[f"reaction_{n}_f{a}"] for n in names for a in "xyz"]), "N")
     fig, axes = new_figure(len(names), 1, size=(7.0, 3.6 * len(names) + 0.8))
     for row, name in enumerate(names):
         ax = axes[row, 0]
@@ -59,17 +60,21 @@ def plot_reactions(history: dict, case: CaseSettings, case_json_path: str, path:
         moving = {c: u for c, u in moves.items() if np.any(u != 0.0)}
         if moving:
             comp = max(moving, key=lambda c: np.abs(moving[c]).max())
-            x, xlabel = moving[comp] * 1e3, f"prescribed displacement u{'xyz'[comp]} of '{name}' [mm]"
+            scale, length_unit = si_scale(moving[comp], "m")
+            x, xlabel = moving[comp] * scale, f"prescribed displacement u{'xyz'[comp]} of '{name}' [{length_unit}]"
         else:
-            x, xlabel = t, "time t [s]"
+            x, xlabel = time_axis(t)
         for axis in "xyz":
             values = history[f"reaction_{name}_f{axis}"]
             if np.any(values != 0.0):
-                ax.plot(x, values, label=f"F{axis}")
+                ax.plot(x, values * factor, label=f"F{axis}")
         ax.set_xlabel(xlabel)
-        ax.set_ylabel("reaction force [N]")
-        ax.set_title(f"{case.heading}: reaction on '{name}'")
-        ax.legend(fontsize="small")
+        ax.set_ylabel(f"reaction force [{unit}]")
+        ax.set_title(short_title(case, f"reaction on '{name}'"))
         ax.grid(alpha=0.3)
+        plain_ticks(ax)
+        if ax.get_lines():
+            place_legend(ax, fontsize="small")
     fig.tight_layout()
     save_figure(fig, path)
+    return f"reaction_force.png: reaction force on node set(s) {', '.join(names)}"

@@ -2,6 +2,7 @@
 which node the probe follows (the nearest to the centre)."""
 from __future__ import annotations
 
+import os
 from typing import Sequence
 
 import numpy as np
@@ -47,3 +48,39 @@ def centre_node(points: np.ndarray) -> int:
     (the lowest index among equally near nodes)."""
     centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
     return int(np.argmin(np.sum((points - centre) ** 2, axis=1)))
+
+
+def nearest_node(points: np.ndarray, point) -> int:
+    """The node nearest to `point` (x, y, z) [m], the lowest index among equally near ones."""
+    return int(np.argmin(np.sum((points - np.asarray(point, dtype=np.float64)) ** 2, axis=1)))
+
+
+def probe_nodes(points: np.ndarray, probe, nodes_vtu: str | None = None) -> tuple[np.ndarray, str]:
+    """The nodes whose displacement probe.png follows (figures.probe) and a short description:
+    None → the node nearest the centre of the box; [x, y, z] → the node nearest that point; a
+    node-set name → every node of the set (from the set_<name> array of nodes.vtu, formats.md §1),
+    whose mean displacement is drawn."""
+    from .errors import PostprocessError
+
+    if probe is None:
+        node = centre_node(points)
+        return np.array([node]), f"node {node}, nearest the centre"
+    if not isinstance(probe, str):
+        node = nearest_node(points, probe)
+        return np.array([node]), f"node {node}, nearest the probe point"
+    from meshio import vtu
+
+    if nodes_vtu is None or not os.path.isfile(nodes_vtu):
+        raise PostprocessError(f"figures.probe: '{probe}' is a node set, read from the node file "
+                               f"{nodes_vtu}, which does not exist; preprocess the case again")
+    data = vtu.read(nodes_vtu).point_data
+    array = data.get(f"set_{probe}")
+    if array is None:
+        sets = sorted(name[4:] for name in data if name.startswith("set_"))
+        raise PostprocessError(f"figures.probe: no node set '{probe}' in {nodes_vtu}; "
+                               f"its sets are: {', '.join(sets) or 'none'}")
+    members = np.flatnonzero(np.asarray(array).reshape(-1) != 0)
+    if len(array) != len(points) or len(members) == 0:
+        raise PostprocessError(f"figures.probe: node set '{probe}' of {nodes_vtu} has "
+                               f"{len(members)} of {len(array)} nodes; the frames have {len(points)}")
+    return members, f"mean of the {len(members)} nodes of '{probe}'"

@@ -18,6 +18,12 @@ Node sets. Every named physical group becomes a node set:
     in 2D or a surface in 3D, so that the first row of cell-centred nodes along the entity is
     taken; the same row along an edge of a box in 3D (√2/2·dx) and the nearest corner node of
     a point (√d/2·dx).
+    The distance is measured to the whole group, its end points included: a layer on an open
+    curve has round caps of radius `layer` around the curve's ends (a layer on a notch face also
+    takes the nodes ahead of the notch tip within `layer`). On a lattice, a layer wider than dx is
+    measured through the body: a node counts only if the straight path to its nearest point of the
+    group stays inside the body (locate.reached_through_body), so a layer on one face of a notch or
+    of a slit does not reach across the gap to the nodes on the other side.
 """
 from __future__ import annotations
 
@@ -29,7 +35,8 @@ from scipy.spatial import cKDTree
 from .cloud import SET_NAME, NodeCloud
 from .errors import PreprocessError, PreprocessWarning
 from .geometry import element_measure, simplices
-from .locate import lattice_axes, lattice_points, locate_lattice, near_entities
+from .locate import (lattice_axes, lattice_points, locate_lattice, near_entities, reached_through_body,
+                     sample_entities)
 from .mesh import Mesh, element_dimension
 
 METHODS = ("lattice", "mesh-nodes")
@@ -126,6 +133,22 @@ def _measures(mesh: Mesh, points, top, dimension, thickness) -> dict[str, np.nda
     return measures
 
 
+def missing_blocks(mesh: Mesh, dimension: int, block_names: list[str]) -> dict[str, str]:
+    """Block name → why it names no top-dimension physical group of the mesh ({} when every block
+    does, or when one block is given and the mesh has at most one top-dimension group: the module
+    docstring's exception). `make check` asks this before preprocessing."""
+    top_groups = [g for g in mesh.groups.values() if g.dim == dimension]
+    if len(block_names) == 1 and len(top_groups) <= 1:
+        return {}
+    missing = {}
+    for n in block_names:
+        if n not in mesh.groups:
+            missing[n] = f"block '{n}' is not a physical group of the mesh"
+        elif mesh.groups[n].dim != dimension:
+            missing[n] = f"block '{n}' is a {mesh.groups[n].dim}D physical group, not a {dimension}D one"
+    return missing
+
+
 def _element_blocks(mesh: Mesh, top, dimension, block_names) -> dict[str, np.ndarray]:
     """1-based block id of every top-dimension element (0: in no block)."""
     path = mesh.path
@@ -135,18 +158,12 @@ def _element_blocks(mesh: Mesh, top, dimension, block_names) -> dict[str, np.nda
         for t in elem_block:
             elem_block[t][:] = 1
         return elem_block
-    missing = [n for n in block_names if n not in mesh.groups or mesh.groups[n].dim != dimension]
+    missing = missing_blocks(mesh, dimension, block_names)
     if missing:
-        lines = []
-        for n in missing:
-            if n in mesh.groups:
-                lines.append(f"block '{n}' is a {mesh.groups[n].dim}D physical group, not a {dimension}D one")
-            else:
-                lines.append(f"block '{n}' is not a physical group of the mesh")
-        err = PreprocessError(f"{path}: {'; '.join(lines)}; the {dimension}D groups are: "
+        err = PreprocessError(f"{path}: {'; '.join(missing.values())}; the {dimension}D groups are: "
                               f"{', '.join(g.name for g in top_groups) or 'none'}")
         # What the driver needs to point at the case file's materials.<name> line instead.
-        err.missing_blocks = dict(zip(missing, lines))
+        err.missing_blocks = missing
         err.top_groups = [g.name for g in top_groups]
         raise err
     for bid, name in enumerate(block_names, start=1):
@@ -314,8 +331,15 @@ def _node_sets(mesh, points, top, cloud, where, method, dx, set_layers) -> dict[
                 if tree is None:
                     tree = cKDTree(cloud.points)
                 mask = np.zeros(len(cloud.volume), dtype=bool)
-                for conn in _entities(mesh, name):
+                entities = _entities(mesh, name)
+                for conn in entities:
                     mask |= near_entities(cloud.points, tree, points, conn, layer)
+                if method == "lattice" and layer > dx:
+                    # measured through the body: not across a notch or a hole (module docstring)
+                    samples = np.concatenate([sample_entities(points, conn, 0.25 * dx) for conn in entities])
+                    inside = reached_through_body(cloud.points, tree, np.flatnonzero(mask), samples, dx, dimension)
+                    mask = np.zeros(len(cloud.volume), dtype=bool)
+                    mask[inside] = True
         if not np.any(mask):
             raise PreprocessError(f"{path}: physical group '{name}' ({group.dim}D) holds no node of the "
                                   f"{method} discretization; "

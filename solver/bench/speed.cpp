@@ -3,12 +3,15 @@
 // free faces, the top layers given an initial velocity, advanced by the velocity-Verlet integrator
 // pdsolve uses (bond breaking on). Prints one CSV row (header with --header).
 //
-//   pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE]
+//   pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps]
 //
 // --nodes FILE reads the brick from a node file instead of writing the x-fastest lattice (the
 // brick must be the side³ lattice of spacing 1 mm at the origin, in any node order): speed.py uses
 // it to measure what the node numbering costs (x-fastest, shuffled, Morton as the pre-processor
 // writes it: preprocess/ordering.py).
+//
+// --model lps: the same brick in the linear peridynamic solid (ν = 0.25, ω = 1: PMB's elastic constants),
+// for LPS's rate per directed bond beside PMB's (materials/lps).
 //
 // set-up = reading the node file (written to D first, not timed) + build_model (bonds, material);
 // loop = S integrator steps, timed; directed bond updates/s = directed bonds × S / loop time, each
@@ -44,10 +47,10 @@ double cpu_seconds() {
 const char* const kHeader =
     "nodes,side,threads,steps,directed_bonds,bonds_per_node,setup_s,setup_us_per_node,loop_s,step_s,"
     "step_ns_per_node,bond_updates_per_s,loop_cpu_s,bond_updates_per_cpu_s,bond_bytes_per_directed_bond,peak_rss_mb,"
-    "broken_bonds";
+    "broken_bonds,model";
 
 int usage() {
-  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] | --header\n");
+  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] | --header\n");
   return 2;
 }
 
@@ -56,6 +59,7 @@ int usage() {
 int main(int argc, char** argv) {
   int side = 0, steps = 20, threads = 0;
   std::filesystem::path dir = "out/bench/tmp", nodes;
+  std::string material = "pmb";
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--header") {
@@ -68,6 +72,7 @@ int main(int argc, char** argv) {
     else if (a == "--threads") threads = std::atoi(argv[++k]);
     else if (a == "--dir") dir = argv[++k];
     else if (a == "--nodes") nodes = argv[++k];
+    else if (a == "--model") material = argv[++k];
     else return usage();
   }
   if (side < 4 || steps < 1) return usage();
@@ -76,7 +81,13 @@ int main(int argc, char** argv) {
 
   // Silica-glass-like brick, dx = 1 mm: the material only sets the time step and the stretch scale.
   const double dx = 1e-3, horizon = 3.0002 * dx;
-  const pd::Case c = pdtest::lattice_case(3, "3d", dx, horizon, 72e9, 2440.0, /*fracture_energy=*/4.0);
+  pd::Case c = pdtest::lattice_case(3, "3d", dx, horizon, 72e9, 2440.0, /*fracture_energy=*/4.0);
+  if (material == "lps") {
+    c.blocks[0].model = "lps";
+    c.blocks[0].parameters["poisson_ratio"] = 0.25;
+  } else if (material != "pmb") {
+    return usage();
+  }
   std::filesystem::path node_file = nodes;
   if (nodes.empty()) {
     std::filesystem::create_directories(dir);
@@ -120,10 +131,10 @@ int main(int argc, char** argv) {
                                                 model.bonds.offsets.size() * sizeof(std::int64_t));
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  std::printf("%zu,%d,%d,%d,%.0f,%.3f,%.4f,%.4f,%.4f,%.6f,%.3f,%.4e,%.4f,%.4e,%.3f,%.1f,%lld\n", n, side, threads,
+  std::printf("%zu,%d,%d,%d,%.0f,%.3f,%.4f,%.4f,%.4f,%.6f,%.3f,%.4e,%.4f,%.4e,%.3f,%.1f,%lld,%s\n", n, side, threads,
               steps, directed, directed / static_cast<double>(n), setup, 1e6 * setup / static_cast<double>(n), loop,
               loop / steps, 1e9 * loop / steps / static_cast<double>(n), directed * steps / loop, loop_cpu,
               directed * steps / loop_cpu,
-              bond_bytes / directed, static_cast<double>(usage.ru_maxrss) / 1024.0, static_cast<long long>(broken));
+              bond_bytes / directed, static_cast<double>(usage.ru_maxrss) / 1024.0, static_cast<long long>(broken), material.c_str());
   return 0;
 }

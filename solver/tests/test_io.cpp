@@ -195,6 +195,17 @@ TEST(CaseFile, RejectsBadValuesNamingTheKey) {
   expect_case_error("\"density\": 1200.0", "\"density\": \"heavy\"", {"blocks[0].density: must be a number"});
   expect_case_error("\"youngs_modulus\": 3.0e9", "\"youngs_modulus\": 0", {"blocks[0].youngs_modulus: must be > 0"});
   expect_case_error("\"fracture_energy\": null", "\"fracture_energy\": -2", {"blocks[0].fracture_energy: must be > 0"});
+  // A parameter of another model names it (PMB fixes ν; LPS has poisson_ratio), and LPS's ν range says why.
+  expect_case_error("\"fracture_energy\": null", "\"fracture_energy\": null, \"poisson_ratio\": 0.3",
+                    {"blocks[0].poisson_ratio: model 'pmb' has no parameter 'poisson_ratio'", "fixes Poisson's ratio",
+                     "model 'lps' has it", "set model: lps"});
+  expect_case_error("\"model\": \"pmb\"", "\"model\": \"lps\", \"poisson_ratio\": 0.5",
+                    {"blocks[0].poisson_ratio: must be between -1.0 and 0.5 (exclusive), got 0.5: an isotropic solid needs"});
+  expect_case_error("\"model\": \"pmb\"", "\"model\": \"lps\", \"poisson_ratio\": -1",
+                    {"blocks[0].poisson_ratio: must be between -1.0 and 0.5 (exclusive), got -1"});
+  expect_case_error("\"model\": \"pmb\"", "\"model\": \"lps\"", {"blocks[0].poisson_ratio: required key is missing"});
+  expect_case_error("\"model\": \"pmb\"", "\"model\": \"lps\", \"poisson_ratio\": 0.3, \"influence\": \"cubic\"",
+                    {"blocks[0].influence: unknown name 'cubic'; known: one, inverse_length, gaussian"});
   expect_case_error("\"id\": 1", "\"id\": 2", {"blocks[0].id: must be 1"});
   expect_case_error("\"component\": 2, \"times\"", "\"component\": 3, \"times\"", {"boundary_conditions[0].component: must be between 0 and 2"});
   expect_case_error("\"times\": [0.0], \"values\": [0.0]", "\"times\": [0.0, 0.0], \"values\": [0.0, 1.0]",

@@ -86,11 +86,26 @@ def described(pdsolve):
     return json.loads(out)
 
 
+# The keys of the other material model: every block of a case uses one model, so the state-based
+# LPS keys come from a second case (EVERYTHING with its materials replaced).
+EVERYTHING_LPS = EVERYTHING.replace("breaking_order: lammps\n", "").replace(
+    "  plate: {density: 2000, youngs_modulus: 1.0e9, fracture_energy: 10}\n"
+    "  disk: {density: 7800, youngs_modulus: 2.0e11}\n"
+    "  rod: {density: 2440, micromodulus: 3.4e21, critical_stretch: 0.001, critical_stretch_alpha: 0.25}\n",
+    "  plate: {model: lps, density: 2000, youngs_modulus: 1.0e9, poisson_ratio: 0.3, fracture_energy: 10,\n"
+    "          influence: gaussian}\n"
+    "  disk: {model: lps, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.29, influence: gaussian}\n")
+
+
 @pytest.fixture(scope="module")
 def case_json_paths(tmp_path_factory):
-    path = tmp_path_factory.mktemp("describe") / "every.yaml"
-    path.write_text(textwrap.dedent(EVERYTHING))
-    resolved = resolve(load_case(str(path)), node_sets=["left"], grid_spacing=0.001, nodes_file="nodes.vtu")
+    assert EVERYTHING_LPS != EVERYTHING
+    resolved_cases = []
+    for name, text in (("every.yaml", EVERYTHING), ("every_lps.yaml", EVERYTHING_LPS)):
+        path = tmp_path_factory.mktemp("describe") / name
+        path.write_text(textwrap.dedent(text))
+        resolved_cases.append(resolve(load_case(str(path)), node_sets=["left"], grid_spacing=0.001,
+                                      nodes_file="nodes.vtu"))
     paths = set()
 
     def walk(value, prefix):
@@ -103,7 +118,8 @@ def case_json_paths(tmp_path_factory):
             for item in value:
                 walk(item, prefix[:-1] + "[].")
 
-    walk(resolved, "")
+    for resolved in resolved_cases:
+        walk(resolved, "")
     return paths
 
 

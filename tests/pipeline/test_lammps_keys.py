@@ -107,3 +107,15 @@ def test_origin_needs_a_lattice_and_the_dimension_s_coordinates(tmp_path):
     assert ("brick.yaml:5: discretization.origin: origin places a lattice; the mesh-nodes method has none: "
             "remove origin or use method: lattice") in message
     assert np.isfinite(load_case(write(tmp_path, LAMMPS_LIKE))["discretization"]["dx"])
+
+
+def test_lammps_keys_belong_to_pmb(tmp_path):
+    lps = (LAMMPS_LIKE.replace("    micromodulus: 3.4e21\n", "    model: lps\n    youngs_modulus: 7.2e10\n"
+                               "    poisson_ratio: 0.3\n")
+           .replace("    critical_stretch: 0.001\n", "").replace("    critical_stretch_alpha: 0.25\n", ""))
+    message = error_of(tmp_path, lps)
+    assert ("brick.yaml:13: breaking_order: lammps is LAMMPS peri/pmb's order, for model pmb; remove it or "
+            "use model: pmb") in message
+    message = error_of(tmp_path, lps.replace("breaking_order: lammps\n", "").replace(
+        "    poisson_ratio: 0.3\n", "    poisson_ratio: 0.3\n    critical_stretch: 0.001\n"))
+    assert "materials.brick.critical_stretch:" in message and "belongs to model pmb" in message

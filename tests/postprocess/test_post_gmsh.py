@@ -63,7 +63,8 @@ def test_our_parser_and_meshio_read_the_values_back(run2d):
             assert np.array_equal(values, frame_arrays(run2d, k)[name])
     mesh = meshio.read(str(path))  # an independent reader of the mesh part (it keeps the last data block)
     assert np.array_equal(mesh.points, run2d.points)
-    assert [c.type for c in mesh.cells] == ["vertex"] and len(mesh.cells[0].data) == len(run2d.points)
+    assert {c.type for c in mesh.cells} == {"vertex"}  # one cell block per run of nodes of one block
+    assert np.array_equal(np.concatenate([c.data for c in mesh.cells]).ravel(), np.arange(len(run2d.points)))
     assert np.array_equal(mesh.point_data["displacement"], run2d.displacements[-1])
 
 
@@ -150,3 +151,45 @@ def test_output_gmsh_figures_copies_only_the_figure_frames_and_none_writes_no_gm
     cli.run(str(run2d.out), log=lambda *_: None)
     assert not (run2d.out / "gmsh" / "results.msh").exists()
     assert (run2d.out / "figures" / "probe.png").exists()  # the frames were still read for the figures
+
+
+def _cloud_box(points):
+    return tuple(points.min(axis=0).tolist() + points.max(axis=0).tolist())
+
+
+def test_results_msh_opens_framed_on_the_cloud_in_2d_and_3d_with_several_blocks(run2d, run3d, gmsh_session):
+    """Gmsh frames a view on the model's bounding box (issue 16: it was a dot)."""
+    gmsh = gmsh_session
+    for run in (run2d, run3d):
+        gmsh.clear()
+        gmsh.open(str(export(run) / "results.msh"))
+        assert gmsh.model.getBoundingBox(-1, -1) == _cloud_box(run.points)
+
+
+def test_a_one_block_cloud_opens_framed_too(tmp_path, gmsh_session):
+    """With one block every node lies on one point entity: only the corner entities give the box."""
+    gmsh = gmsh_session
+    rng = np.random.default_rng(3)
+    points = rng.random((40, 3)) * [0.2, 0.05, 0.01] + [-0.1, 0.3, 0.0]
+    frame = Frame(path="f.vtu", points=points, point_data={"damage": np.zeros(40)},
+                  broken_bonds=np.zeros((0, 2), np.int64))
+    path = tmp_path / "results.msh"
+    write_results_msh(str(path), [(0, 0.0, frame)], block_names={1: "plate"})
+    gmsh.open(str(path))
+    assert gmsh.model.getBoundingBox(-1, -1) == _cloud_box(points)
+    assert [gmsh.model.getPhysicalName(0, tag) for _, tag in gmsh.model.getPhysicalGroups(0)] == ["plate"]
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    assert np.array_equal(np.asarray(coords).reshape(-1, 3)[np.argsort(node_tags)], points)
+
+
+def test_damage_pos_fixes_the_damage_range_and_hides_the_constant_legend_of_broken_bonds(run2d, gmsh_session):
+    gmsh = gmsh_session
+    gmsh.merge(str(export(run2d) / "damage_final.pos"))
+    damage, bonds = (gmsh.view.getIndex(t) for t in gmsh.view.getTags())
+    assert gmsh.option.getString(f"View[{damage}].Name") == "damage"
+    assert gmsh.option.getNumber(f"View[{damage}].RangeType") == 2  # custom: 0…1
+    assert (gmsh.option.getNumber(f"View[{damage}].CustomMin"),
+            gmsh.option.getNumber(f"View[{damage}].CustomMax")) == (0.0, 1.0)
+    assert gmsh.option.getNumber(f"View[{damage}].ShowScale") == 1
+    assert gmsh.option.getString(f"View[{bonds}].Name") == "broken bonds"
+    assert gmsh.option.getNumber(f"View[{bonds}].ShowScale") == 0  # its legend read "1 1 1"

@@ -23,6 +23,14 @@ struct BlockMaterial {
     const auto it = parameters.find(key);
     return it == parameters.end() ? std::nullopt : std::optional<double>(it->second);
   }
+  // The model's text parameters by name, each one of a closed list (materials/<model>: e.g. LPS's
+  // influence function); the reader fills in the parameter's default (its first choice).
+  std::map<std::string, std::string> choices;
+
+  std::string choice(const std::string& key, const std::string& otherwise) const {
+    const auto it = choices.find(key);
+    return it == choices.end() ? otherwise : it->second;
+  }
 };
 
 struct PairConstants {

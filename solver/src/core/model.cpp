@@ -61,6 +61,8 @@ Model build_model(const Case& c, Nodes nodes) {
   m.damping = c.damping;
   // Every block uses one material model (the reader checks it); its formulas give c and s0.
   m.material = make_material_table(c.blocks, c.analysis, c.horizon, c.thickness);
+  m.block_materials = c.blocks;
+  m.analysis = c.analysis;
   m.density.resize(n);
   m.block_index.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

@@ -18,6 +18,11 @@ struct Model {
   Nodes nodes;
   BondList bonds;  // the only part that changes: bonds break
   MaterialTable material;  // c and s0 per block pair, from the material model's formulas
+  // The blocks' materials as the case gives them and the analysis (3d, plane_stress,
+  // plane_strain): a law whose constants are more than c and s0 (a state-based one's moduli per
+  // block) reads them when it is made.
+  std::vector<BlockMaterial> block_materials;
+  std::string analysis = "3d";
   std::shared_ptr<const BondModel> bond_model;  // the material law (materials/<model>/)
   double horizon = 0.0;  // δ [m]
   double grid_spacing = 0.0;  // dx [m]

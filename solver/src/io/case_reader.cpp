@@ -158,6 +158,17 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
   const MaterialDefinition& law = material_registry().get(b.model);
   std::vector<std::string> allowed = {"id", "name", "model", "density"};
   for (const auto& p : law.parameters) allowed.push_back(p.name);
+  // A parameter of another model (poisson_ratio under model: pmb): say which model has it and what
+  // this one does instead, rather than only "unknown key".
+  for (const auto& item : j.items()) {
+    if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
+    for (const std::string& other : material_registry().keys())
+      for (const auto& p : material_registry().get(other).parameters)
+        if (p.name == item.key())
+          ck.fail(where + "." + item.key(), "model '" + b.model + "' has no parameter '" + item.key() + "' (" + b.model +
+                                                ": " + law.doc + "); model '" + other + "' has it (" + p.doc +
+                                                "): set model: " + other);
+  }
   ck.known_keys(j, where, allowed);
   const std::int64_t id = ck.integer(ck.required(j, "id", where + ".id"), where + ".id", 1, 1 << 30);
   if (id != static_cast<std::int64_t>(k) + 1)
@@ -168,6 +179,15 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
   for (const auto& p : law.parameters) {
     const std::string key = where + "." + p.name;
     const json* value = p.required ? &ck.required(j, p.name, key) : ck.optional(j, p.name);
+    if (!p.choices.empty()) {  // a text parameter: one of its names, the first by default
+      b.choices[p.name] = p.choices.front();
+      if (!value || value->is_null()) continue;
+      const std::string name = ck.string(*value, key);
+      if (std::find(p.choices.begin(), p.choices.end(), name) == p.choices.end())
+        ck.fail(key, "unknown name '" + name + "'" + closest(name, p.choices) + "; known: " + joined(p.choices));
+      b.choices[p.name] = name;
+      continue;
+    }
     if (!value || (!p.required && value->is_null())) continue;
     const double v = ck.number(*value, key);
     if (p.lower_inclusive) {
@@ -184,7 +204,7 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
     }
     if (!(v > p.lower && v < p.upper))
       ck.fail(key, "must be between " + show(json(p.lower)) + " and " + show(json(p.upper)) + " (exclusive), got " +
-                       show(*value));
+                       show(*value) + (p.bounds_reason.empty() ? std::string() : ": " + p.bounds_reason));
     b.parameters[p.name] = v;
   }
   if (law.check)
@@ -454,6 +474,13 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
       ck.fail("blocks[" + std::to_string(k) + "].model",
               "is '" + c.blocks[k].model + "' but blocks[0] is '" + c.blocks[0].model +
                   "': every block of a case must use the same material model");
+  // A text parameter (LPS's influence function) is one per case: m_i sums over both blocks of a bond.
+  for (std::size_t k = 1; k < c.blocks.size(); ++k)
+    for (const auto& [name, value] : c.blocks[k].choices)
+      if (value != c.blocks[0].choice(name, value))
+        ck.fail("blocks[" + std::to_string(k) + "]." + name, "is '" + value + "' but blocks[0] has '" +
+                                                               c.blocks[0].choice(name, value) +
+                                                               "': every block of a case must use the same " + name);
 
   if (const json* j = ck.optional(root, "breaking_order")) {
     c.breaking_order = ck.string(*j, "breaking_order");

@@ -40,7 +40,11 @@ struct MaterialParameter {
   // when lower_inclusive.
   double lower = 0.0;
   double upper = std::numeric_limits<double>::infinity();
-  bool lower_inclusive = false;
+  // Not empty: a text parameter, one of these names (the first is the default), not a number.
+  std::vector<std::string> choices = {};
+  // Why the range is what it is, appended to the reader's error for a value outside it.
+  std::string bounds_reason = {};
+  bool lower_inclusive = false;  // lower ≤ value instead of lower < value
 };
 
 // What a model's own check finds wrong with a block's parameters as a whole (a key and what to do);

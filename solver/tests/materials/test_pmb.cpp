@@ -57,7 +57,7 @@ TEST(Pmb, IsRegisteredWithItsParameters) {
     pd::material_registry().get("lps2");
     FAIL() << "no error";
   } catch (const pd::Error& e) {
-    EXPECT_EQ(std::string(e.what()), "unknown material model 'lps2'; known: pmb");
+    EXPECT_EQ(std::string(e.what()), "unknown material model 'lps2'; known: lps, pmb");
   }
 }
 

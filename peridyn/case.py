@@ -1,0 +1,146 @@
+"""A case file held in memory: read, changed by dotted keys, written and run stage by stage."""
+from __future__ import annotations
+
+import argparse
+import copy
+import glob
+import json
+import os
+import subprocess
+
+import yaml
+
+from pipeline.case import CaseError, load_case
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PYTHON = "/usr/bin/python3"
+
+
+class RunError(RuntimeError):
+    """A stage failed: the message names the stage, the command or file, and the log to read."""
+
+
+def load(path: str) -> "Case":
+    """The case file at `path` (checked against the schema now, so a bad file fails here)."""
+    load_case(path)  # CaseError with the file, the line and the key
+    with open(path, encoding="utf-8") as stream:
+        return Case(yaml.safe_load(stream) or {}, source=path)
+
+
+def _parts(key: str) -> list:
+    """"materials.glass.density" → ["materials", "glass", "density"]; "boundary_conditions.0.set"
+    → [..., 0, ...] (a list index)."""
+    return [int(p) if p.isdigit() else p for p in key.split(".")]
+
+
+class Case:
+    """The case file's data (a nested dict as YAML reads it) and the folder it came from, where the
+    case's .geo or given mesh (cases/<case>/<case>.geo | .unv | .msh) is found."""
+
+    def __init__(self, data: dict, source: str):
+        self.data = copy.deepcopy(data)
+        self.source = os.path.abspath(source)
+
+    @property
+    def folder(self) -> str:
+        return os.path.dirname(self.source)
+
+    @property
+    def base_name(self) -> str:
+        """The case's folder name: its .geo or mesh is <folder>/<base_name>.geo | .unv | .msh."""
+        return os.path.basename(self.folder)
+
+    def __getitem__(self, key: str):
+        node = self.data
+        for part in _parts(key):
+            try:
+                node = node[part]
+            except (KeyError, IndexError, TypeError):
+                raise KeyError(f"{key}: not in the case file {self.source} (defaults are in docs/case-file.md)") from None
+        return node
+
+    def __setitem__(self, key: str, value):
+        """Set a dotted key, making the sections on the way; checked against the schema at run()."""
+        parts = _parts(key)
+        node = self.data
+        for part in parts[:-1]:
+            if isinstance(node, list):
+                node = node[part]
+            else:
+                node = node.setdefault(part, {})
+        node[parts[-1]] = value
+
+    def copy(self) -> "Case":
+        return Case(self.data, self.source)
+
+    def write(self, path: str) -> str:
+        """Write the case file (YAML) and check it; returns the path."""
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        with open(path, "w", encoding="utf-8") as stream:
+            yaml.safe_dump(self.data, stream, sort_keys=False, allow_unicode=True)
+        load_case(path)
+        return path
+
+    def mesh_source(self) -> tuple[str, str]:
+        """("given", path) of cases/<case>/<case>.unv|.msh, else ("geo", path of the .geo)."""
+        for ext in (".unv", ".msh"):
+            path = os.path.join(self.folder, self.base_name + ext)
+            if os.path.isfile(path):
+                return "given", path
+        geo = os.path.join(self.folder, self.base_name + ".geo")
+        if not os.path.isfile(geo):
+            raise RunError(f"{self.source}: no mesh {self.base_name}.unv/.msh and no {self.base_name}.geo "
+                           f"in {self.folder}: a case needs one of them")
+        return "geo", geo
+
+    def run(self, out_dir: str, *, figures: bool = True, threads: int | None = None,
+            solver: str | None = None, log=None):
+        """Run the case into `out_dir` through make's stages; returns a results.Run.
+
+        The case file is written to <out_dir>/<basename(out_dir)>.yaml, so the run's name (in
+        case.json and the figures) is the folder's. The mesh is made again only when the gmsh
+        parameters changed (as make does); the solver's output goes to <out_dir>/solver.log.
+        solver: pdsolve's path (default: PDSOLVE, else build/solver/pdsolve); threads: its --threads.
+        """
+        from pipeline import run as stages
+
+        from .results import Run
+
+        say = log or (lambda text: None)
+        out_dir = os.path.abspath(out_dir)
+        name = os.path.basename(out_dir)
+        yaml_path = self.write(os.path.join(out_dir, name + ".yaml"))
+        kind, mesh = self.mesh_source()
+        if kind == "geo":
+            params, target = os.path.join(out_dir, "mesh-parameters.json"), os.path.join(out_dir, "mesh.msh")
+            before = os.path.getmtime(params) if os.path.isfile(params) else None
+            stages.cmd_mesh_parameters(argparse.Namespace(case=yaml_path, out=params))
+            if not os.path.isfile(target) or os.path.getmtime(params) != before:
+                say(f"mesh: {mesh} → {target}")
+                stages.cmd_mesh(argparse.Namespace(case=yaml_path, geo=mesh, out=target))
+            mesh = target
+        say(f"preprocess: {yaml_path} + {mesh} → {out_dir}/nodes.vtu, case.json")
+        stages.cmd_preprocess(argparse.Namespace(case=yaml_path, mesh=mesh, out_dir=out_dir))
+        solver = solver or os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+        if not os.path.isfile(solver):
+            raise RunError(f"{solver}: the solver is not built; run `make solver` in {ROOT}")
+        for stale in glob.glob(os.path.join(out_dir, "frames", "*.vtu")):
+            os.unlink(stale)  # frames of an earlier, longer run would stay listed nowhere but on disk
+        command = [solver, os.path.join(out_dir, "case.json")] + (["--threads", str(threads)] if threads else [])
+        say("solve: " + " ".join(command))
+        with open(os.path.join(out_dir, "solver.log"), "w", encoding="utf-8") as stream:
+            status = subprocess.run(command, stdout=stream, stderr=subprocess.STDOUT).returncode
+        if status != 0:
+            raise RunError(f"{' '.join(command)} failed (exit {status}); see {out_dir}/solver.log and run.log")
+        if figures:
+            from postprocess.cli import run as postprocess
+
+            say(f"postprocess: {out_dir}")
+            postprocess(out_dir, log=say)
+        return Run(out_dir)
+
+    def __repr__(self) -> str:
+        return f"peridyn.Case({self.source!r})"
+
+
+__all__ = ["Case", "CaseError", "RunError", "load"]

@@ -1,0 +1,76 @@
+"""history.json: the unit and meaning of every column of a run's history.csv, for people and programs.
+
+Written by postprocess beside history.csv from its header (the solver's columns are not touched):
+{"format_version": 1, "file": "history.csv",
+ "columns": {"<name>": {"unit": "J", "description": "…"}, …}}   (header order)
+Units are SI symbols; "1" marks a count or a ratio (formats.md §4 writes it "–"). The table below
+is formats.md §4's; tests/postprocess/test_post_history_json.py checks the two agree.
+"""
+from __future__ import annotations
+
+import json
+import re
+
+from pipeline.atomic import atomic_path
+
+FORMAT_VERSION = 1
+
+# name → (unit, description), formats.md §4 in its order.
+COLUMNS = {
+    "step": ("1", "completed steps"),
+    "time": ("s", "simulated time after the step"),
+    "dt": ("s", "the step just taken"),
+    "iterations": ("1", "fixed-point or Newton iterations K of the step (1 for Verlet)"),
+    "rejected": ("1", "rejected attempts before the step was accepted (0 for Verlet)"),
+    "kinetic_energy": ("J", "kinetic energy, sum of 1/2 rho V |v|^2"),
+    "strain_energy": ("J", "strain energy of the intact bonds, sum of 1/4 c s^2 |xi| V_i V_j"),
+    "external_work": ("J", "work of body forces, of the reactions at prescribed nodes and of moving indenters"),
+    "damping_work": ("J", "energy removed by damping, integral of sum rho alpha V |v|^2 dt"),
+    "broken_bonds": ("1", "broken bonds, each counted once"),
+    "wall_time": ("s", "wall-clock seconds since the time loop started"),
+    "contact_energy": ("J", "potential of the contact pairs (and of the indenters, where the solver adds them here)"),
+    "indenter_energy": ("J", "potential of the rigid indenters, sum of V K h^3/3"),
+    "contact_rebuilds": ("1", "Verlet-list builds of the contact search so far"),
+    "broken_bond_energy": ("J", "energy the broken bonds held when they broke, sum of 1/2 c s^2 |xi| nu V_i V_j"),
+    "mode": ("1", "kind of the step of the mixed integrator: 1 quasi-static load step, 0 explicit step"),
+}
+# Families of columns, one triple per indenter or node set: (pattern, unit, description template).
+FAMILIES = (
+    (re.compile(r"^indenter_(?P<name>.+)_f(?P<axis>[xyz])$"), "N",
+     "reaction force on indenter '{name}' along {axis} (minus its force on the body)"),
+    (re.compile(r"^reaction_(?P<name>.+)_f(?P<axis>[xyz])$"), "N",
+     "force the prescribed displacement or velocity applies to node set '{name}' along {axis}"),
+)
+
+
+def describe_column(name: str) -> tuple[str | None, str]:
+    """(unit, description) of a history.csv column; (None, …) for a column formats.md does not know."""
+    if name in COLUMNS:
+        return COLUMNS[name]
+    for pattern, unit, template in FAMILIES:
+        match = pattern.match(name)
+        if match:
+            return unit, template.format(**match.groupdict())
+    return None, "not documented in pipeline/formats.md §4 (a newer solver?)"
+
+
+def header_of(history_csv: str) -> list[str]:
+    """The column names of history.csv's header line (the first non-blank line)."""
+    with open(history_csv, encoding="utf-8") as stream:
+        for line in stream:
+            if line.strip():
+                return [name.strip() for name in line.split(",")]
+    return []
+
+
+def write_history_json(history_csv: str, path: str) -> dict:
+    """Write the sidecar of history_csv to path; returns its content."""
+    columns = {}
+    for name in header_of(history_csv):
+        unit, description = describe_column(name)
+        columns[name] = {"unit": unit, "description": description}
+    content = {"format_version": FORMAT_VERSION, "file": "history.csv", "columns": columns}
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as stream:
+        json.dump(content, stream, indent=1, ensure_ascii=False)
+        stream.write("\n")
+    return content

@@ -1,0 +1,449 @@
+// The LPS kernel in two sweeps over the bonds (materials/lps/lps.hpp): the first computes every
+// node's dilatation θ_i (breaking bonds first where asked), the second the force from θ of both
+// ends. Each sweep is parallel over nodes and a node writes only its own row and its own θ, f, W,
+// summing its bonds in row order: bitwise the same for any thread count.
+#include <algorithm>
+#include <cmath>
+
+#include "materials/lps/lps.hpp"
+
+namespace pd {
+
+// A stretch with |s| ≤ kStretchZero is set to zero, as PMB does (thesis §2.2, machine-precision
+// remark): round-off in y_j − y_i under a rigid motion would otherwise create forces.
+constexpr double kLpsStretchZero = 4.0 * DBL_EPSILON;
+
+// Plain pointers into the model, the law's per-node constants and u, so the sweeps are loops over arrays.
+struct LpsKernel {
+  const std::int64_t* offsets;
+  const std::int32_t* neighbour;
+  std::uint8_t* broken;  // written only by the breaking sweep, row by row
+  VolumeWeight volume_weight;
+  const double* x[3];
+  const double* u[3];
+  const double* volume;
+  const double* m;      // m_i
+  const double* kappa;  // κ_i
+  const double* a;      // α_i/m_i
+  const double* b;      // dκ_i/m_i
+  double d;
+  Influence kind;
+  double horizon;
+  std::int64_t nodes;
+
+  LpsKernel(const LpsModel& law, const Model& model, const Vec3Array& uu) {
+    offsets = model.bonds.offsets.data();
+    neighbour = model.bonds.neighbour.data();
+    broken = const_cast<std::uint8_t*>(model.bonds.broken.data());
+    volume_weight = model.bonds.volume_weight;
+    for (int q = 0; q < 3; ++q) {
+      x[q] = model.nodes.x[static_cast<std::size_t>(q)].data();
+      u[q] = uu[static_cast<std::size_t>(q)].data();
+    }
+    volume = model.nodes.volume.data();
+    m = law.m_.data();
+    kappa = law.kappa_.data();
+    a = law.a_.data();
+    b = law.b_.data();
+    d = law.d_;
+    kind = law.influence_;
+    horizon = law.horizon_;
+    nodes = static_cast<std::int64_t>(model.nodes.size());
+  }
+
+  // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, raw = y − |ξ| and the extension ext = raw but
+  // 0 where |raw| ≤ kLpsStretchZero·|ξ| (round-off), 1/y (1 for a crushed bond: its
+  // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j.
+  struct Bond {
+    double length, e0, e1, e2, y, raw, ext, inv_y, omega, vj;
+    // The breaking criterion (PMB's s > s0, without a division): y − |ξ| > s0 |ξ|. Both copies of
+    // a bond see bitwise the same y and |ξ|, so they break in the same sweep.
+    bool over(double s0) const { return raw > s0 * length; }
+  };
+  Bond bond(std::int64_t i, std::int64_t j) const {
+    Bond t;
+    const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
+    t.length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);  // core/bonds.hpp bond_length
+    t.e0 = (x[0][j] + u[0][j]) - (x[0][i] + u[0][i]);
+    t.e1 = (x[1][j] + u[1][j]) - (x[1][i] + u[1][i]);
+    t.e2 = (x[2][j] + u[2][j]) - (x[2][i] + u[2][i]);
+    t.y = std::sqrt(t.e0 * t.e0 + t.e1 * t.e1 + t.e2 * t.e2);
+    const double ext = t.y - t.length;
+    const bool real = std::fabs(ext) > kLpsStretchZero * t.length;
+    t.raw = ext;
+    t.ext = real ? ext : 0.0;
+    t.inv_y = 1.0 / (t.y > 0.0 ? t.y : 1.0);
+    t.omega = influence(kind, t.length, horizon);
+    t.vj = volume[j] * volume_weight(t.length);
+    return t;
+  }
+
+  // Σ ω|ξ| e V_j and m'_i = Σ ω|ξ|² V_j over row i's intact bonds.
+  void row_sums(std::int64_t i, double& sum_theta, double& m_intact) const {
+    double st = 0.0, sm = 0.0;
+    for (std::int64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+      if (broken[k]) continue;
+      const Bond t = bond(i, neighbour[k]);
+      st += t.omega * t.length * t.ext * t.vj;
+      sm += t.omega * t.length * t.length * t.vj;
+    }
+    sum_theta = st;
+    m_intact = sm;
+  }
+
+  double theta_of(std::int64_t i, double sum_theta) const { return m[i] > 0.0 ? d / m[i] * sum_theta : 0.0; }
+
+  // P_i of lps.hpp: t_ij = ω(|ξ| P_i + a_i e).
+  double p_of(std::int64_t i, double theta, double m_intact) const {
+    return m[i] > 0.0 ? theta * (b[i] - a[i] / d - a[i] * (m[i] - m_intact) / (d * m[i])) : 0.0;
+  }
+
+  // W_i = (κ/2)θ² + (a_i/2) Σ ω (e − θ|ξ|/d)² V_j over row i's intact bonds.
+  double row_energy(std::int64_t i, double theta) const {
+    double dev = 0.0;
+    for (std::int64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+      if (broken[k]) continue;
+      const Bond t = bond(i, neighbour[k]);
+      const double ed = t.ext - theta * t.length / d;
+      dev += t.omega * ed * ed * t.vj;
+    }
+    return 0.5 * kappa[i] * theta * theta + 0.5 * a[i] * dev;
+  }
+};
+
+namespace {
+
+// Bonds per chunk of a row: the chunk's terms are computed by loops the compiler vectorises (no
+// reduction in them), then summed in bond order by a short scalar loop, so the sums are those of
+// a plain loop over the row in order (and the slow exact paths above give bitwise the same).
+constexpr int kChunk = 64;
+
+// One binary for every x86-64 machine, each running its widest code with the same IEEE operations
+// (no FMA contraction: solver/CMakeLists.txt), as PMB's kernel (docs/performance.md).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define PD_LPS_CLONES __attribute__((target_clones("default", "arch=x86-64-v2", "arch=x86-64-v3")))
+#else
+#define PD_LPS_CLONES
+#endif
+
+// Sweep 1, row i from the current flags: Σ ω|ξ| ext V_j and m'_i; kBreaking also counts the intact
+// bonds over s0 (candidates: no-fail ends are left to dilatation_row); kOneBlock skips the gather of
+// the far end's block (one s0 for every bond).
+template <Influence kKind, bool kBreaking, bool kOneBlock>
+PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const double* s0_row,
+                                       const std::int32_t* block, double& sum_theta, double& m_intact,
+                                       std::int64_t& over) {
+  const double xi0 = k.x[0][i], xi1 = k.x[1][i], xi2 = k.x[2][i];
+  const double yi0 = xi0 + k.u[0][i], yi1 = xi1 + k.u[1][i], yi2 = xi2 + k.u[2][i];
+  double st = 0.0, sm = 0.0;
+  std::int64_t ov = 0;
+  const std::int64_t end = k.offsets[i + 1];
+  for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
+    std::int64_t jq[kChunk];
+    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk];
+    for (int q = 0; q < m; ++q) {
+      jq[q] = k.neighbour[base + q];
+      intact[q] = k.broken[base + q] ? 0.0 : 1.0;
+      if constexpr (kBreaking) s0q[q] = kOneBlock ? s0_row[0] : s0_row[block[jq[q]]];
+    }
+    for (int q = 0; q < m; ++q) {
+      const std::int64_t j = jq[q];
+      const double d0 = k.x[0][j] - xi0, d1 = k.x[1][j] - xi1, d2 = k.x[2][j] - xi2;
+      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+      const double e0 = (k.x[0][j] + k.u[0][j]) - yi0, e1 = (k.x[1][j] + k.u[1][j]) - yi1,
+                   e2 = (k.x[2][j] + k.u[2][j]) - yi2;
+      const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+      const double raw = y - length;
+      const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
+      const double omega = influence_of<kKind>(length, k.horizon);
+      const double vj = k.volume[j] * k.volume_weight(length);
+      ta[q] = intact[q] * (omega * length * ext * vj);
+      tb[q] = intact[q] * (omega * length * length * vj);
+      if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw > s0q[q] * length);  // Bond::over
+    }
+    for (int q = 0; q < m; ++q) {
+      st += ta[q];
+      sm += tb[q];
+    }
+  }
+  sum_theta = st;
+  m_intact = sm;
+  over = ov;
+}
+
+// Sweep 2, row i: the force density and W_i (lps.hpp), from θ and P of both ends.
+struct ForceRow {
+  double f0, f1, f2, w;
+};
+template <Influence kKind>
+PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const double* theta, const double* p) {
+  const double xi0 = k.x[0][i], xi1 = k.x[1][i], xi2 = k.x[2][i];
+  const double yi0 = xi0 + k.u[0][i], yi1 = xi1 + k.u[1][i], yi2 = xi2 + k.u[2][i];
+  const double pi = p[i], ai = k.a[i], th = theta[i], d = k.d;
+  double f0 = 0.0, f1 = 0.0, f2 = 0.0, dev = 0.0;
+  const std::int64_t end = k.offsets[i + 1];
+  for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
+    std::int64_t jq[kChunk];
+    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk];
+    for (int q = 0; q < m; ++q) {
+      jq[q] = k.neighbour[base + q];
+      intact[q] = k.broken[base + q] ? 0.0 : 1.0;
+      pq[q] = p[jq[q]];
+      aq[q] = k.a[jq[q]];
+    }
+    for (int q = 0; q < m; ++q) {
+      const std::int64_t j = jq[q];
+      const double d0 = k.x[0][j] - xi0, d1 = k.x[1][j] - xi1, d2 = k.x[2][j] - xi2;
+      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+      const double e0 = (k.x[0][j] + k.u[0][j]) - yi0, e1 = (k.x[1][j] + k.u[1][j]) - yi1,
+                   e2 = (k.x[2][j] + k.u[2][j]) - yi2;
+      const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+      const double raw = y - length;
+      const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
+      const double inv_y = 1.0 / (y > 0.0 ? y : 1.0);
+      const double omega = influence_of<kKind>(length, k.horizon);
+      const double vj = k.volume[j] * k.volume_weight(length);
+      const double tt = omega * (length * (pi + pq[q]) + (ai + aq[q]) * ext);
+      const double scale = intact[q] * (tt * vj * inv_y);
+      t0[q] = scale * e0;
+      t1[q] = scale * e1;
+      t2[q] = scale * e2;
+      const double ed = ext - th * length / d;
+      tw[q] = intact[q] * (omega * ed * ed * vj);
+    }
+    for (int q = 0; q < m; ++q) {  // in bond order: the same sums for any thread count
+      f0 += t0[q];
+      f1 += t1[q];
+      f2 += t2[q];
+      dev += tw[q];
+    }
+  }
+  return ForceRow{f0, f1, f2, 0.5 * k.kappa[i] * th * th + 0.5 * ai * dev};
+}
+
+// What the breaking sweep needs besides the kernel (the PMB criterion: a bond breaks once its
+// stretch exceeds s0 of its block pair, unless an end is in a no-fail set).
+struct Breaking {
+  const double* s0_pair;
+  const std::int32_t* block;
+  std::int64_t blocks;
+  const std::uint8_t* no_fail;
+  double* lost;  // per node, or null: V_i (W_i before − W_i after) [J]
+};
+
+// Sweep 1 for row i: θ_i and m'_i; with breaking, first breaks the row's bonds over their critical
+// stretch (only row i's flags: both copies of a bond see bitwise the same stretch, since y_j − y_i
+// is the exact negative of y_i − y_j, and break in the same sweep). Returns the bonds i < j broken.
+std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* br, double& theta, double& m_intact) {
+  double sum_theta = 0.0;
+  k.row_sums(i, sum_theta, m_intact);
+  theta = k.theta_of(i, sum_theta);
+  if (!br || br->no_fail[i]) {
+    if (br && br->lost) br->lost[i] = 0.0;
+    return 0;
+  }
+  const double* s0_row = br->s0_pair + br->block[i] * br->blocks;
+  std::int64_t over = 0;
+  for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
+    const std::int64_t j = k.neighbour[q];
+    if (k.broken[q] || br->no_fail[j]) continue;
+    over += k.bond(i, j).over(s0_row[br->block[j]]);
+  }
+  if (over == 0) {
+    if (br->lost) br->lost[i] = 0.0;
+    return 0;
+  }
+  const double before = br->lost ? k.row_energy(i, theta) : 0.0;
+  std::int64_t once = 0;
+  for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
+    const std::int64_t j = k.neighbour[q];
+    if (k.broken[q] || br->no_fail[j] || !k.bond(i, j).over(s0_row[br->block[j]])) continue;
+    k.broken[q] = 1;
+    once += i < j;
+  }
+  k.row_sums(i, sum_theta, m_intact);
+  theta = k.theta_of(i, sum_theta);
+  if (br->lost) br->lost[i] = k.volume[i] * (before - k.row_energy(i, theta));
+  return once;
+}
+
+// Sweep 1 over every node: θ and P per node. Returns the bonds broken now (each once). A row with
+// candidates for breaking (rare: near a crack tip) is redone by dilatation_row, exactly.
+template <Influence kKind>
+std::int64_t dilatation_sweep_of(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
+                                 std::vector<double>& p) {
+  theta.assign(static_cast<std::size_t>(k.nodes), 0.0);
+  p.assign(static_cast<std::size_t>(k.nodes), 0.0);
+  std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
+#pragma omp parallel for schedule(static) reduction(+ : newly)
+  for (std::int64_t i = 0; i < k.nodes; ++i) {
+    double th = 0.0, st = 0.0, mi = 0.0;
+    std::int64_t over = 0;
+    if (br && !br->no_fail[i]) {
+      const double* s0_row = br->s0_pair + br->block[i] * br->blocks;
+      if (br->blocks == 1) dilatation_row_fast<kKind, true, true>(k, i, s0_row, br->block, st, mi, over);
+      else dilatation_row_fast<kKind, true, false>(k, i, s0_row, br->block, st, mi, over);
+    } else {
+      dilatation_row_fast<kKind, false, true>(k, i, nullptr, nullptr, st, mi, over);
+    }
+    if (over > 0) {
+      newly += dilatation_row(k, i, br, th, mi);
+    } else {
+      th = k.theta_of(i, st);
+      if (br && br->lost) br->lost[i] = 0.0;
+    }
+    theta[static_cast<std::size_t>(i)] = th;
+    p[static_cast<std::size_t>(i)] = k.p_of(i, th, mi);
+  }
+  return newly;
+}
+
+std::int64_t dilatation_sweep(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
+                              std::vector<double>& p) {
+  switch (k.kind) {
+    case Influence::inverse_length: return dilatation_sweep_of<Influence::inverse_length>(k, br, theta, p);
+    case Influence::gaussian: return dilatation_sweep_of<Influence::gaussian>(k, br, theta, p);
+    case Influence::one: break;
+  }
+  return dilatation_sweep_of<Influence::one>(k, br, theta, p);
+}
+
+// Sweep 2: f_i += Σ_j (t_ij + t_ji) V_j e/y, t_ij + t_ji = ω(|ξ|(P_i + P_j) + (a_i + a_j) ext); W_i.
+template <Influence kKind>
+void force_sweep_of(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
+                    double* w) {
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < k.nodes; ++i) {
+    const ForceRow r = force_row_fast<kKind>(k, i, theta.data(), p.data());
+    const auto iu = static_cast<std::size_t>(i);
+    f[0][iu] += r.f0;
+    f[1][iu] += r.f1;
+    f[2][iu] += r.f2;
+    if (w) w[i] = r.w;
+  }
+}
+
+void force_sweep(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
+                 double* w) {
+  switch (k.kind) {
+    case Influence::inverse_length: return force_sweep_of<Influence::inverse_length>(k, theta, p, f, w);
+    case Influence::gaussian: return force_sweep_of<Influence::gaussian>(k, theta, p, f, w);
+    case Influence::one: break;
+  }
+  force_sweep_of<Influence::one>(k, theta, p, f, w);
+}
+
+Breaking breaking_of(Model& m, double* lost) {
+  return Breaking{m.material.critical_pair.data(), m.block_index.data(), m.material.blocks, m.no_fail.data(), lost};
+}
+
+}  // namespace
+
+void LpsModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const {
+  const LpsKernel k(*this, model, u);
+  std::vector<double> theta, p;
+  dilatation_sweep(k, nullptr, theta, p);
+  force_sweep(k, theta, p, f, w);
+}
+
+BreakReport LpsModel::break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                bool want_energy) const {
+  const LpsKernel k(*this, model, u);
+  std::vector<double> theta, p, lost(want_energy ? model.nodes.size() : 0, 0.0);
+  const Breaking br = breaking_of(model, want_energy ? lost.data() : nullptr);
+  BreakReport r;
+  r.broken = dilatation_sweep(k, model.material.can_break() ? &br : nullptr, theta, p);
+  force_sweep(k, theta, p, f, w);
+  if (r.broken > 0)
+    for (double e : lost) r.energy += e;  // serially in node order: the same for any thread count
+  return r;
+}
+
+BreakReport LpsModel::break_bonds(Model& model, const Vec3Array& u, bool want_energy) const {
+  BreakReport r;
+  if (!model.material.can_break()) return r;
+  const LpsKernel k(*this, model, u);
+  std::vector<double> theta, p, lost(want_energy ? model.nodes.size() : 0, 0.0);
+  const Breaking br = breaking_of(model, want_energy ? lost.data() : nullptr);
+  r.broken = dilatation_sweep(k, &br, theta, p);
+  if (r.broken > 0)
+    for (double e : lost) r.energy += e;
+  return r;
+}
+
+std::vector<double> LpsModel::strain_energy_density(const Model& model, const Vec3Array& u) const {
+  const LpsKernel k(*this, model, u);
+  std::vector<double> w(model.nodes.size(), 0.0);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < k.nodes; ++i) {
+    double st = 0.0, mi = 0.0;
+    k.row_sums(i, st, mi);
+    w[static_cast<std::size_t>(i)] = k.row_energy(i, k.theta_of(i, st));
+  }
+  return w;
+}
+
+std::vector<double> LpsModel::dilatation(const Model& model, const Vec3Array& u) const {
+  const LpsKernel k(*this, model, u);
+  std::vector<double> theta, p;
+  dilatation_sweep(k, nullptr, theta, p);
+  return theta;
+}
+
+// δf = J(u)·x in the same two sweeps: δθ_i = (d/m_i) Σ ω|ξ| (n·δη) V_j, δP_i = γ_i δθ_i with
+// γ_i = P_i/θ_i (m'_i does not depend on u), and per bond, n = e/y, δη = x_j − x_i,
+//   δf_i += V_j { ω[|ξ|(δP_i + δP_j) + (a_i + a_j) n·δη] n + T (δη − n (n·δη))/y },
+// T = t_ij + t_ji (the rotation of a loaded bond). Bonds crushed to a point (y = 0) carry no force
+// and have no direction: left out, as the kernel leaves their force out.
+void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  const LpsKernel k(*this, model, u);
+  const auto n = static_cast<std::size_t>(k.nodes);
+  std::vector<double> p(n), dp(n);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < k.nodes; ++i) {
+    double st = 0.0, sd = 0.0, sm = 0.0;
+    for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
+      if (k.broken[q]) continue;
+      const std::int64_t j = k.neighbour[q];
+      const LpsKernel::Bond t = k.bond(i, j);
+      const double along = t.y > 0.0 ? ((x[0][j] - x[0][i]) * t.e0 + (x[1][j] - x[1][i]) * t.e1 +
+                                        (x[2][j] - x[2][i]) * t.e2) * t.inv_y
+                                     : 0.0;
+      st += t.omega * t.length * t.ext * t.vj;
+      sd += t.omega * t.length * along * t.vj;
+      sm += t.omega * t.length * t.length * t.vj;
+    }
+    const double theta = k.theta_of(i, st);
+    p[static_cast<std::size_t>(i)] = k.p_of(i, theta, sm);
+    dp[static_cast<std::size_t>(i)] = k.p_of(i, k.theta_of(i, sd), sm);  // P is linear in θ at fixed m'
+  }
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < k.nodes; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
+      if (k.broken[q]) continue;
+      const std::int64_t j = k.neighbour[q];
+      const auto ju = static_cast<std::size_t>(j);
+      const LpsKernel::Bond t = k.bond(i, j);
+      if (!(t.y > 0.0)) continue;
+      const double n0 = t.e0 * t.inv_y, n1 = t.e1 * t.inv_y, n2 = t.e2 * t.inv_y;
+      const double x0 = x[0][ju] - x[0][iu], x1 = x[1][ju] - x[1][iu], x2 = x[2][ju] - x[2][iu];
+      const double along = n0 * x0 + n1 * x1 + n2 * x2;
+      const double ai_aj = k.a[i] + k.a[j];
+      const double dt = t.omega * (t.length * (dp[iu] + dp[ju]) + ai_aj * along);
+      const double tt = t.omega * (t.length * (p[iu] + p[ju]) + ai_aj * t.ext);
+      const double turn = tt * t.inv_y;
+      s0 += t.vj * (dt * n0 + turn * (x0 - n0 * along));
+      s1 += t.vj * (dt * n1 + turn * (x1 - n1 * along));
+      s2 += t.vj * (dt * n2 + turn * (x2 - n2 * along));
+    }
+    y[0][iu] += s0;
+    y[1][iu] += s1;
+    y[2][iu] += s2;
+  }
+}
+
+}  // namespace pd
