@@ -6,6 +6,7 @@
 # libraries (apt-get install -s --no-install-recommends lammps: 5 packages).
 set -eu
 PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev nlohmann-json3-dev zlib1g-dev \
+libopenmpi-dev openmpi-bin \
 gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
 python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev lammps"
 missing=""

@@ -112,6 +112,7 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "time": time,
         "adaptive": dict(case["adaptive"]),
         "quasi_static": dict(case["quasi_static"]),
+        "implicit": dict(case["implicit"]),
         "mixed": dict(case["mixed"]),
         "output": dict(case["output"]),
         "figures": figures,

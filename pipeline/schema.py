@@ -203,8 +203,9 @@ CASE = {
                        "quasi_static (time is a load parameter: equilibrium by Newton at every load step, "
                        "settings in quasi_static:) or mixed (quasi-static load steps while the body is in "
                        "equilibrium, Verlet at time.dt while a crack runs, switching both ways by itself; "
-                       "settings in mixed: and quasi_static:)",
-                       default="verlet", choices=("verlet", "adaptive", "quasi_static", "mixed")),
+                       "settings in mixed: and quasi_static:) or implicit (dynamics by the generalized-α method "
+                       "solved by Newton, the step set by a local error estimate: settings in implicit:)",
+                       default="verlet", choices=("verlet", "adaptive", "quasi_static", "mixed", "implicit")),
         dt=Key("number_or_choice", "time step: 'stable' (thesis eq. 2.5, minimised over nodes, times "
                "safety_factor), 'exact' (2/ω_max, ω_max² the largest eigenvalue of the linearised PMB "
                "operator M⁻¹K, times safety_factor: about 1.7× 'stable' in 2D, 2× in 3D), or a number; "
@@ -257,6 +258,35 @@ CASE = {
                    "end/100)", default=None, unit="s",
                    above=0.0),
         dt_max=Key("number", "largest load step (default: end/10)", default=None, unit="s", above=0.0),
+    ),
+    "implicit": section(
+        "implicit dynamics (time.integrator: implicit): the generalized-α method (Chung & Hulbert "
+        "1993) solved by Newton's method with a sparse Cholesky factorisation of the tangent plus the "
+        "lumped mass (CHOLMOD); the step is limited by accuracy, not by the explicit limit: a local "
+        "error estimate (Zienkiewicz & Xie 1991) below tol, and eq. 2.8 from the Newton iterations; "
+        "bonds break after each accepted step; damping is integrated implicitly",
+        rho_infinity=Key("number", "ρ∞: the amplification of the highest frequencies per step; 1 is "
+                         "Newmark's average acceleration (trapezoidal) rule, which conserves the energy "
+                         "of a linear system; below 1 damps the high frequencies (0.8: mildly, 0: "
+                         "strongest), the low ones barely", default=1.0, minimum=0.0, maximum=1.0),
+        tol=Key("number", "TOL on the local error estimate of a step relative to its motion (about the "
+                "relative phase error it adds); a step above it is redone with a smaller Δt",
+                default=1e-3, above=0.0, below=1.0),
+        newton_tol=Key("number", "Newton: the last correction relative to the step's motion (eq. 2.6 "
+                       "for Newton); well below tol, so that the iteration error stays under the time error",
+                       default=1e-6, above=0.0, below=1.0),
+        residual_tol=Key("number", "Newton: the out-of-balance force relative to the inertia plus the "
+                         "force", default=1e-8, above=0.0, below=1.0),
+        kd=Key("integer", "K_d: the Newton iterations a step is aimed at (eq. 2.8)", default=5,
+               minimum=1, maximum=1000),
+        p=Key("number", "exponent p of eq. 2.8", default=2.0, above=0.0),
+        max_iterations=Key("integer", "Newton iterations before the step is halved", default=20,
+                           minimum=1, maximum=100000),
+        dt_initial=Key("number", "the first step (default: from time.dt)", default=None, unit="s",
+                       above=0.0),
+        dt_min=Key("number", "smallest step; a step not accepted there stops the run (default: 1e-6 × "
+                   "eq. 2.5)", default=None, unit="s", above=0.0),
+        dt_max=Key("number", "largest step (default: end/10)", default=None, unit="s", above=0.0),
     ),
     "mixed": section(
         "the mixed scheme (time.integrator: mixed): quasi-static load steps (the quasi_static "

@@ -12,6 +12,7 @@
 #include "io/case_reader.hpp"
 #include "io/describe.hpp"
 #include "io/node_file.hpp"
+#include "parallel/session.hpp"
 #include "run.hpp"
 
 #ifdef _OPENMP
@@ -82,7 +83,8 @@ void print_version() {
 #else
             << "OpenMP: off\n"
 #endif
-            << "sanitizers: " << pd::build::kSanitizers << "\n";
+            << "sanitizers: " << pd::build::kSanitizers << "\n"
+            << "MPI: " << (pd::built_with_mpi() ? "on (PD_MPI; mpirun -np R pdsolve CASE.json)" : "off") << "\n";
 }
 
 [[noreturn]] void usage_error(const std::string& what) {
@@ -129,7 +131,16 @@ int print_stable_dt(const std::filesystem::path& case_file, bool exact) {
 
 }  // namespace
 
+// MPI's ranks for the lifetime of main (parallel/session.hpp; nothing without PD_MPI).
+struct Ranks {
+  Ranks(int* argc, char*** argv) { pd::start_ranks(argc, argv); }
+  ~Ranks() { pd::stop_ranks(); }
+  Ranks(const Ranks&) = delete;
+  Ranks& operator=(const Ranks&) = delete;
+};
+
 int main(int argc, char** argv) {
+  const Ranks ranks(&argc, &argv);
   // Keep freed memory in the heap. A frame of 10⁵ nodes is built in buffers of ~10 MB; glibc would
   // map and unmap them at every frame, and touching fresh pages costs more than writing the file
   // (cases/branching: output 44 % → 9.5 % of the time loop, docs/performance.md §3). Buffers over
@@ -187,7 +198,8 @@ int main(int argc, char** argv) {
     }
     return pd::run(options);
   } catch (const pd::Error& e) {
-    std::cerr << "pdsolve: error: " << e.what() << "\n";
+    // Bad input is found by every rank of a decomposed run alike (each reads the same files): one says it.
+    if (pd::world_ranks().rank == 0) std::cerr << "pdsolve: error: " << e.what() << "\n";
     return pd::kInputError;
   } catch (const std::exception& e) {
     std::cerr << "pdsolve: internal error: " << e.what() << "\n";

@@ -187,9 +187,13 @@ TEST(CaseFile, RejectsBadValuesNamingTheKey) {
   expect_case_error("\"kd\": 20", "\"kd\": 0", {"adaptive.kd: must be between 1 and 1000"});
   expect_case_error("\"tol\": 1e-3", "\"tol\": 1.5", {"adaptive.tol: must be below 1"});
   expect_case_error("\"dt_min\": null, \"dt_max\": null", "\"dt_min\": 1.0, \"dt_max\": 0.5", {"adaptive.dt_min: is larger than adaptive.dt_max"});
+  expect_case_error("\"p\": 3.0, \"phi\"", "\"p\": 3.0, \"phi\": 1.0}, \"implicit\": {\"rho_infinity\": 1.5, \"p\"",
+                    {"implicit.rho_infinity: must be between 0 and 1 (1: no numerical dissipation), got 1.5"});
+  expect_case_error("\"p\": 3.0, \"phi\"", "\"p\": 3.0, \"phi\": 1.0}, \"implicit\": {\"newton_tol\": 2, \"p\"",
+                    {"implicit.newton_tol: must be below 1 (a relative error), got 2"});
   expect_case_error("\"p\": 3.0", "\"p\": 3.0, \"pp\": 1", {"adaptive.pp: unknown key (did you mean 'p'?)"});
   expect_case_error("\"dt\": \"stable\"", "\"dt\": -1e-6", {"time.dt: must be > 0"});
-  expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: adaptive, mixed, quasi_static, verlet"});
+  expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: adaptive, implicit, mixed, quasi_static, verlet"});
   expect_case_error("\"analysis\": \"plane_stress\"", "\"analysis\": \"planar\"", {"analysis: unknown analysis 'planar'; known: 3d, plane_strain, plane_stress"});
   expect_case_error("\"analysis\": \"plane_stress\"", "\"analysis\": \"3d\"", {"analysis: '3d' does not fit dimension 2"});
   expect_case_error("\"density\": 1200.0", "\"density\": \"heavy\"", {"blocks[0].density: must be a number"});

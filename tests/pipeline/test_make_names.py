@@ -78,3 +78,26 @@ def test_valid_names_pass_and_are_quoted():
     assert result.stdout.strip() == "rm -rf -- 'out/membrane-adaptive'"
     result = make("-n", "clean-case")   # the default case
     assert result.returncode == 0 and result.stdout.strip() == "rm -rf -- 'out/membrane'"
+
+
+@pytest.mark.parametrize("value", [
+    "a`touch$${IFS}{marker}`",
+    "$(shell touch {marker})",
+    "1;touch {marker}",
+    "x", "0", "-2", "2.5",
+])
+def test_ranks_is_a_number_of_mpi_ranks(tmp_path, value):
+    marker = tmp_path / "pwned"
+    result = make("clean-case", "case=membrane", "RANKS=" + value.replace("{marker}", str(marker)))
+    assert result.returncode != 0
+    assert "is not a number of MPI ranks" in result.stderr, result.stderr
+    assert not marker.exists()
+
+
+def test_ranks_puts_the_solver_under_mpiexec():
+    def solve_line(*args):
+        result = make("-n", "case=membrane", *args, "out/membrane/.solved")
+        return [line for line in result.stdout.splitlines() if "exec " in line and "--restart" not in line]
+    assert not any("mpiexec" in line for line in solve_line())
+    assert not any("mpiexec" in line for line in solve_line("RANKS=1"))
+    assert any("exec mpiexec --oversubscribe -np 3 'build/solver/pdsolve'" in line for line in solve_line("RANKS=3"))

@@ -56,6 +56,19 @@ struct QuasiStaticSettings {
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-6, end/10
 };
 
+// implicit: dynamics by the generalized-α method solved by Newton (integrators/implicit.hpp), the
+// step set by a local error estimate and by eq. 2.8 from the Newton iterations.
+struct ImplicitSettings {
+  double rho_infinity = 1.0;   // ρ∞: spectral radius at infinite frequency (1: trapezoidal, no dissipation)
+  double tol = 1e-3;           // TOL on the local error estimate relative to the step's motion
+  double newton_tol = 1e-6;    // Newton: the last correction relative to the step's motion (eq. 2.6)
+  double residual_tol = 1e-8;  // Newton: ‖r‖ ≤ this × (‖inertia‖ + ‖force‖)
+  int kd = 5;                  // K_d: the Newton iterations a step is aimed at (eq. 2.8)
+  double p = 2.0;              // exponent of eq. 2.8
+  int max_iterations = 20;     // Newton iterations before the step is cut
+  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: time.dt, 1e-6 × eq. 2.5, end/10
+};
+
 // mixed: quasi-static load steps while the body is in equilibrium, Verlet while a crack runs
 // (integrators/mixed.hpp); the quasi_static section sets the load steps, time.dt the explicit ones.
 struct MixedSettings {
@@ -133,6 +146,7 @@ struct Case {
   TimeSettings time;
   AdaptiveSettings adaptive;
   QuasiStaticSettings quasi_static;
+  ImplicitSettings implicit;
   MixedSettings mixed;
   OutputSettings output;
 };

@@ -351,6 +351,36 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
   return q;
 }
 
+// The implicit section (integrators/implicit.hpp).
+ImplicitSettings read_implicit(const Checker& ck, const json& j) {
+  ck.object(j, "implicit");
+  ck.known_keys(j, "implicit", case_keys().at("implicit"));
+  ImplicitSettings m;
+  if (const json* v = ck.optional(j, "rho_infinity")) {
+    m.rho_infinity = ck.number(*v, "implicit.rho_infinity");
+    // Chung & Hulbert's family is unconditionally stable and second order for ρ∞ in [0, 1].
+    if (m.rho_infinity < 0.0 || m.rho_infinity > 1.0)
+      ck.fail("implicit.rho_infinity", "must be between 0 and 1 (1: no numerical dissipation), got " + show(*v));
+  }
+  for (auto [name, slot] : {std::pair<const char*, double*>{"tol", &m.tol}, {"newton_tol", &m.newton_tol},
+                            {"residual_tol", &m.residual_tol}})
+    if (const json* v = ck.optional(j, name)) {
+      *slot = ck.positive(*v, std::string("implicit.") + name);
+      if (!(*slot < 1.0)) ck.fail(std::string("implicit.") + name, "must be below 1 (a relative error), got " + show(*v));
+    }
+  if (const json* v = ck.optional(j, "kd")) m.kd = static_cast<int>(ck.integer(*v, "implicit.kd", 1, 1000));
+  if (const json* v = ck.optional(j, "p")) m.p = ck.positive(*v, "implicit.p");
+  if (const json* v = ck.optional(j, "max_iterations"))
+    m.max_iterations = static_cast<int>(ck.integer(*v, "implicit.max_iterations", 1, 100000));
+  for (auto [name, slot] : {std::pair<const char*, std::optional<double>*>{"dt_initial", &m.dt_initial},
+                            {"dt_min", &m.dt_min}, {"dt_max", &m.dt_max}})
+    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("implicit.") + name);
+  if (m.dt_min && m.dt_max && *m.dt_min > *m.dt_max) ck.fail("implicit.dt_min", "is larger than implicit.dt_max");
+  if (m.dt_initial && m.dt_max && *m.dt_initial > *m.dt_max) ck.fail("implicit.dt_initial", "is larger than implicit.dt_max");
+  if (m.dt_initial && m.dt_min && *m.dt_initial < *m.dt_min) ck.fail("implicit.dt_initial", "is smaller than implicit.dt_min");
+  return m;
+}
+
 // The mixed section (integrators/mixed.hpp).
 MixedSettings read_mixed(const Checker& ck, const json& j) {
   ck.object(j, "mixed");
@@ -400,7 +430,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "mixed", "output", "figures", "partial_volume", "breaking_order", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "breaking_order", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -410,6 +440,8 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
       {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "dt_initial", "dt_min",
                         "dt_max"}},
+      {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
+                    "dt_min", "dt_max"}},
       {"mixed", {"unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
@@ -534,6 +566,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
 
   if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) c.adaptive = read_adaptive(ck, *j);
   if (const json* j = ck.optional(root, "quasi_static"); j && !j->is_null()) c.quasi_static = read_quasi_static(ck, *j);
+  if (const json* j = ck.optional(root, "implicit"); j && !j->is_null()) c.implicit = read_implicit(ck, *j);
   if (const json* j = ck.optional(root, "mixed"); j && !j->is_null()) c.mixed = read_mixed(ck, *j);
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 

@@ -136,6 +136,18 @@ json describe_case() {
   keys["quasi_static.dt_initial"] = defaulted("number", value_or_null(q.dt_initial), {{"above", 0.0}, {"unit", "s"}});
   keys["quasi_static.dt_min"] = defaulted("number", value_or_null(q.dt_min), {{"above", 0.0}, {"unit", "s"}});
   keys["quasi_static.dt_max"] = defaulted("number", value_or_null(q.dt_max), {{"above", 0.0}, {"unit", "s"}});
+  const ImplicitSettings im{};
+  keys["implicit"] = defaulted("object", json::object());
+  keys["implicit.rho_infinity"] = defaulted("number", im.rho_infinity, {{"minimum", 0.0}, {"maximum", 1.0}});
+  keys["implicit.tol"] = defaulted("number", im.tol, {{"above", 0.0}, {"below", 1.0}});
+  keys["implicit.newton_tol"] = defaulted("number", im.newton_tol, {{"above", 0.0}, {"below", 1.0}});
+  keys["implicit.residual_tol"] = defaulted("number", im.residual_tol, {{"above", 0.0}, {"below", 1.0}});
+  keys["implicit.kd"] = defaulted("integer", im.kd, {{"minimum", 1}, {"maximum", 1000}});
+  keys["implicit.p"] = defaulted("number", im.p, positive);
+  keys["implicit.max_iterations"] = defaulted("integer", im.max_iterations, {{"minimum", 1}, {"maximum", 100000}});
+  keys["implicit.dt_initial"] = defaulted("number", value_or_null(im.dt_initial), {{"above", 0.0}, {"unit", "s"}});
+  keys["implicit.dt_min"] = defaulted("number", value_or_null(im.dt_min), {{"above", 0.0}, {"unit", "s"}});
+  keys["implicit.dt_max"] = defaulted("number", value_or_null(im.dt_max), {{"above", 0.0}, {"unit", "s"}});
   const MixedSettings mx{};
   keys["mixed"] = defaulted("object", json::object());
   keys["mixed.unstable_rounds"] = defaulted("integer", mx.unstable_rounds, {{"minimum", 1}, {"maximum", 100000000}});

@@ -295,12 +295,14 @@ RunLog::RunLog(std::filesystem::path path, bool quiet, bool append) : path_(std:
 }
 
 void RunLog::line(const std::string& text) {
+  if (path_.empty()) return;  // a rank other than 0 of a decomposed run: rank 0 writes the log
   if (!quiet_) std::cout << text << std::endl;
   text_ += text + "\n";
   write_file_atomically(path_, text_);
 }
 
 void RunLog::error(const std::string& text) {
+  if (path_.empty()) return;
   std::cerr << text << std::endl;
   text_ += text + "\n";
   write_file_atomically(path_, text_);

@@ -96,7 +96,8 @@ class OutputWriter {
 // atomically after every message so run.log is complete even if the run is killed.
 class RunLog {
  public:
-  // append: keep what run.log holds already (a restarted run adds to it).
+  // append: keep what run.log holds already (a restarted run adds to it). An empty path: a log that
+  // says nothing (the ranks other than 0 of a decomposed run).
   RunLog(std::filesystem::path path, bool quiet, bool append = false);
   void line(const std::string& text);
   void error(const std::string& text);  // stderr always, and run.log

@@ -70,9 +70,11 @@ class BondModel {
   virtual void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const = 0;
   // Breaks every intact bond over its critical stretch at u, then adds the force of the intact
   // bonds as add_force does (the thesis §2.2 order: bonds break after the state update, before the
-  // force there). want_energy: also the energy the broken bonds held.
+  // force there). want_energy: also the energy the broken bonds held. lost_per_node (a decomposed
+  // run, size = nodes, zeros on entry): each node's share of that energy is left there instead and
+  // BreakReport::energy is 0 — the operator sums the shares over the ranks in node order.
   virtual BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
-                                                bool want_energy) const = 0;
+                                                bool want_energy, double* lost_per_node = nullptr) const = 0;
   // Only the breaking of break_bonds_and_add_force.
   virtual BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const = 0;
   // W_i per node at u [J/m³].

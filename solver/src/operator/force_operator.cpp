@@ -3,8 +3,10 @@
 
 #include <algorithm>
 
+#include "core/error.hpp"
 #include "core/stability.hpp"
 #include "forces/damping.hpp"
+#include "parallel/node_sum.hpp"
 
 namespace pd {
 
@@ -24,6 +26,7 @@ ForceOperator::ForceOperator(Model& model) : model_(model) {
 }
 
 void ForceOperator::evaluate(State& s, double t) const {
+  if (decomposed_) decomposed_->update_ghosts(s.u);
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
   model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
   s.contact_energy = 0.0;
@@ -32,7 +35,19 @@ void ForceOperator::evaluate(State& s, double t) const {
 
 BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
-  const BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
+  BreakReport report;
+  if (!decomposed_) {
+    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
+  } else {
+    // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
+    // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
+    decomposed_->update_ghosts(s.u);
+    std::vector<double> lost(s.size(), 0.0);
+    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost.data());
+    report.broken = decomposed_->total(report.broken);
+    // The energy the broken bonds held, summed per node in node order as the serial path sums it.
+    if (report.broken > 0) report.energy = decomposed_->ordered_sum(lost);
+  }
   s.contact_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
   return report;
@@ -169,20 +184,17 @@ void ForceOperator::impose_prescribed_velocity(Vec3Array& v, double t1) const {
 
 double ForceOperator::kinetic_energy(const State& s) const {
   const Model& m = model_;
-  double sum = 0.0;  // serial, node order: the same for any thread count
-  for (std::size_t i = 0; i < s.size(); ++i)
-    sum += 0.5 * m.density[i] * m.nodes.volume[i] *
-           (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
-  return sum;
+  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) {
+    return 0.5 * m.density[i] * m.nodes.volume[i] * (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
+  });
 }
 
 double ForceOperator::strain_energy(const State& s) const {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < s.size(); ++i) sum += s.w[i] * model_.nodes.volume[i];
-  return sum;
+  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) { return s.w[i] * model_.nodes.volume[i]; });
 }
 
 double ForceOperator::external_power(const State& s, double t) const {
+  if (decomposed_) return decomposed_external_power(s, t);
   double p = 0.0;
   for (const ForceTerm* term : power_terms_) term->add_power(s, t, p);
   for (const auto& bc : model_.conditions.prescribed) {
@@ -197,21 +209,69 @@ double ForceOperator::external_power(const State& s, double t) const {
   return p;
 }
 
+// The serial loops of external_power and damping_power, one ordered sum per loop, each continuing
+// the last (parallel/decomposed.hpp): the same additions in the same order, so the same bits.
+double ForceOperator::decomposed_external_power(const State& s, double t) const {
+  // The force terms' powers are their own loops (forces/): none is decomposed yet, and the run
+  // refuses a decomposed scene that has one (check_decomposable).
+  if (!power_terms_.empty())
+    throw Error("external_power: a force term's power (body force, contact, indenters) is not decomposed yet");
+  double p = 0.0;
+  std::vector<double> term(s.size());
+  for (const auto& bc : model_.conditions.prescribed) {
+    const auto c = static_cast<std::size_t>(bc.component);
+    const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;
+    std::fill(term.begin(), term.end(), 0.0);
+    for (std::int32_t i32 : bc.nodes) {
+      const auto i = static_cast<std::size_t>(i32);
+      const double reaction = model_.density[i] * a - s.f[c][i];
+      term[i] = model_.nodes.volume[i] * reaction * s.v[c][i];
+    }
+    p = decomposed_->ordered_sum(term, p);
+  }
+  return p;
+}
+
+double ForceOperator::decomposed_damping_power(const State& s) const {
+  if (model_.damping == 0.0) return 0.0;
+  const Model& m = model_;
+  double p = 0.0;
+  std::vector<double> term(s.size());
+  for (std::size_t d = 0; d < 3; ++d) {
+    for (std::size_t i = 0; i < term.size(); ++i)
+      term[i] = m.conditions.fixed[d][i] ? 0.0 : m.density[i] * m.nodes.volume[i] * s.v[d][i] * s.v[d][i];
+    p = decomposed_->ordered_sum(term, p);
+  }
+  return model_.damping * p;
+}
+
 void ForceOperator::update_work(State& s, double t, double dt) const {
   const double pe = external_power(s, t);
-  const double pd = damping_power(model_.damping, model_.density, model_.nodes.volume, s.v, model_.conditions.fixed);
+  const double pd = decomposed_ ? decomposed_damping_power(s)
+                                : damping_power(model_.damping, model_.density, model_.nodes.volume, s.v, model_.conditions.fixed);
   s.external_work += 0.5 * dt * (s.external_power + pe);
   s.damping_work += 0.5 * dt * (s.damping_power + pd);
   s.external_power = pe;
   s.damping_power = pd;
 }
 
-double ForceOperator::stable_time_step() const { return pd::stable_time_step(model_); }
-double ForceOperator::exact_time_step() const { return pd::exact_time_step(model_); }
+double ForceOperator::stable_time_step() const {
+  // A ghost's row is empty, so the local minimum is over owned nodes; min is exact in any order.
+  const double dt = pd::stable_time_step(model_);
+  return decomposed_ ? decomposed_->minimum(dt) : dt;
+}
+
+double ForceOperator::exact_time_step() const {
+  if (decomposed_) throw Error("time.dt: exact (the Lanczos limit) is not decomposed yet: use dt: stable on several ranks");
+  return pd::exact_time_step(model_);
+}
 
 std::vector<std::string> ForceOperator::work_plan(const Case& c) const {
   std::vector<std::string> lines;
-  lines.push_back("work: bond forces over " + std::to_string(model_.bonds.directed() / 2) + " bonds, partial volume " +
+  // A piece's rows hold every bond of its owned nodes: summed over the ranks, each bond twice.
+  const auto directed = static_cast<std::int64_t>(model_.bonds.directed());
+  lines.push_back("work: bond forces over " + std::to_string((decomposed_ ? decomposed_->total(directed) : directed) / 2) +
+                  " bonds, partial volume " +
                   c.partial_volume + (c.dimension == 2 ? "; 2D (cell grids one bin thick)" : "; 3D"));
   const auto& registry = force_term_registry();
   for (std::size_t k = 0; k < registry.size(); ++k) {

@@ -13,6 +13,7 @@
 #include "core/state.hpp"
 #include "forces/force_term.hpp"
 #include "linalg/sparse_matrix.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
@@ -29,6 +30,12 @@ class ForceOperator {
   const std::array<std::vector<std::uint8_t>, 3>& fixed() const { return model_.conditions.fixed; }
   // "Can anything break?", asked of the material's constants: the one place.
   bool can_break() const { return model_.material.can_break(); }
+
+  // A decomposed run (issue 15): the model is this rank's piece (parallel/local_model), and before
+  // each sweep the ghosts' displacements come from their owners; energies and break reports are
+  // reduced over the ranks in an order that does not depend on them. Null (the default): serial.
+  void set_decomposed(const Decomposed* d) { decomposed_ = d; }
+  const Decomposed* decomposed() const { return decomposed_; }
 
   // s.f = force density at (s.u, t) (cleared, then the bonds and every active term add into it);
   // also s.w (strain-energy density), s.contact_energy and s.indenter_force.
@@ -63,7 +70,7 @@ class ForceOperator {
   // v of every velocity-table component = its value at t1 (the end of a Verlet step).
   void impose_prescribed_velocity(Vec3Array& v, double t1) const;
 
-  // Energies [J], summed serially in node order (the same for any thread count).
+  // Energies [J], summed in node order by parallel/node_sum.hpp (the same for any thread and rank count).
   double kinetic_energy(const State& s) const;
   double strain_energy(const State& s) const;  // Σ W_i V_i from the last force evaluation
   // Body-force and moving-indenter power plus the power of the reactions at prescribed components,
@@ -86,6 +93,9 @@ class ForceOperator {
   std::vector<std::unique_ptr<ForceTerm>> terms_;        // in force order (forces/force_term.hpp)
   std::vector<const ForceTerm*> power_terms_;            // the same, in power order
   std::vector<const ForceTerm*> built_;                  // per registry entry: its term, or null
+  const Decomposed* decomposed_ = nullptr;
+  double decomposed_external_power(const State& s, double t) const;
+  double decomposed_damping_power(const State& s) const;
 };
 
 }  // namespace pd

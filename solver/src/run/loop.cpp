@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "forces/indenter.hpp"
+#include "parallel/local_model.hpp"
 #include "run/measures.hpp"
 #include "run/schedule.hpp"
 #include "run/signals.hpp"
@@ -80,7 +81,7 @@ class Energies {
 
 }  // namespace
 
-LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColumns& columns, OutputWriter& out,
+LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColumns& columns, OutputWriter* out,
                  RunLog& log) {
   const auto loop_start = Clock::now();
   const Model& model = p.model;
@@ -93,11 +94,33 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   Energies energies(*p.op, state);
   BlowUpWatch blow_up(loop.growth);
   IndenterDepthWatch indenter_depth(p.indenter_watch);
-  Progress progress(!opt.quiet && isatty(fileno(stderr)), p.c.time.end, p.max_steps, p.steps_expected);
+  Progress progress(out && !opt.quiet && isatty(fileno(stderr)), p.c.time.end, p.max_steps, p.steps_expected);
   LoopEnd end;
 
-  const auto history_row = [&](double dt_taken) {
+  // What output reads: the run's state, or on a decomposed run every rank's owned part gathered on
+  // rank 0 in the whole model's numbering, with the broken flags (frames' damage). Collective.
+  const Decomposed* dec = p.decomposed.get();
+  State gathered;
+  const auto output_state = [&]() -> const State& {
+    if (!dec) return state;
+    gathered.u = dec->gather(state.u);
+    gathered.v = dec->gather(state.v);
+    gathered.f = dec->gather(state.f);
+    gathered.w = dec->gather(state.w);
+    gathered.contact_energy = state.contact_energy;
+    gathered.indenter_force = state.indenter_force;
+    gathered.external_power = state.external_power;
+    gathered.damping_power = state.damping_power;
+    gathered.external_work = state.external_work;
+    gathered.damping_work = state.damping_work;
+    dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
+    return gathered;
+  };
+
+  const auto history_row = [&](double dt_taken, const State* whole) {
     energies.at(loop.step);
+    const State& st = whole ? *whole : output_state();
+    if (!out) return;
     HistoryRow r;
     r.step = loop.step;
     r.time = loop.t;
@@ -110,12 +133,13 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     r.damping_work = state.damping_work;
     r.broken_bonds = loop.broken;
     r.wall_time = wall_before + seconds_since(loop_start);
-    columns.fill(r, HistoryInputs{state, loop.t, loop.broken_energy});
-    out.history(r);
+    columns.fill(r, HistoryInputs{st, loop.t, loop.broken_energy});
+    out->history(r);
   };
   const auto frame = [&](double dt_taken) {
-    out.frame(model, state, loop.t, loop.step);
-    history_row(dt_taken);
+    const State& st = output_state();
+    if (out) out->frame(model, st, loop.t, loop.step);
+    history_row(dt_taken, &st);
     schedule.frame_written(loop);
   };
   // Wall time spent writing frames and history rows, reported in run.log: the share of the run
@@ -126,11 +150,11 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     end.output_seconds += seconds_since(output_start);
   };
   // Written atomically (io/checkpoint.hpp), after the history rows so far are on disk.
-  const auto write_restart = [&]() {
-    out.flush_history();
+  const auto write_restart = [&]() {  // never on a decomposed run (run/prepare.cpp refuses checkpoints)
+    out->flush_history();
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
-    write_checkpoint(checkpoint_file, checkpoint_of(p, s, saved, out));
+    write_checkpoint(checkpoint_file, checkpoint_of(p, s, saved, *out));
   };
   const auto likely_cause = [&](double h) {
     return BlowUpWatch::likely_cause(h, p.exact_limit(), p.dt_stable, integrator.explicit_step());
@@ -158,9 +182,17 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     loop.force_evaluations += report.force_evaluations;
     if (report.next_dt > 0.0) loop.dt = report.next_dt;
 
-    if (const std::int64_t bad = first_non_finite(state); bad >= 0) {
-      log.error(BlowUpWatch::non_finite_message(node_text(model, bad), loop.step, loop.t,
-                                                node_text(model, fastest_node(state)), likely_cause(h)));
+    std::int64_t bad = first_non_finite(state);
+    const State* whole = &state;
+    if (dec) {  // the first non-finite node of the whole model, the same decision on every rank
+      const double first = dec->minimum(bad >= 0 ? static_cast<double>(dec->piece().global[static_cast<std::size_t>(bad)]) : HUGE_VAL);
+      bad = std::isfinite(first) ? static_cast<std::int64_t>(first) : -1;
+      if (bad >= 0) whole = &output_state();
+    }
+    if (bad >= 0) {
+      if (out)
+        log.error(BlowUpWatch::non_finite_message(node_text(model, bad), loop.step, loop.t,
+                                                  node_text(model, fastest_node(*whole)), likely_cause(h)));
       end.status = kRunFailed;
       end.state_valid = false;
       break;
@@ -168,7 +200,9 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     energies.at(loop.step);
     const double energy = energies.kinetic + energies.strain + state.contact_energy;
     if (blow_up.grew_too_long(energy)) {
-      log.error(blow_up.growth_message(energy, loop.step, loop.t, node_text(model, fastest_node(state)), likely_cause(h)));
+      const State& st = output_state();
+      if (out)
+        log.error(blow_up.growth_message(energy, loop.step, loop.t, node_text(model, fastest_node(st)), likely_cause(h)));
       end.status = kRunFailed;
       end.state_valid = false;
       break;
@@ -183,11 +217,19 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
 
     timed([&] {
       if (schedule.frame_due(loop, h)) frame(h);
-      else if (schedule.history_due(loop)) history_row(h);
+      else if (schedule.history_due(loop)) history_row(h, nullptr);
     });
     const bool restart_due = schedule.restart_due(loop);
     if (opt.after_step) opt.after_step(loop.step);
-    if (const int signal = pending_signal(); signal != 0) {
+    int signal = pending_signal();
+    if (dec) signal = -static_cast<int>(dec->minimum(-signal));  // stop on every rank after the same step
+    if (signal != 0 && dec) {
+      log.error("pdsolve: interrupted by " + std::string(signal_name(signal)) + " after step " +
+                std::to_string(loop.step) + "; no checkpoint: checkpoints are not decomposed over MPI ranks yet");
+      end.status = kInterruptedBase + signal;
+      break;
+    }
+    if (signal != 0) {
       end.interrupted = signal;
       write_restart();
       break;
@@ -199,7 +241,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   // An interrupted run writes no last frame: the restart goes on with the frames of an uninterrupted run.
   timed([&] {
     if (end.state_valid && !end.interrupted && loop.last_frame_step != loop.step) frame(loop.dt_taken);
-    out.finish();
+    if (out) out->finish();
   });
   end.wall = seconds_since(loop_start);
   return end;

@@ -19,7 +19,9 @@ struct LoopEnd {
 };
 
 // s.loop and s.state are advanced in place. Throws pd::Error if output fails (a full disk).
-LoopEnd run_loop(const RunOptions& options, Prepared& p, Start& s, const HistoryColumns& columns, OutputWriter& out,
+// out is null on the ranks other than 0 of a decomposed run: they take part in every gather and
+// sum, and write nothing.
+LoopEnd run_loop(const RunOptions& options, Prepared& p, Start& s, const HistoryColumns& columns, OutputWriter* out,
                  RunLog& log);
 
 }  // namespace pd

@@ -13,6 +13,8 @@
 #include "forces/indenter.hpp"
 #include "io/case_reader.hpp"
 #include "io/node_file.hpp"
+#include "parallel/local_model.hpp"
+#include "parallel/session.hpp"
 #include "run/schedule.hpp"
 #include "run/text.hpp"
 
@@ -64,6 +66,29 @@ std::pair<std::int64_t, std::int64_t> isolated_nodes(const Model& model) {
   return {isolated, first};
 }
 
+// What is not decomposed yet is refused on several ranks, on every rank alike, before any output:
+// a clear error instead of a silently wrong result (issue 15).
+void check_decomposable(const Prepared& p, const RunOptions& opt) {
+  const Case& c = p.c;
+  const std::string ranks = std::to_string(world_ranks().size);
+  std::string what;
+  if (p.model.bond_model->name() != "pmb")
+    what = "blocks[].model: " + p.model.bond_model->name() + " (a state-based law needs its ghosts' dilatation too)";
+  else if (!p.model.node_critical_stretch.empty())
+    what = "blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end)";
+  else if (c.time.integrator != "verlet") what = "time.integrator: " + c.time.integrator;
+  else if (c.time.dt_rule == "exact") what = "time.dt: exact";
+  else if (p.model.contact.pairs) what = "contact";
+  else if (!p.model.indenters.empty()) what = "indenters";
+  else if (!p.model.conditions.body_forces.empty()) what = "body forces (boundary_conditions kind body_force)";
+  else if (!opt.restart.empty()) what = "--restart";
+  else if (c.output.restart_every_time || c.output.restart_every_steps) what = "output.restart_every_time/_steps (checkpoints)";
+  if (!what.empty())
+    throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
+                "verlet integrator with bonds, breaking, displacement and velocity conditions, damping, frames and "
+                "history): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
+}
+
 }  // namespace
 
 double Prepared::exact_limit() {
@@ -91,7 +116,12 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   choose_dt(*p);
   p->max_steps = c.time.max_steps;
   if (opt.max_steps) p->max_steps = std::min(p->max_steps, *opt.max_steps);
-  p->op = std::make_unique<ForceOperator>(p->model);
+  if (world_ranks().size > 1) {
+    check_decomposable(*p, opt);
+    p->decomposed = decompose_over_ranks(p->model);
+  }
+  p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
+  if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
   p->integrator = integrator_registry().get(c.time.integrator)(*p->op);
   p->dt_exact_configured = p->dt_exact;
   p->integrator->configure(c, p->dt_exact);
@@ -145,6 +175,14 @@ void log_setup(RunLog& log, const Prepared& p) {
   if (c.time.dt_rule == "fixed" && p.dt > p.dt_stable)
     log.line("warning: dt exceeds the stable time step of thesis eq. 2.5; the run may blow up");
   for (const auto& text : work_summary(*p.op, c)) log.line(text);
+  if (p.decomposed) {
+    const Decomposed& d = *p.decomposed;
+    const std::int64_t ghosts = d.total(static_cast<std::int64_t>(d.piece().ghost_local.size()));
+    log.line("decomposed over " + std::to_string(d.ranks()) + " MPI ranks (Morton pieces balanced by bond count): " +
+             std::to_string(ghosts) + " ghosts in all, " +
+             format("%.3f", static_cast<double>(ghosts) / static_cast<double>(n)) + " per owned node; " +
+             "frames, history and run.log from rank 0");
+  }
   if (p.indenter_watch)
     for (const auto& ind : model.indenters)
       log.line("indenter '" + ind.name + "': dt stays stable while no node is deeper than " +

@@ -9,6 +9,7 @@
 #include "core/model.hpp"
 #include "integrators/integrator.hpp"
 #include "io/output.hpp"
+#include "parallel/decomposed.hpp"
 #include "run.hpp"
 
 namespace pd {
@@ -16,7 +17,11 @@ namespace pd {
 struct Prepared {
   Case c;
   int threads = 0;  // OpenMP's, after --threads
-  Model model;
+  Model model;  // the whole model (on every rank of a decomposed run: output and run.log read it)
+  // A run on several MPI ranks (issue 15): this rank's piece, its ghosts and the ordered sums; the
+  // operator then works on the piece's model. Null on one rank: the serial path.
+  std::unique_ptr<Decomposed> decomposed;
+  bool writes_output() const { return !decomposed || decomposed->rank() == 0; }
   double build_seconds = 0.0;  // wall time of build_model
 
   // The time step (time.dt stable | exact | fixed, × safety_factor; adaptive.dt_initial first).

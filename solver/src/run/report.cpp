@@ -7,7 +7,7 @@
 
 namespace pd {
 
-int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, const LoopEnd& end, const OutputWriter& out,
+int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, const LoopEnd& end, std::int64_t frames_written,
            RunLog& log) {
   const Model& model = p.model;
   const double wall = end.wall;
@@ -15,7 +15,7 @@ int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, cons
   log.line(std::string(end.interrupted ? "interrupted" : end.status == kOk ? "done" : "stopped") + ": " +
            std::to_string(loop.step) + " steps to t = " + format("%.6g", loop.t) + " s in " + format("%.3f", wall) +
            " s wall (" + format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
-           std::to_string(out.frames_written()) + " frames, " + std::to_string(loop.broken) + " broken bonds, " +
+           std::to_string(frames_written) + " frames, " + std::to_string(loop.broken) + " broken bonds, " +
            std::to_string(loop.force_evaluations) + " force evaluations");
   log.line("output: frames and history.csv took " + format("%.3f", end.output_seconds) + " s wall, " +
            format("%.1f", wall > 0 ? 100.0 * end.output_seconds / wall : 0.0) + " % of the time loop");

@@ -8,6 +8,6 @@ namespace pd {
 
 // kOk, kRunFailed, or 128 + the signal that interrupted the run.
 int report(const RunOptions& options, const Prepared& p, const LoopState& loop, const LoopEnd& end,
-           const OutputWriter& out, RunLog& log);
+           std::int64_t frames_written, RunLog& log);
 
 }  // namespace pd

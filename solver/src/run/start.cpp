@@ -2,6 +2,7 @@
 #include "run/start.hpp"
 
 #include "core/conditions.hpp"
+#include "parallel/local_model.hpp"
 #include "run/measures.hpp"
 #include "run/text.hpp"
 
@@ -70,6 +71,13 @@ Start start_or_restore(const RunOptions& opt, Prepared& p) {
     }
   } else {
     apply_initial_conditions(p.c, p.model.nodes, s.state.u, s.state.v);
+    if (p.decomposed) {  // this rank's piece of the initial state; the operator works on the piece
+      const LocalPiece& piece = p.decomposed->piece();
+      State local(piece.size());
+      local.u = to_local(piece, s.state.u);
+      local.v = to_local(piece, s.state.v);
+      s.state = std::move(local);
+    }
     p.integrator->initialize(s.state, 0.0);
     s.loop.dt = p.dt;
     s.loop.broken = broken_bond_count(p.model);
@@ -82,12 +90,14 @@ Start start_or_restore(const RunOptions& opt, Prepared& p) {
 
 std::filesystem::path checkpoint_path(const Case& c) { return (c.output_dir / "checkpoint.bin").lexically_normal(); }
 
-OutputWriter open_output(const RunOptions& opt, const Prepared& p, const Start& s, const HistoryColumns& columns) {
+std::unique_ptr<OutputWriter> open_output(const RunOptions& opt, const Prepared& p, const Start& s,
+                                          const HistoryColumns& columns) {
+  if (!p.writes_output()) return nullptr;
   // The frames' format (output.precision, compression, fields) reaches the writer here.
   const FrameFormat format = frame_format_of(p.c.output);
-  if (!s.restarting) return OutputWriter(p.c.output_dir, columns.names(), nullptr, format);
+  if (!s.restarting) return std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), nullptr, format);
   try {
-    return OutputWriter(p.c.output_dir, columns.names(), &s.resume, format);
+    return std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), &s.resume, format);
   } catch (const Error& e) {  // history.csv shorter than recorded, a frame missing
     throw start_over(opt, e);
   }

@@ -33,7 +33,9 @@ std::filesystem::path checkpoint_path(const Case& c);
 
 // The output writer: a fresh one, or on a restart one that keeps the frames and history rows up to
 // the checkpoint (a refusal says how to start over).
-OutputWriter open_output(const RunOptions& options, const Prepared& p, const Start& s, const HistoryColumns& columns);
+// Null on the ranks other than 0 of a decomposed run: rank 0 writes every file.
+std::unique_ptr<OutputWriter> open_output(const RunOptions& options, const Prepared& p, const Start& s,
+                                          const HistoryColumns& columns);
 
 // run.log's line after the title on a restart.
 std::string restart_line(const RunOptions& options, const Start& s);

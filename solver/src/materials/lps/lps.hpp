@@ -79,7 +79,7 @@ class LpsModel : public BondModel {
   std::string name() const override { return "lps"; }
   void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const override;
   BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
-                                        bool want_energy) const override;
+                                        bool want_energy, double* lost_per_node = nullptr) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override;

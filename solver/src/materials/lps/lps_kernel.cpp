@@ -349,13 +349,17 @@ void LpsModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, d
 }
 
 BreakReport LpsModel::break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
-                                                bool want_energy) const {
+                                                bool want_energy, double* lost_per_node) const {
   const LpsKernel k(*this, model, u);
   std::vector<double> theta, p, lost(want_energy ? model.nodes.size() : 0, 0.0);
   const Breaking br = breaking_of(model, want_energy ? lost.data() : nullptr);
   BreakReport r;
   r.broken = dilatation_sweep(k, model.material.can_break() ? &br : nullptr, theta, p);
   force_sweep(k, theta, p, f, w);
+  if (lost_per_node && want_energy) {  // the caller sums the shares (materials/bond_model.hpp)
+    std::copy(lost.begin(), lost.end(), lost_per_node);
+    return r;
+  }
   if (r.broken > 0)
     for (double e : lost) r.energy += e;  // serially in node order: the same for any thread count
   return r;

@@ -73,8 +73,11 @@ std::int64_t update_broken_bonds(Model& model, const Vec3Array& u, double* energ
 
 // update_broken_bonds followed by PmbBondForce::AddMult, in one sweep over the bonds (the path the
 // integrators take after each state update; bitwise the same flags, forces, W and energy).
+// lost_per_node (size = nodes): the per-node energies of the bonds broken now are left there, and
+// broken_energy is not touched (a decomposed run sums them over the ranks, operator/force_operator).
 std::int64_t break_bonds_and_add_pmb_force(Model& model, const Vec3Array& u, Vec3Array& f,
-                                           double* energy_density = nullptr, double* broken_energy = nullptr);
+                                           double* energy_density = nullptr, double* broken_energy = nullptr,
+                                           double* lost_per_node = nullptr);
 
 // True when the model breaks bonds by LAMMPS peri/pmb's rules (Model::break_after_force, or a
 // per-node critical stretch: some α > 0); then break_bonds_lammps_rules is the breaking pass.
@@ -89,10 +92,12 @@ bool uses_lammps_rules(const Model& model);
 //   bond over s0 still pulls in the step it breaks); otherwise the force after breaking, bitwise
 //   what break_bonds_and_add_pmb_force gives when the α rule decides the same bonds.
 // energy_density (if not null, with f) is overwritten with W_i of the bonds that carried force;
-// broken_energy (if not null) gets the energy the broken bonds held. Each row writes only its own
-// flags and s0: the same for any thread count. Returns the bonds broken now, each counted once.
+// broken_energy (if not null) gets the energy the broken bonds held; lost_per_node (if not null, a
+// decomposed run) gets each node's share instead, as break_bonds_and_add_pmb_force. Each row writes
+// only its own flags and s0: the same for any thread count. Returns the bonds broken now, each
+// counted once.
 std::int64_t break_bonds_lammps_rules(Model& model, const Vec3Array& u, Vec3Array* f, double* energy_density,
-                                      double* broken_energy);
+                                      double* broken_energy, double* lost_per_node = nullptr);
 
 // U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
 // summed serially in node order, so the value does not depend on the thread count.
@@ -118,7 +123,7 @@ class PmbModel : public BondModel {
   std::string name() const override { return "pmb"; }
   void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const override;
   BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
-                                        bool want_energy) const override;
+                                        bool want_energy, double* lost_per_node = nullptr) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override { return pmb_damage(model); }

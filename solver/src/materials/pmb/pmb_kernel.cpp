@@ -210,11 +210,15 @@ std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
 }
 
 std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Array& f, double* energy_density,
-                                           double* broken_energy) {
+                                           double* broken_energy, double* lost_per_node) {
   const PmbArrays a = pmb_arrays(m, u);
   if (!m.material.can_break()) {
     add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density);
     return 0;
+  }
+  if (lost_per_node) {
+    const PmbBreaking br = pmb_breaking(m, lost_per_node);
+    return add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br);
   }
   std::vector<double> lost(broken_energy ? static_cast<std::size_t>(a.nodes) : 0, 0.0);
   const PmbBreaking br = pmb_breaking(m, broken_energy ? lost.data() : nullptr);
@@ -227,7 +231,7 @@ std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Arr
 bool uses_lammps_rules(const Model& m) { return m.break_after_force || !m.node_critical_stretch.empty(); }
 
 std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f, double* energy_density,
-                                      double* broken_energy) {
+                                      double* broken_energy, double* lost_per_node) {
   const PmbArrays a = pmb_arrays(m, u);
   if (!m.material.can_break()) {  // nothing can break: the force alone, as the thesis path
     if (f) add_pmb_force_density(a, (*f)[0].data(), (*f)[1].data(), (*f)[2].data(), energy_density);
@@ -238,7 +242,8 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
   const bool force_first = m.break_after_force;
   const double* s0_node = node_rule ? m.node_critical_stretch.data() : nullptr;
   std::vector<double> s0_next(node_rule ? n : 0);
-  std::vector<double> lost(broken_energy ? n : 0, 0.0);
+  std::vector<double> lost(broken_energy && !lost_per_node ? n : 0, 0.0);
+  double* lost_out = lost_per_node ? lost_per_node : (broken_energy ? lost.data() : nullptr);
   std::uint8_t* broken = m.bonds.broken.data();
   const double* s0_pair = m.material.critical_pair.data();
   const double* alpha_pair = m.material.alpha_pair.data();
@@ -279,7 +284,7 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
       }
     }
     if (node_rule) s0_next[iu] = next;
-    if (broken_energy) lost[iu] = lost_i;
+    if (lost_out) lost_out[iu] = lost_i;
     // Thesis order: the force from the flags after breaking (a bond over s0 adds no force).
     if (f && !force_first) r = pmb_row<false, false>(a, i, nullptr);
     if (f) {
@@ -290,7 +295,7 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
     }
   }
   if (node_rule) m.node_critical_stretch.swap(s0_next);  // every row read the previous s0 above
-  if (broken_energy && newly > 0)
+  if (broken_energy && !lost_per_node && newly > 0)
     for (double e : lost) *broken_energy += e;  // serially in node order, as update_broken_bonds
   return newly;
 }

@@ -13,10 +13,11 @@ void PmbModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, d
 }
 
 BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
-                                                bool want_energy) const {
+                                                bool want_energy, double* lost_per_node) const {
   BreakReport r;
-  if (uses_lammps_rules(model)) r.broken = break_bonds_lammps_rules(model, u, &f, w, want_energy ? &r.energy : nullptr);
-  else r.broken = break_bonds_and_add_pmb_force(model, u, f, w, want_energy ? &r.energy : nullptr);
+  double* energy = want_energy && !lost_per_node ? &r.energy : nullptr;
+  if (uses_lammps_rules(model)) r.broken = break_bonds_lammps_rules(model, u, &f, w, energy, lost_per_node);
+  else r.broken = break_bonds_and_add_pmb_force(model, u, f, w, energy, lost_per_node);
   return r;
 }
 

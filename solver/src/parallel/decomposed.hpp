@@ -1,0 +1,55 @@
+// What the operator asks of a decomposed run (issue 15), without naming MPI: fill the ghosts of a
+// per-node array before a sweep, and sum per-node values in an order that does not depend on the
+// decomposition. parallel/mpi_decomposed implements it with MPI; a serial run has none (null), and
+// parallel/node_sum.hpp then sums in node order exactly as before.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/bonds.hpp"
+#include "core/nodes.hpp"
+
+namespace pd {
+
+struct LocalPiece;
+
+class Decomposed {
+ public:
+  virtual ~Decomposed() = default;
+  // Sets the ghost entries of a local per-node array (e.g. the displacement) to their owners'
+  // values: exact copies, so a row sums the same bits as on one rank.
+  virtual void update_ghosts(Vec3Array& a) const = 0;
+  // start + Σ over owned local nodes of per_node[l], added one by one in global node order (the
+  // serial sum's order), the same on every rank: bitwise the serial result for any rank count.
+  // Entries of ghosts are ignored. start lets a serial sum that runs through several loops (over
+  // components, over conditions) be continued loop by loop. A node the serial loop skips may enter
+  // as +0.0: a sum that starts at +0.0 never becomes −0.0, and x + (+0.0) = x for any other x, so
+  // the bits are those of skipping it. Collective: every rank calls it.
+  virtual double ordered_sum(const std::vector<double>& per_node, double start = 0.0) const = 0;
+  // Σ over ranks of an integer (exact, so the order does not matter). Collective.
+  virtual std::int64_t total(std::int64_t local) const = 0;
+  // The least of the ranks' values (exact, so the order does not matter). Collective.
+  virtual double minimum(double local) const = 0;
+
+  virtual int rank() const = 0;
+  virtual int ranks() const = 0;
+  virtual const LocalPiece& piece() const = 0;
+  virtual LocalPiece& piece() = 0;
+  // The owned entries of a local per-node array, in global node order, on rank 0 (empty elsewhere).
+  // Collective.
+  virtual std::vector<double> gather(const std::vector<double>& per_node) const = 0;
+  Vec3Array gather(const Vec3Array& a) const {
+    return {gather(a[0]), gather(a[1]), gather(a[2])};
+  }
+  // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
+  // frames' damage reads). Collective.
+  virtual void gather_broken(const BondList& local, BondList& global) const = 0;
+};
+
+struct Model;
+// A run on several MPI ranks: the model decomposed over them (parallel/mpi_decomposed); null for a
+// run on one rank (or a build without MPI), which then takes the serial path. Collective.
+std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global);
+
+}  // namespace pd

@@ -1,0 +1,109 @@
+// One rank's piece of the model: owned nodes, ghosts, local rows (parallel/local_model.hpp).
+#include "parallel/local_model.hpp"
+
+#include <algorithm>
+
+namespace pd {
+
+namespace {
+
+template <class T>
+std::vector<T> pick(const std::vector<T>& a, const std::vector<std::int32_t>& global) {
+  std::vector<T> out(global.size());
+  for (std::size_t l = 0; l < global.size(); ++l) out[l] = a[static_cast<std::size_t>(global[l])];
+  return out;
+}
+
+// A list of global node numbers → the local numbers of those this rank owns, in the same order.
+std::vector<std::int32_t> owned_only(const std::vector<std::int32_t>& nodes, const std::vector<std::int32_t>& local_of,
+                                     const std::vector<std::int32_t>& owner, int rank) {
+  std::vector<std::int32_t> out;
+  for (std::int32_t g : nodes)
+    if (owner[static_cast<std::size_t>(g)] == rank) out.push_back(local_of[static_cast<std::size_t>(g)]);
+  return out;
+}
+
+}  // namespace
+
+LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank) {
+  const std::size_t n = g.nodes.size();
+  LocalPiece p;
+  p.rank = rank;
+  p.global_nodes = static_cast<std::int64_t>(n);
+  // Owned nodes and their bond partners (broken bonds too: the set never changes during a run).
+  std::vector<std::uint8_t> wanted(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (owner[i] != rank) continue;
+    wanted[i] = 1;
+    for (std::int64_t k = g.bonds.offsets[i]; k < g.bonds.offsets[i + 1]; ++k)
+      wanted[static_cast<std::size_t>(g.bonds.neighbour[static_cast<std::size_t>(k)])] = 1;
+  }
+  std::vector<std::int32_t> local_of(n, -1);
+  for (std::size_t i = 0; i < n; ++i)
+    if (wanted[i]) {
+      local_of[i] = static_cast<std::int32_t>(p.global.size());
+      p.owned.push_back(owner[i] == rank ? 1 : 0);
+      (owner[i] == rank ? p.owned_local : p.ghost_local).push_back(local_of[i]);
+      p.global.push_back(static_cast<std::int32_t>(i));
+    }
+  const std::size_t nl = p.global.size();
+
+  Model& m = p.model;
+  m.horizon = g.horizon;
+  m.grid_spacing = g.grid_spacing;
+  m.damping = g.damping;
+  m.material = g.material;
+  m.contact = g.contact;
+  m.indenters = g.indenters;
+  m.density = pick(g.density, p.global);
+  m.block_index = pick(g.block_index, p.global);
+  m.no_fail = pick(g.no_fail, p.global);
+  m.nodes.dimension = g.nodes.dimension;
+  m.nodes.grid_spacing = g.nodes.grid_spacing;
+  for (int d = 0; d < 3; ++d) m.nodes.x[static_cast<std::size_t>(d)] = pick(g.nodes.x[static_cast<std::size_t>(d)], p.global);
+  m.nodes.volume = pick(g.nodes.volume, p.global);
+  m.nodes.block = pick(g.nodes.block, p.global);
+  for (const NodeSet& set : g.nodes.sets) m.nodes.sets.push_back(NodeSet{set.name, pick(set.member, p.global)});
+
+  // Owned rows in the global order of their neighbours (local_of is increasing, so a row stays
+  // ascending); a ghost's row is empty.
+  m.bonds.volume_weight = g.bonds.volume_weight;
+  m.bonds.offsets.assign(nl + 1, 0);
+  for (std::size_t l = 0; l < nl; ++l) {
+    const auto i = static_cast<std::size_t>(p.global[l]);
+    if (p.owned[l])
+      for (std::int64_t k = g.bonds.offsets[i]; k < g.bonds.offsets[i + 1]; ++k) {
+        m.bonds.neighbour.push_back(local_of[static_cast<std::size_t>(g.bonds.neighbour[static_cast<std::size_t>(k)])]);
+        m.bonds.broken.push_back(g.bonds.broken[static_cast<std::size_t>(k)]);
+      }
+    m.bonds.offsets[l + 1] = static_cast<std::int64_t>(m.bonds.neighbour.size());
+  }
+
+  // Conditions act on owned nodes only: a ghost's motion is its owner's.
+  for (const PrescribedMotion& pm : g.conditions.prescribed) {
+    PrescribedMotion local = pm;
+    local.nodes = owned_only(pm.nodes, local_of, owner, rank);
+    m.conditions.prescribed.push_back(std::move(local));
+  }
+  for (const BodyForce& bf : g.conditions.body_forces) {
+    BodyForce local = bf;
+    local.nodes = owned_only(bf.nodes, local_of, owner, rank);
+    m.conditions.body_forces.push_back(std::move(local));
+  }
+  for (int d = 0; d < 3; ++d)
+    if (g.conditions.fixed[static_cast<std::size_t>(d)].size() == n)
+      m.conditions.fixed[static_cast<std::size_t>(d)] = pick(g.conditions.fixed[static_cast<std::size_t>(d)], p.global);
+
+  // The law again from the registry on the local model: a model that precomputes per-node
+  // quantities (materials/bond_model.hpp MaterialDefinition::make) computes them for these nodes.
+  m.bond_model = material_registry().get(g.bond_model->name()).make(m);
+  return p;
+}
+
+Vec3Array to_local(const LocalPiece& piece, const Vec3Array& a) {
+  Vec3Array out;
+  for (int d = 0; d < 3; ++d) out[static_cast<std::size_t>(d)] = pick(a[static_cast<std::size_t>(d)], piece.global);
+  return out;
+}
+
+}  // namespace pd

@@ -1,0 +1,39 @@
+// One rank's piece of the model (issue 15): the nodes it owns and their ghosts — every node within
+// the horizon of an owned node, i.e. every bond partner of an owned row — numbered locally in
+// ascending global order, with a local Model whose rows are the owned rows (a ghost's row is empty).
+//
+// Why ascending global order: the kernels compare node numbers (i < j: the copy of a bond that
+// counts it once, materials/pmb) and sum a row's bonds in the order of its neighbours; a local
+// numbering that keeps the global order keeps both, so an owned row sums the same terms in the same
+// order as the serial sweep and gives the same bits. Why ghosts have empty rows: the kernels run
+// unchanged over the local arrays, and a ghost's force is its owner's business.
+// Pure bookkeeping, no MPI (parallel/halo and parallel/ordered_sum move the data).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace pd {
+
+struct LocalPiece {
+  int rank = 0;
+  std::int64_t global_nodes = 0;          // nodes of the whole model
+  std::vector<std::int32_t> global;       // global number of local node l (ascending)
+  std::vector<std::uint8_t> owned;        // 1: owned by this rank, 0: a ghost
+  std::vector<std::int32_t> owned_local;  // the owned local nodes, ascending
+  std::vector<std::int32_t> ghost_local;  // the ghosts, ascending
+  Model model;                            // the local model (see above)
+
+  std::size_t size() const { return global.size(); }
+};
+
+// The piece of `rank` under `owner` (parallel/decomposition): nodes, per-node data, bonds (the
+// owned rows, neighbours renumbered, flags copied), material, and the conditions restricted to
+// owned nodes. The law is built again from the registry on the local model.
+LocalPiece make_local_piece(const Model& global, const std::vector<std::int32_t>& owner, int rank);
+
+// a_local[l] = a_global[global[l]] for every local node (owned and ghost).
+Vec3Array to_local(const LocalPiece& piece, const Vec3Array& a_global);
+
+}  // namespace pd

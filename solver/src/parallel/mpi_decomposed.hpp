@@ -1,0 +1,52 @@
+// A decomposed run on MPI's ranks (issue 15): the decomposition, this rank's piece, its halo
+// exchange and the ordered sums, behind the Decomposed interface the operator calls.
+#pragma once
+#include <mpi.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/model.hpp"
+#include "parallel/decomposed.hpp"
+#include "parallel/decomposition.hpp"
+#include "parallel/halo.hpp"
+#include "parallel/local_model.hpp"
+#include "parallel/ordered_sum.hpp"
+
+namespace pd {
+
+class MpiDecomposed : public Decomposed {
+ public:
+  // Collective over comm: every rank decomposes the (whole) model the same way and builds its own
+  // piece, halo and sums. Throws pd::Error on every rank alike for a decomposition that cannot
+  // work (parallel/decomposition.hpp), so no rank waits for another.
+  MpiDecomposed(MPI_Comm comm, const Model& global);
+
+  int rank() const override { return rank_; }
+  int ranks() const override { return decomposition_.ranks; }
+  const Decomposition& decomposition() const { return decomposition_; }
+  LocalPiece& piece() override { return piece_; }
+  const LocalPiece& piece() const override { return piece_; }
+  const HaloExchange& halo() const { return *halo_; }
+
+  void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
+  double ordered_sum(const std::vector<double>& per_node, double start = 0.0) const override {
+    return sum_->sum(per_node, start);
+  }
+  std::int64_t total(std::int64_t local) const override;
+  double minimum(double local) const override;
+
+  using Decomposed::gather;
+  std::vector<double> gather(const std::vector<double>& per_node) const override { return sum_->gather(per_node); }
+  void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0;
+  Decomposition decomposition_;
+  LocalPiece piece_;
+  std::unique_ptr<HaloExchange> halo_;
+  std::unique_ptr<OrderedSum> sum_;
+};
+
+}  // namespace pd

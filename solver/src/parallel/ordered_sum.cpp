@@ -1,0 +1,76 @@
+// Rank-count-independent sums and gathers over nodes (parallel/ordered_sum.hpp).
+#include "parallel/ordered_sum.hpp"
+
+namespace pd {
+
+OrderedSum::OrderedSum(MPI_Comm comm, const LocalPiece& piece)
+    : comm_(comm), global_nodes_(piece.global_nodes), owned_local_(piece.owned_local) {
+  int ranks = 1;
+  MPI_Comm_rank(comm, &rank_);
+  MPI_Comm_size(comm, &ranks);
+  ranks_ = ranks;
+  const int mine = static_cast<int>(owned_local_.size());
+  if (rank_ == 0) counts_.resize(static_cast<std::size_t>(ranks)), starts_.assign(static_cast<std::size_t>(ranks) + 1, 0);
+  MPI_Gather(&mine, 1, MPI_INT, counts_.data(), 1, MPI_INT, 0, comm);
+  if (rank_ == 0)
+    for (int r = 0; r < ranks; ++r) starts_[static_cast<std::size_t>(r) + 1] = starts_[static_cast<std::size_t>(r)] + counts_[static_cast<std::size_t>(r)];
+  std::vector<std::int32_t> owned_global(owned_local_.size());
+  for (std::size_t k = 0; k < owned_local_.size(); ++k) owned_global[k] = piece.global[static_cast<std::size_t>(owned_local_[k])];
+  if (rank_ == 0) gathered_node_.resize(static_cast<std::size_t>(global_nodes_));
+  MPI_Gatherv(owned_global.data(), mine, MPI_INT32_T, gathered_node_.data(), counts_.data(), starts_.data(),
+              MPI_INT32_T, 0, comm);
+  send_.resize(owned_local_.size());
+  if (rank_ == 0) received_.resize(static_cast<std::size_t>(global_nodes_));
+}
+
+std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) const {
+  for (std::size_t k = 0; k < owned_local_.size(); ++k) send_[k] = per_node[static_cast<std::size_t>(owned_local_[k])];
+  MPI_Gatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, received_.data(), counts_.data(),
+              starts_.data(), MPI_DOUBLE, 0, comm_);
+  std::vector<double> out;
+  if (rank_ == 0) {
+    out.resize(received_.size());
+    for (std::size_t k = 0; k < received_.size(); ++k) out[static_cast<std::size_t>(gathered_node_[k])] = received_[k];
+  }
+  return out;
+}
+
+void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
+  std::vector<std::uint8_t> flags;
+  for (std::int32_t l : owned_local_)
+    flags.insert(flags.end(), local.broken.begin() + local.offsets[static_cast<std::size_t>(l)],
+                 local.broken.begin() + local.offsets[static_cast<std::size_t>(l) + 1]);
+  // Rank 0 knows every rank's owned rows (gathered_node_) and so how many flags each sends.
+  std::vector<int> counts, starts;
+  if (rank_ == 0) {
+    counts.assign(static_cast<std::size_t>(ranks_), 0);
+    starts.assign(static_cast<std::size_t>(ranks_) + 1, 0);
+    for (int r = 0; r < ranks_; ++r) {
+      for (int k = starts_[static_cast<std::size_t>(r)]; k < starts_[static_cast<std::size_t>(r) + 1]; ++k) {
+        const auto g = static_cast<std::size_t>(gathered_node_[static_cast<std::size_t>(k)]);
+        counts[static_cast<std::size_t>(r)] += static_cast<int>(global.offsets[g + 1] - global.offsets[g]);
+      }
+      starts[static_cast<std::size_t>(r) + 1] = starts[static_cast<std::size_t>(r)] + counts[static_cast<std::size_t>(r)];
+    }
+  }
+  std::vector<std::uint8_t> all(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
+  MPI_Gatherv(flags.data(), static_cast<int>(flags.size()), MPI_UINT8_T, all.data(), counts.data(), starts.data(),
+              MPI_UINT8_T, 0, comm_);
+  if (rank_ != 0) return;
+  std::size_t at = 0;
+  for (std::int32_t g32 : gathered_node_) {
+    const auto g = static_cast<std::size_t>(g32);
+    for (std::int64_t k = global.offsets[g]; k < global.offsets[g + 1]; ++k) global.broken[static_cast<std::size_t>(k)] = all[at++];
+  }
+}
+
+double OrderedSum::sum(const std::vector<double>& per_node, double start) const {
+  double total = start;
+  const std::vector<double> ordered = gather(per_node);
+  if (rank_ == 0)
+    for (double term : ordered) total += term;  // one by one in node order: the serial loop's bits
+  MPI_Bcast(&total, 1, MPI_DOUBLE, 0, comm_);
+  return total;
+}
+
+}  // namespace pd

@@ -1,0 +1,189 @@
+// The PMB force sweep, breaking and energies decomposed over the ranks of this run (issue 15): the
+// gathered force, the strain and kinetic energy, the break count and the energy lost with the
+// broken bonds equal the serial operator's bit for bit, for 1, 2 and 3 ranks (ctest mpi_ranks_R),
+// with 1 and 2 threads per rank. Every rank computes the serial result itself on the whole model.
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "core/model.hpp"
+#include "lattice.hpp"
+#include "materials/pmb/pmb.hpp"
+#include "operator/force_operator.hpp"
+#include "parallel/mpi_decomposed.hpp"
+
+namespace {
+
+constexpr double kDx = 1e-3;
+constexpr int kNx = 14, kNy = 11, kNz = 9;  // 1386 nodes: pieces of ~460 nodes on 3 ranks
+
+pd::Model lattice_model(double fracture_energy) {
+  const pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 70e9, 2700.0, fracture_energy);
+  return pd::build_model(c, pdtest::cubic_lattice(kNx, kNy, kNz, kDx, 3));
+}
+
+// A smooth field with no symmetry, so that every row's sum has rounding to get wrong. amplitude
+// relative to dx.
+pd::Vec3Array wavy(const pd::Model& m, double amplitude) {
+  pd::Vec3Array u = pd::make_vec3(m.nodes.size());
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    const double x = m.nodes.x[0][i] / kDx, y = m.nodes.x[1][i] / kDx, z = m.nodes.x[2][i] / kDx;
+    u[0][i] = amplitude * kDx * std::sin(0.37 * x + 0.11 * y * z);
+    u[1][i] = amplitude * kDx * std::cos(0.23 * y - 0.05 * x * x);
+    u[2][i] = amplitude * kDx * std::sin(0.41 * z + 0.07 * x * y + 0.3);
+  }
+  return u;
+}
+
+// Pre-broken bonds: every bond crossing the plane x = 6.5 dx within y < 5 dx (a notch).
+void notch(pd::Model& m) {
+  for (std::size_t i = 0; i < m.nodes.size(); ++i)
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+      const double xi = m.nodes.x[0][i] / kDx, xj = m.nodes.x[0][j] / kDx;
+      if ((xi - 6.5) * (xj - 6.5) < 0 && m.nodes.x[1][i] < 5 * kDx && m.nodes.x[1][j] < 5 * kDx)
+        m.bonds.broken[static_cast<std::size_t>(k)] = 1;
+    }
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+int rank_count() {
+  int r = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+// The local state of this rank's piece from a global field, ghosts poisoned (NaN) so that only the
+// halo exchange can make them right.
+pd::State local_state(const pd::MpiDecomposed& dec, const pd::Vec3Array& u_global, const pd::Vec3Array& v_global) {
+  const pd::LocalPiece& p = dec.piece();
+  pd::State s(p.size());
+  s.u = pd::to_local(p, u_global);
+  s.v = pd::to_local(p, v_global);
+  for (std::int32_t l : p.ghost_local)
+    for (auto& c : s.u) c[static_cast<std::size_t>(l)] = std::nan("");
+  return s;
+}
+
+// Gathered force on rank 0 equals the serial force bitwise; returns the number of differing values.
+std::int64_t differing_forces(const pd::MpiDecomposed& dec, const pd::State& local, const pd::State& serial) {
+  const pd::Vec3Array f = dec.gather(local.f);
+  std::int64_t bad = 0;
+  if (dec.rank() == 0)
+    for (int d = 0; d < 3; ++d)
+      for (std::size_t i = 0; i < serial.size(); ++i) bad += !same_bits(f[static_cast<std::size_t>(d)][i], serial.f[static_cast<std::size_t>(d)][i]);
+  return bad;
+}
+
+class Decomposed : public ::testing::TestWithParam<int> {};  // threads per rank
+
+TEST_P(Decomposed, ForceAndEnergiesEqualTheSerialSweepBitwise) {
+  omp_set_num_threads(GetParam());
+  pd::Model global = lattice_model(-1.0);  // unbreakable
+  notch(global);
+  const pd::Vec3Array u = wavy(global, 0.01), v = wavy(global, 3.0);
+
+  pd::ForceOperator serial_op(global);
+  pd::State serial(global.nodes.size());
+  serial.u = u;
+  serial.v = v;
+  serial_op.evaluate(serial, 0.0);
+
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, global);
+  pd::ForceOperator op(dec.piece().model);
+  op.set_decomposed(&dec);
+  pd::State local = local_state(dec, u, v);
+  op.evaluate(local, 0.0);
+
+  // A real decomposition: with more than one rank every piece has ghosts and owns only its share.
+  if (rank_count() > 1) {
+    EXPECT_GT(dec.piece().ghost_local.size(), 0u);
+    EXPECT_LT(dec.piece().owned_local.size(), global.nodes.size());
+  }
+  for (std::int32_t l : dec.piece().ghost_local)
+    EXPECT_TRUE(same_bits(local.u[0][static_cast<std::size_t>(l)], u[0][static_cast<std::size_t>(dec.piece().global[static_cast<std::size_t>(l)])]));
+  EXPECT_EQ(differing_forces(dec, local, serial), 0);
+  const double strain = op.strain_energy(local), kinetic = op.kinetic_energy(local);
+  EXPECT_GT(strain, 0.0);
+  EXPECT_TRUE(same_bits(strain, serial_op.strain_energy(serial))) << strain << " vs " << serial_op.strain_energy(serial);
+  EXPECT_TRUE(same_bits(kinetic, serial_op.kinetic_energy(serial))) << kinetic << " vs " << serial_op.kinetic_energy(serial);
+}
+
+TEST_P(Decomposed, BondsCrossingRanksBreakOnBothEndsInTheSameStepAsSerially) {
+  omp_set_num_threads(GetParam());
+  pd::Model global = lattice_model(0.5);  // breakable: s0 small enough for the field below
+  notch(global);
+  const double s0 = global.material.block[0].critical_stretch;
+  // Opening of the notch plane: u_x jumps by a few s0·δ across x = 6.5 dx (plus the wavy field), so
+  // some bonds across it break and others, shorter in x, do not.
+  pd::Vec3Array u = wavy(global, 0.2 * s0);
+  for (std::size_t i = 0; i < global.nodes.size(); ++i)
+    if (global.nodes.x[0][i] > 6.5 * kDx) u[0][i] += 2.0 * s0 * kDx;
+  const pd::Vec3Array v = pd::make_vec3(global.nodes.size());
+
+  pd::ForceOperator serial_op(global);
+  pd::State serial(global.nodes.size());
+  serial.u = u;
+  const pd::BreakReport serial_report = serial_op.break_bonds_and_evaluate(serial, 0.0);
+  ASSERT_GT(serial_report.broken, 0);
+  ASSERT_LT(serial_report.broken, static_cast<std::int64_t>(global.bonds.directed() / 2));
+
+  pd::Model before_breaking = lattice_model(0.5);
+  notch(before_breaking);
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, before_breaking);
+  pd::ForceOperator op(dec.piece().model);
+  op.set_decomposed(&dec);
+  pd::State local = local_state(dec, u, v);
+  const pd::BreakReport report = op.break_bonds_and_evaluate(local, 0.0);
+
+  EXPECT_EQ(report.broken, serial_report.broken);
+  EXPECT_TRUE(same_bits(report.energy, serial_report.energy)) << report.energy << " vs " << serial_report.energy;
+  EXPECT_EQ(differing_forces(dec, local, serial), 0);
+  EXPECT_TRUE(same_bits(op.strain_energy(local), serial_op.strain_energy(serial)));
+  // Every owned row's flags are the serial row's: a bond to a ghost broke here exactly when it broke
+  // in the serial sweep, where both copies break together, so it broke on the other rank too.
+  const pd::LocalPiece& p = dec.piece();
+  std::int64_t differing_flags = 0, crossing_broken = 0;
+  for (std::int32_t l : p.owned_local) {
+    const auto i = static_cast<std::size_t>(p.global[static_cast<std::size_t>(l)]);
+    const std::int64_t lk = p.model.bonds.offsets[static_cast<std::size_t>(l)], gk = global.bonds.offsets[i];
+    for (std::int64_t q = 0; q < global.bonds.offsets[i + 1] - gk; ++q) {
+      const std::uint8_t flag = p.model.bonds.broken[static_cast<std::size_t>(lk + q)];
+      differing_flags += flag != global.bonds.broken[static_cast<std::size_t>(gk + q)];
+      crossing_broken += flag && !p.owned[static_cast<std::size_t>(p.model.bonds.neighbour[static_cast<std::size_t>(lk + q)])];
+    }
+  }
+  EXPECT_EQ(differing_flags, 0);
+  // Some broken bonds cross ranks (else the test would not test it): summed over the ranks.
+  if (rank_count() > 1) EXPECT_GT(dec.total(crossing_broken), 0);
+
+  // The next step on the broken state: still the serial bits.
+  const pd::Vec3Array u2 = wavy(global, 0.3 * s0);
+  serial.u = u2;
+  serial_op.evaluate(serial, 0.0);
+  local.u = pd::to_local(p, u2);
+  op.evaluate(local, 0.0);
+  EXPECT_EQ(differing_forces(dec, local, serial), 0);
+  EXPECT_TRUE(same_bits(op.strain_energy(local), serial_op.strain_energy(serial)));
+}
+
+INSTANTIATE_TEST_SUITE_P(Threads, Decomposed, ::testing::Values(1, 2));
+
+TEST(Halo, MessagesGoOnlyToRanksThatShareBonds) {
+  const pd::Model global = lattice_model(-1.0);
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, global);
+  const int ranks = rank_count();
+  // Everything received is a ghost; everything sent, summed over the ranks, is everything received.
+  const std::int64_t sent = dec.total(dec.halo().bytes_sent()), ghosts = dec.total(dec.halo().ghosts());
+  EXPECT_EQ(dec.halo().ghosts(), static_cast<std::int64_t>(dec.piece().ghost_local.size()));
+  EXPECT_EQ(sent, ghosts * 24);
+  EXPECT_LE(dec.halo().messages_sent(), ranks - 1);
+  if (ranks == 1) EXPECT_EQ(sent, 0);
+  EXPECT_EQ(dec.total(static_cast<std::int64_t>(dec.piece().owned_local.size())), static_cast<std::int64_t>(global.nodes.size()));
+}
+
+}  // namespace
