@@ -1,12 +1,14 @@
 #!/bin/sh
 # Check that Debian's packages this project needs are installed; install the missing
 # ones with apt-get when running as root, otherwise print the exact command and fail.
-# Arguments name further packages a target needs (make bench: lammps openmpi-bin).
+# Arguments name further packages a target needs (make bench: openmpi-bin). lammps (Debian's lmp,
+# with PERI) is for tests/e2e/test_lammps.py, the side-by-side run of docs/lammps.md: 72 MB with its
+# libraries (apt-get install -s --no-install-recommends lammps: 5 packages).
 set -eu
 PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev nlohmann-json3-dev zlib1g-dev \
 libopenmpi-dev openmpi-bin \
 gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
-python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev"
+python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev lammps"
 missing=""
 for p in $PACKAGES; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -105,6 +105,7 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "initial_conditions": initial,
         "cracks": [{"from": _point3(c["from"]), "to": _point3(c["to"])} for c in case["cracks"]],
         "damping": case["damping"],
+        "breaking_order": case["breaking_order"],
         "partial_volume": case["discretization"]["partial_volume"],
         "contact": contact,
         "indenters": indenters,

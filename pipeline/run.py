@@ -147,6 +147,7 @@ def cmd_preprocess(args):
             block_names=list(case["materials"]),
             set_layers={name: opts["layer"] for name, opts in case["node_sets"].items()
                         if opts["layer"] is not None},
+            lattice_origin=disc["origin"],
         )
     except PreprocessError as err:
         if not getattr(err, "missing_blocks", None):

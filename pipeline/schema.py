@@ -52,24 +52,34 @@ MATERIAL = {
                  default="pmb", choices=("pmb", "lps")),
     "density": Key("number", "mass density ρ", default=REQUIRED, unit="kg/m³", above=0.0),
     "youngs_modulus": Key("number", "Young's modulus E (bond-based PMB fixes ν: 1/4 in 3D and "
-                          "plane strain, 1/3 in plane stress)", default=REQUIRED, unit="Pa", above=0.0),
+                          "plane strain, 1/3 in plane stress); give it, or (pmb) micromodulus", default=None,
+                          unit="Pa", above=0.0),
     "poisson_ratio": Key("number", "Poisson's ratio ν of the isotropic solid; lps only, required there "
                          "(−1 < ν < 1/2: K and G positive)", default=None, above=-1.0, below=0.5),
-    "fracture_energy": Key("number", "critical energy release rate G0; omit for an unbreakable "
-                           "material", default=None, unit="J/m²", above=0.0),
+    "fracture_energy": Key("number", "critical energy release rate G0, with youngs_modulus; omit for an "
+                           "unbreakable material", default=None, unit="J/m²", above=0.0),
     "influence": Key("choice", "lps only: influence function ω(|ξ|), one, inverse_length (1/|ξ|) or gaussian "
                      "(exp(−|ξ|²/δ²)); default one, the same in every block", default=None,
                      choices=("one", "inverse_length", "gaussian")),
+    "micromodulus": Key("number", "pmb only: the micromodulus c itself, instead of youngs_modulus (LAMMPS "
+                        "pair_coeff's c; docs/lammps.md)", default=None, unit="N/m⁶", above=0.0),
+    "critical_stretch": Key("number", "pmb only: the critical stretch s0 itself, with micromodulus (LAMMPS "
+                            "pair_coeff's s00); omit for an unbreakable material", default=None,
+                            above=0.0),
+    "critical_stretch_alpha": Key("number", "pmb only: α of LAMMPS's rule s0_i = s0 − α·min_j s_ij (per node, "
+                                  "from the previous step's stretches; a bond breaks when s > min(s0_i, s0_j)); "
+                                  "omitted: 0, s0 stays fixed", default=None, minimum=0.0),
 }
 
 # The material keys each model reads (besides model and density), and what a key means to a model
 # that has no such parameter: validate.py rejects such a key with this explanation, as the solver's
 # reader does (solver/src/io/case_reader.cpp read_block).
 MODEL_KEYS = {
-    "pmb": ("youngs_modulus", "fracture_energy"),
+    "pmb": ("youngs_modulus", "fracture_energy", "micromodulus", "critical_stretch", "critical_stretch_alpha"),
     "lps": ("youngs_modulus", "poisson_ratio", "fracture_energy", "influence"),
 }
-MODEL_REQUIRED = {"lps": ("poisson_ratio",)}
+# PMB needs youngs_modulus or micromodulus (validate.py _check_pmb_pairs).
+MODEL_REQUIRED = {"lps": ("youngs_modulus", "poisson_ratio")}
 MODEL_NOTE = {
     "pmb": "PMB is bond-based and fixes Poisson's ratio (1/4 in 3D and plane strain, 1/3 in plane stress)",
 }
@@ -137,6 +147,9 @@ CASE = {
         horizon_factor=Key("number", "horizon δ = horizon_factor × dx (thesis §2.1: δ = 3dx works well; "
                            "the extra 0.015 keeps lattice bonds at exactly 3dx)", default=3.015, above=0.0),
         horizon=Key("number", "horizon δ; overrides horizon_factor", default=None, unit="m", above=0.0),
+        origin=Key("numbers", "lattice: a point [x, y(, z)] the lattice passes through, nodes at "
+                   "origin + k·dx (as LAMMPS's lattice puts atoms at k·a); default: cell centres of the "
+                   "mesh's bounding box", default=None, unit="m"),
         partial_volume=Key("choice", "share ν of a neighbour's volume inside the horizon (validation.md F3): "
                            "none (full volumes), lammps (ν = (δ − |ξ|)/dx + ½ for δ − dx/2 ≤ |ξ| ≤ δ), "
                            "hhb (family |ξ| − dx/2 ≤ δ, ν = (δ − |ξ| + dx/2)/dx on the outer shell)",
@@ -161,6 +174,10 @@ CASE = {
     "cracks": Key("list", "pre-cracks (notches): every bond whose reference segment crosses the segment "
                   "from–to in the xy plane (in 3D: the plane through it parallel to z) starts broken; "
                   "lay it between two rows of nodes", default=[], fields=CRACK),
+    "breaking_order": Key("choice", "when a bond over its critical stretch stops carrying force: thesis "
+                          "(it breaks before the force at the new state, §2.2) or lammps (it still carries "
+                          "its force in the step it breaks and is gone from the next, as LAMMPS peri/pmb; "
+                          "docs/lammps.md)", default="thesis", choices=("thesis", "lammps")),
     "damping": Key("number", "velocity damping α: force density −ρ·α·v (the thesis's damping "
                    "correction); 0 for none", default=0.0, unit="1/s", minimum=0.0),
     "contact": section(

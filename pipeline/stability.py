@@ -47,6 +47,13 @@ def micromodulus(analysis: str, youngs_modulus: float, horizon: float, thickness
     raise ValueError(f"unknown analysis {analysis!r}")
 
 
+def block_micromodulus(case: dict, material: dict, horizon: float) -> float:
+    """c of one material of a validated case: given directly (micromodulus), or from E (F1)."""
+    if material.get("micromodulus") is not None:
+        return float(material["micromodulus"])
+    return micromodulus(case["analysis"], material["youngs_modulus"], horizon, case["thickness"])
+
+
 def lps_moduli(analysis: str, youngs_modulus: float, poisson_ratio: float) -> tuple[float, float]:
     """(κ, μ) of an LPS block, as solver/src/materials/lps/lps_constants.cpp: κ the bulk modulus in 3D,
     the in-plane bulk modulus in 2D."""
@@ -142,8 +149,7 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
         kind = materials[0].get("influence") or "one"
         lps = (lps_node_terms(cloud, block, moduli, case["analysis"], horizon, kind, resolved, tree), kind)
     else:
-        c = np.array([micromodulus(case["analysis"], m["youngs_modulus"], horizon, case["thickness"])
-                      for m in materials])
+        c = np.array([block_micromodulus(case, m, horizon) for m in materials])
     c_pair = 0.5 * (c[:, None] + c[None, :])
     density = np.array([m["density"] for m in materials], dtype=np.float64)
     return stable_time_step(np.asarray(cloud.points), np.asarray(cloud.volume), block, density, c_pair,
@@ -213,7 +219,7 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
         if m["density"] < LOW_DENSITY:
             warnings.append(f"{_where(case, 'materials', name, 'density')}: {m['density']:g} kg/m³ is lighter "
                             f"than most foams; was it given in g/cm³? (SI: kg/m³, e.g. 7850 for steel)")
-        if m["youngs_modulus"] < LOW_MODULUS:
+        if m["youngs_modulus"] is not None and m["youngs_modulus"] < LOW_MODULUS:
             warnings.append(f"{_where(case, 'materials', name, 'youngs_modulus')}: {m['youngs_modulus']:g} Pa "
                             f"is softer than rubber; was it given in MPa or GPa? (SI: Pa, e.g. 2.1e11 for steel)")
 
@@ -252,7 +258,8 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
     m = case["materials"][material]
     origin = (f"thesis eq. 2.5 gives a stable step of {dt_stable:.3g} s at node {node} {_fmt(points[node])}, "
               f"from material '{material}' ({_where(case, 'materials', material)}): ρ = {m['density']:g} kg/m³, "
-              f"E = {m['youngs_modulus']:g} Pa"
+              + (f"E = {m['youngs_modulus']:g} Pa" if m["youngs_modulus"] is not None
+                 else f"c = {m['micromodulus']:g} N/m⁶")
               + (f", ν = {m['poisson_ratio']:g} (LPS)" if m.get("model") == "lps" else "")
               + f", with horizon {horizon:.6g} m")
     units = "check the units (SI: kg/m³, Pa, m, s)"

@@ -299,6 +299,19 @@ def _check_context(case: dict, checker: _Checker):
     if disc["horizon"] is None and disc["horizon_factor"] < 1.0:
         checker.error(("discretization", "horizon_factor"),
                       "must be at least 1 (the horizon must reach the nearest neighbour); use about 3")
+    if disc["origin"] is not None:
+        if disc["method"] != "lattice":
+            checker.error(("discretization", "origin"), "origin places a lattice; the mesh-nodes method has "
+                          "none: remove origin or use method: lattice")
+        elif len(disc["origin"]) != dim:
+            checker.error(("discretization", "origin"), f"needs {dim} coordinates (dimension {dim}), "
+                          f"got {len(disc['origin'])}")
+    for name, m in case["materials"].items():
+        if m["model"] == "pmb":
+            _check_pmb_pairs(name, m, checker)
+    if case["breaking_order"] == "lammps" and any(m["model"] != "pmb" for m in case["materials"].values()):
+        checker.error(("breaking_order",), "lammps is LAMMPS peri/pmb's order, for model pmb; remove it or "
+                      "use model: pmb")
     for i, bc in enumerate(case["boundary_conditions"]):
         kinds = [k for k in ("displacement", "velocity", "body_force") if bc[k]]
         if not kinds:
@@ -332,6 +345,28 @@ def _check_context(case: dict, checker: _Checker):
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
         out["every_time"] = case["time"]["end"] / 50.0
+
+
+def _check_pmb_pairs(name: str, m: dict, checker: _Checker):
+    """PMB's constants come from one pair: E with G0 (validation.md F1) or c with s0 as given
+    (a LAMMPS pair_coeff), never a mix; α only for a material that can break."""
+    pairs = "give youngs_modulus (and fracture_energy) or micromodulus (and critical_stretch), not a mix"
+    where = ("materials", name)
+    e, g0 = m["youngs_modulus"] is not None, m["fracture_energy"] is not None
+    c, s0 = m["micromodulus"] is not None, m["critical_stretch"] is not None
+    if e and c:
+        checker.error(where + ("micromodulus",), f"is given beside youngs_modulus: {pairs}")
+    elif not e and not c:
+        checker.error(where, f"needs a stiffness: {pairs}")
+    elif e and s0:
+        checker.error(where + ("critical_stretch",), f"is given with youngs_modulus: {pairs} "
+                      "(fracture_energy gives s0 from E)")
+    elif c and g0:
+        checker.error(where + ("fracture_energy",), f"is given with micromodulus: {pairs} "
+                      "(critical_stretch is s0 itself)")
+    elif (m["critical_stretch_alpha"] or 0.0) > 0.0 and not g0 and not s0:
+        checker.error(where + ("critical_stretch_alpha",), "needs a breakable material: give "
+                      "fracture_energy or critical_stretch")
 
 
 def _check_materials(case: dict, checker: _Checker):

@@ -59,8 +59,13 @@ def _fmt(p) -> str:
 
 
 def discretize(mesh: Mesh, *, dimension: int, thickness: float | None, method: str, dx: float | None,
-               block_names: list[str], set_layers: dict[str, float]) -> NodeCloud:
-    """Turn `mesh` into a NodeCloud (see the module docstring for blocks and sets)."""
+               block_names: list[str], set_layers: dict[str, float],
+               lattice_origin=None) -> NodeCloud:
+    """Turn `mesh` into a NodeCloud (see the module docstring for blocks and sets).
+
+    lattice_origin: a point [x, y(, z)] of the lattice, so that its nodes sit at origin + k·dx
+    (k integer), as LAMMPS's `lattice` puts atoms at k·a; None: cell centres of the mesh's
+    bounding box."""
     path = mesh.path
     if method not in METHODS:
         raise PreprocessError(f"{path}: unknown discretization method '{method}'; known: {', '.join(METHODS)}")
@@ -78,7 +83,7 @@ def discretize(mesh: Mesh, *, dimension: int, thickness: float | None, method: s
     elem_block = _element_blocks(mesh, top, dimension, block_names)
 
     if method == "lattice":
-        cloud, where = _lattice(mesh, points, top, dimension, dx, thickness, elem_block)
+        cloud, where = _lattice(mesh, points, top, dimension, dx, thickness, elem_block, lattice_origin)
     else:
         cloud, where = _mesh_nodes(mesh, points, top, dimension, measures, elem_block)
     cloud.sets = _node_sets(mesh, points, top, cloud, where, method, dx, set_layers)
@@ -193,9 +198,10 @@ def _no_block_error(path, points, count):
                           f"add their elements to the physical group of a block (a material of the case)")
 
 
-def _lattice(mesh, points, top, dimension, dx, thickness, elem_block):
-    """Cell-centred lattice nodes inside the top-dimension elements. Returns the cloud and, per
-    node, (type id, element index, types) of the element that holds it."""
+def _lattice(mesh, points, top, dimension, dx, thickness, elem_block, lattice_origin=None):
+    """Cell-centred lattice nodes inside the top-dimension elements (or, with lattice_origin, the
+    lattice through that point). Returns the cloud and, per node, (type id, element index, types)
+    of the element that holds it."""
     path = mesh.path
     used = np.unique(np.concatenate([c.ravel() for c in top.values()]))
     lo, hi = points[used].min(axis=0), points[used].max(axis=0)
@@ -204,7 +210,19 @@ def _lattice(mesh, points, top, dimension, dx, thickness, elem_block):
         raise PreprocessError(f"{path}: the lattice with dx = {dx:g} m over the mesh's bounding box {_fmt(lo)} to "
                               f"{_fmt(hi)} would have {cells:.3g} cells, more than {MAX_LATTICE_CELLS:.0e}; "
                               "use a larger dx, or check the mesh for a node far from the others")
-    origin, shape = lattice_axes(lo[:dimension], hi[:dimension], dx)
+    first = None  # lattice index of cell 0 per axis, counted from lattice_origin
+    if lattice_origin is not None:
+        anchor = np.asarray(lattice_origin, dtype=np.float64).ravel()
+        if len(anchor) != dimension:
+            raise PreprocessError(f"{path}: the lattice origin needs {dimension} coordinates, got {len(anchor)}")
+        # Cells of width dx centred on anchor + k·dx; cell `first` holds lo, and the cells from it
+        # cover [lo, hi] as the cell-centred lattice does.
+        first = np.floor((lo[:dimension] - anchor) / dx + 0.5).astype(np.int64)
+        corner = anchor + (first - 0.5) * dx
+        _, shape = lattice_axes(corner, hi[:dimension], dx)
+        origin = corner
+    else:
+        origin, shape = lattice_axes(lo[:dimension], hi[:dimension], dx)
     origin = np.concatenate([origin, np.zeros(3 - dimension)])
     conn, owner_type, owner_index, types = simplices(top, dimension)
     flat, simplex = locate_lattice(points, conn, dimension, origin, dx, shape)
@@ -212,6 +230,11 @@ def _lattice(mesh, points, top, dimension, dx, thickness, elem_block):
         raise PreprocessError(f"{path}: no lattice node with dx = {dx:g} m falls inside the mesh "
                               f"(bounding box {_fmt(lo)} to {_fmt(hi)}); use a smaller dx")
     pts = lattice_points(flat, origin, dx, shape, dimension)
+    if first is not None:  # exactly anchor + k·dx (LAMMPS: k·a for origin 0), not corner + (i + ½)·dx
+        rem = flat
+        for a in range(dimension):
+            pts[:, a] = anchor[a] + (first[a] + rem % shape[a]) * dx
+            rem = rem // shape[a]
     etype, eidx = owner_type[simplex], owner_index[simplex]
     block = np.zeros(len(flat), dtype=np.int32)
     for ti, t in enumerate(types):

@@ -3,6 +3,8 @@
 // Verlet and the adaptive step, with breaking and with contact; a checkpoint of another case, or a
 // damaged one, is refused. Also the blow-up report, the isolated-node warning and the material check.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <unistd.h>
 
 #include <cmath>
@@ -23,6 +25,8 @@
 #include "files.hpp"
 #include "lattice.hpp"
 #include "run.hpp"
+#include "run/prepare.hpp"
+#include "run/start.hpp"
 
 namespace fs = std::filesystem;
 
@@ -39,8 +43,9 @@ void replace(std::string& text, const std::string& from, const std::string& to) 
 
 // A 2D glass plate, 16 × 8 nodes, left edge clamped, the right edge pulled until bonds break.
 // `integrator`: verlet | adaptive; `contact`: self-contact on (a Verlet list to carry over).
+// `lammps`: LAMMPS's breaking order and α rule (a per-node critical stretch to carry over).
 void write_case(const fs::path& dir, const std::string& integrator, bool contact, const std::string& output_extra = "",
-                bool isolated_node = false) {
+                bool isolated_node = false, bool lammps = false) {
   const double dx = 1e-3;
   pd::Nodes nodes = pdtest::cubic_lattice(16, 8, 1, dx, 2, 1e-3);
   if (isolated_node) {  // one node 20 dx away from the plate: no bond
@@ -61,7 +66,8 @@ void write_case(const fs::path& dir, const std::string& integrator, bool contact
     "nodes_file": "nodes.vtu", "output_dir": "out", "dimension": 2, "analysis": "plane_stress",
     "thickness": 0.001, "grid_spacing": 0.001, "horizon": 0.003015,
     "blocks": [{"id": 1, "name": "plate", "model": "pmb", "density": 2440.0, "youngs_modulus": 7.2e10,
-                "fracture_energy": 3.8}],
+                "fracture_energy": 3.8)" + std::string(lammps ? R"(, "critical_stretch_alpha": 0.25}],
+    "breaking_order": "lammps",)" : "}],") + R"(
     "no_fail_sets": ["left"], "node_sets": ["left", "right"],
     "boundary_conditions": [
       {"set": "left", "kind": "displacement", "component": 0, "times": [0.0], "values": [0.0]},
@@ -151,17 +157,21 @@ void expect_same_output(const fs::path& a, const fs::path& b) {
 struct Variant {
   std::string integrator;
   bool contact;
+  bool lammps = false;  // LAMMPS's breaking order and α rule (docs/lammps.md)
 };
 
-void PrintTo(const Variant& v, std::ostream* os) { *os << v.integrator << (v.contact ? " with contact" : ""); }
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.integrator << (v.contact ? " with contact" : "") << (v.lammps ? " with LAMMPS's rules" : "");
+}
 
 class Restart : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(Restart, SigtermThenRestartIsBitwiseTheUninterruptedRun) {
   const Variant v = GetParam();
-  const fs::path whole = temp_dir("whole_" + v.integrator), cut = temp_dir("cut_" + v.integrator);
-  write_case(whole, v.integrator, v.contact);
-  write_case(cut, v.integrator, v.contact);
+  const std::string tag = v.integrator + (v.lammps ? "_lammps" : "");
+  const fs::path whole = temp_dir("whole_" + tag), cut = temp_dir("cut_" + tag);
+  write_case(whole, v.integrator, v.contact, "", false, v.lammps);
+  write_case(cut, v.integrator, v.contact, "", false, v.lammps);
   ASSERT_EQ(slurp(whole / "case.json"), slurp(cut / "case.json"));
   ASSERT_EQ(run(whole / "case.json"), pd::kOk);
   const std::int64_t steps = total_steps(whole / "out" / "history.csv");
@@ -192,6 +202,11 @@ TEST_P(Restart, SigtermThenRestartIsBitwiseTheUninterruptedRun) {
   const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
   EXPECT_EQ(ck.loop.step, stop);
   EXPECT_EQ(ck.integrator, v.integrator);
+  // LAMMPS's α rule: the per-node s0 is state the checkpoint carries (and has moved off s00).
+  EXPECT_EQ(ck.node_critical_stretch.size(), v.lammps ? 16u * 8u : 0u);
+  if (v.lammps)
+    EXPECT_NE(*std::min_element(ck.node_critical_stretch.begin(), ck.node_critical_stretch.end()),
+              *std::max_element(ck.node_critical_stretch.begin(), ck.node_critical_stretch.end()));
   EXPECT_EQ(ck.history_bytes, fs::file_size(cut / "out" / "history.csv"));  // whole rows only, all on disk
   EXPECT_NE(slurp(cut / "out" / "run.log").find("interrupted by SIGTERM after step " + std::to_string(stop)),
             std::string::npos)
@@ -208,9 +223,10 @@ TEST_P(Restart, SigtermThenRestartIsBitwiseTheUninterruptedRun) {
 // (here by max_steps, as a kill would): the restart drops what came after the checkpoint.
 TEST_P(Restart, PeriodicCheckpointThenCutOffRunRestartsBitwise) {
   const Variant v = GetParam();
-  const fs::path whole = temp_dir("pwhole_" + v.integrator), cut = temp_dir("pcut_" + v.integrator);
-  write_case(whole, v.integrator, v.contact, R"(, "restart_every_steps": 7)");
-  write_case(cut, v.integrator, v.contact, R"(, "restart_every_steps": 7)");
+  const std::string tag = v.integrator + (v.lammps ? "_lammps" : "");
+  const fs::path whole = temp_dir("pwhole_" + tag), cut = temp_dir("pcut_" + tag);
+  write_case(whole, v.integrator, v.contact, R"(, "restart_every_steps": 7)", false, v.lammps);
+  write_case(cut, v.integrator, v.contact, R"(, "restart_every_steps": 7)", false, v.lammps);
   ASSERT_EQ(run(whole / "case.json"), pd::kOk);
   const std::int64_t steps = total_steps(whole / "out" / "history.csv");
   const std::int64_t stop = steps * 2 / 3 + 1;
@@ -226,10 +242,34 @@ TEST_P(Restart, PeriodicCheckpointThenCutOffRunRestartsBitwise) {
 
 INSTANTIATE_TEST_SUITE_P(Checkpoint, Restart,
                          ::testing::Values(Variant{"verlet", false}, Variant{"adaptive", false},
-                                           Variant{"verlet", true}, Variant{"adaptive", true}),
+                                           Variant{"verlet", true}, Variant{"adaptive", true},
+                                           Variant{"verlet", false, true}),
                          [](const auto& info) {
-                           return info.param.integrator + (info.param.contact ? "_contact" : "");
+                           return info.param.integrator + (info.param.contact ? "_contact" : "") +
+                                  (info.param.lammps ? "_lammps" : "");
                          });
+
+// LAMMPS's α rule: the per-node critical stretch is state. It moves with every breaking pass, so a
+// stale one after a restart would only show in the step after it (the bitwise Restart variant
+// verlet_lammps cannot see that); here the restored model holds the checkpoint's values exactly.
+TEST(Checkpoint, RestoresThePerNodeCriticalStretchOfTheAlphaRule) {
+  const fs::path dir = temp_dir("alpha");
+  write_case(dir, "verlet", false, R"(, "restart_every_steps": 10)", false, true);
+  ASSERT_EQ(run(dir / "case.json", {}, {}, 25), pd::kOk);
+  const pd::Checkpoint ck = pd::read_checkpoint(dir / "out" / "checkpoint.bin");
+  ASSERT_EQ(ck.loop.step, 20);
+  ASSERT_EQ(ck.node_critical_stretch.size(), 16u * 8u);
+  pd::RunOptions o;
+  o.case_file = dir / "case.json";
+  o.quiet = true;
+  o.restart = dir / "out" / "checkpoint.bin";
+  std::unique_ptr<pd::Prepared> p = pd::prepare(o);
+  const std::vector<double> fresh = p->model.node_critical_stretch;  // at rest: s00 everywhere
+  pd::start_or_restore(o, *p);
+  EXPECT_EQ(p->model.node_critical_stretch, ck.node_critical_stretch);
+  EXPECT_NE(p->model.node_critical_stretch, fresh);  // the stretched plate moved s0 off s00
+  fs::remove_all(dir);
+}
 
 TEST(Checkpoint, RestartTimeEveryTimeWritesCheckpoints) {
   const fs::path dir = temp_dir("every_time");

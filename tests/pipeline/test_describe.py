@@ -58,6 +58,8 @@ discretization:
 materials:
   plate: {density: 2000, youngs_modulus: 1.0e9, fracture_energy: 10}
   disk: {density: 7800, youngs_modulus: 2.0e11}
+  rod: {density: 2440, micromodulus: 3.4e21, critical_stretch: 0.001, critical_stretch_alpha: 0.25}
+breaking_order: lammps
 no_fail: [left]
 boundary_conditions:
   - {set: left, displacement: {x: 0}, velocity: {y: [[0, 0], [1, 1]]}, body_force: {z: 1}}
@@ -86,9 +88,10 @@ def described(pdsolve):
 
 # The keys of the other material model: every block of a case uses one model, so the state-based
 # LPS keys come from a second case (EVERYTHING with its materials replaced).
-EVERYTHING_LPS = EVERYTHING.replace(
+EVERYTHING_LPS = EVERYTHING.replace("breaking_order: lammps\n", "").replace(
     "  plate: {density: 2000, youngs_modulus: 1.0e9, fracture_energy: 10}\n"
-    "  disk: {density: 7800, youngs_modulus: 2.0e11}\n",
+    "  disk: {density: 7800, youngs_modulus: 2.0e11}\n"
+    "  rod: {density: 2440, micromodulus: 3.4e21, critical_stretch: 0.001, critical_stretch_alpha: 0.25}\n",
     "  plate: {model: lps, density: 2000, youngs_modulus: 1.0e9, poisson_ratio: 0.3, fracture_energy: 10,\n"
     "          influence: gaussian}\n"
     "  disk: {model: lps, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.29, influence: gaussian}\n")

@@ -138,6 +138,9 @@ struct Case {
   double horizon = 0.0;
   std::string partial_volume = "none";  // validation.md F3: none | lammps | hhb
   std::vector<BlockMaterial> blocks;
+  // thesis: a bond over its critical stretch breaks before the force at the new state (§2.2);
+  // lammps: it carries its force in that step and breaks after it (LAMMPS peri/pmb).
+  std::string breaking_order = "thesis";
   std::vector<std::string> no_fail_sets, node_sets;
   std::vector<BoundaryCondition> boundary_conditions;
   std::vector<InitialCondition> initial_conditions;

@@ -36,6 +36,9 @@ struct BlockMaterial {
 struct PairConstants {
   double micromodulus = 0.0;      // c [N/m⁶] (3D) so that c·s·V_j is a force density
   double critical_stretch = 0.0;  // s0; +inf for an unbreakable block
+  // α of LAMMPS's critical-stretch rule s0_i = s0 − α·min_j s_ij (validation.md F5; Parks et al.
+  // 2008, the PERI package); 0: s0 stays fixed (the thesis).
+  double critical_stretch_alpha = 0.0;
 };
 
 // c and s0 for every ordered pair of blocks (row-major, blocks × blocks). A bond between blocks
@@ -48,6 +51,10 @@ struct MaterialTable {
   std::vector<PairConstants> block;       // per block id − 1
   std::vector<double> micromodulus_pair;  // c_ab
   std::vector<double> critical_pair;      // s0_ab
+  std::vector<double> alpha_pair;         // α_ab: the mean of the blocks' α, as c_ab
+
+  // True when some α_ab > 0: then the critical stretch is a per-node state (Model::node_critical_stretch).
+  bool node_rule() const;
 
   // False when no bond can ever break (every pair unbreakable): then no pass tests breaking.
   // The one place that answers "can anything break?".

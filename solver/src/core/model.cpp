@@ -13,6 +13,29 @@
 
 namespace pd {
 
+namespace {
+
+// s0_i of LAMMPS's rule at rest (every s_ij = 0): max_j s0_ij over i's intact bonds, +inf without
+// one — what LAMMPS's set-up force pass leaves before the first step (validation.md F5).
+std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
+                                                  const BondList& bonds) {
+  const std::size_t n = bonds.nodes(), nb = static_cast<std::size_t>(table.blocks);
+  std::vector<double> s0(n, std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < n; ++i) {
+    bool first = true;
+    for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      if (bonds.broken[static_cast<std::size_t>(k)]) continue;
+      const std::size_t j = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(k)]);
+      const double pair = table.critical_pair[static_cast<std::size_t>(block[i]) * nb + static_cast<std::size_t>(block[j])];
+      s0[i] = first ? pair : std::max(s0[i], pair);
+      first = false;
+    }
+  }
+  return s0;
+}
+
+}  // namespace
+
 Model build_model(const Case& c, Nodes nodes) {
   const std::size_t n = nodes.size();
   const std::string where = c.nodes_file.string() + ": ";
@@ -64,6 +87,8 @@ Model build_model(const Case& c, Nodes nodes) {
   cut_crossing_bonds(c.cracks, nodes.x, m.bonds);  // pre-cracks (notches) start broken
   m.contact = plan_contact(c, m.block_index, cutoff * (1.0 + kHorizonTolerance));
   m.indenters = c.indenters;
+  m.break_after_force = c.breaking_order == "lammps";
+  if (m.material.node_rule()) m.node_critical_stretch = initial_node_critical_stretch(m.material, m.block_index, m.bonds);
   m.nodes = std::move(nodes);
   m.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(m);
   return m;

@@ -30,6 +30,15 @@ struct Model {
   std::vector<double> density;             // ρ per node [kg/m³]
   std::vector<std::int32_t> block_index;   // block id − 1 per node (row of the pair tables)
   std::vector<std::uint8_t> no_fail;       // 1: bonds with this end never break
+  // Where a breaking pass puts the bonds it breaks (Case::breaking_order): false, the thesis §2.2
+  // order (they break before the force at the new state); true, LAMMPS peri/pmb's (they carry their
+  // force in the step they break and are gone from the next one).
+  bool break_after_force = false;
+  // LAMMPS's critical-stretch rule (validation.md F5), when some α > 0 (MaterialTable::node_rule):
+  // s0_i = max_j (s0_ij − α_ij·s_ij) over i's intact bonds at the previous breaking pass (= s0 −
+  // α·min_j s_ij for one block), +inf for a node without intact bonds; a bond breaks when
+  // s > min(s0_i, s0_j). State, like bonds.broken: every breaking pass updates it. Empty otherwise.
+  std::vector<double> node_critical_stretch;
   Conditions conditions;
   // Short-range contact (validation.md F4) and rigid indenters: what the scene needs is decided
   // once from the case (core/work_plan); contact.pairs is false when nothing can touch.

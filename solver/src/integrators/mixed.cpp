@@ -60,6 +60,7 @@ void Mixed::step(State& state, double& t, double& dt) {
   int evaluations = 0, rejected = 0;
   if (mode_ == kQuasiStatic) {
     broken_before_ = op_.model().bonds.broken;
+    critical_before_ = op_.model().node_critical_stretch;  // LAMMPS's per-node s0 (empty unless α > 0)
     static_dt_ = dt;
     try {
       static_.step(state, t, dt);
@@ -75,6 +76,7 @@ void Mixed::step(State& state, double& t, double& dt) {
       // state's force is already that of this state with these bonds (evaluated when the step that
       // reached it ended), so Verlet's first half kick needs no new evaluation.
       op_.model().bonds.broken = broken_before_;
+      op_.model().node_critical_stretch = critical_before_;
       static_.forget_factorisation();
       evaluations = static_.last_step().force_evaluations;
       rejected = static_.last_step().rejected + 1;

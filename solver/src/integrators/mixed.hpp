@@ -73,6 +73,7 @@ class Mixed : public Integrator {
   double static_dt_ = 0.0;       // the load step proposed when the quasi-static mode was left [s]
   int switches_ = 0;
   std::vector<std::uint8_t> broken_before_;  // the bonds' state before a quasi-static attempt
+  std::vector<double> critical_before_;      // and the per-node s0 of LAMMPS's α rule
   std::vector<std::string> log_lines_;
 };
 

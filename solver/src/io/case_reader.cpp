@@ -192,6 +192,14 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
     }
     if (!value || (!p.required && value->is_null())) continue;
     const double v = ck.number(*value, key);
+    if (p.lower_inclusive) {
+      if (!(v >= p.lower && v < p.upper))
+        ck.fail(key, "must be at least " + show(json(p.lower)) +
+                         (std::isinf(p.upper) ? std::string() : " and below " + show(json(p.upper))) + ", got " +
+                         show(*value));
+      b.parameters[p.name] = v;
+      continue;
+    }
     if (p.lower == 0.0 && std::isinf(p.upper)) {
       b.parameters[p.name] = ck.positive(*value, key);
       continue;
@@ -201,6 +209,9 @@ BlockMaterial read_block(const Checker& ck, const json& j, std::size_t k) {
                        show(*value) + (p.bounds_reason.empty() ? std::string() : ": " + p.bounds_reason));
     b.parameters[p.name] = v;
   }
+  if (law.check)
+    if (const ParameterProblem problem = law.check(b); !problem.key.empty())
+      ck.fail(where + "." + problem.key, problem.message);
   return b;
 }
 
@@ -428,7 +439,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "breaking_order", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -512,6 +523,13 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
                                                                c.blocks[0].choice(name, value) +
                                                                "': every block of a case must use the same " + name);
 
+  if (const json* j = ck.optional(root, "breaking_order")) {
+    c.breaking_order = ck.string(*j, "breaking_order");
+    if (c.breaking_order != "thesis" && c.breaking_order != "lammps")
+      ck.fail("breaking_order", "unknown order '" + c.breaking_order + "'; known: thesis, lammps");
+    if (c.breaking_order == "lammps" && c.blocks[0].model != "pmb")
+      ck.fail("breaking_order", "lammps is LAMMPS peri/pmb's order, for model pmb; blocks use '" + c.blocks[0].model + "'");
+  }
   if (const json* j = ck.optional(root, "no_fail_sets")) c.no_fail_sets = ck.strings(*j, "no_fail_sets");
   if (const json* j = ck.optional(root, "node_sets")) c.node_sets = ck.strings(*j, "node_sets");
   if (const json* j = ck.optional(root, "boundary_conditions"))

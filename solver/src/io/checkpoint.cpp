@@ -115,6 +115,7 @@ void fields(IO& io, Checkpoint& c) {
     for (std::size_t d = 0; d < 3; ++d) s.indenter_force[k][d] = indenter[3 * k + d];
   io.scalar(s.external_power), io.scalar(s.damping_power), io.scalar(s.external_work), io.scalar(s.damping_work);
   io.array(c.broken_flags);
+  io.array(c.node_critical_stretch);
   io.scalar(c.contact_rebuilds), io.scalar(c.contact_seconds), io.vec3(c.contact_u_build);
   io.array(c.frame_times), io.scalar(c.history_bytes);
 }

@@ -18,7 +18,8 @@
 
 namespace pd {
 
-constexpr std::uint32_t kCheckpointVersion = 1;
+// 2: the per-node critical stretch of LAMMPS's α rule after the broken flags (docs/lammps.md).
+constexpr std::uint32_t kCheckpointVersion = 2;
 
 struct Checkpoint {
   // What it belongs to: a restart refuses a checkpoint of another case or node file.
@@ -33,6 +34,7 @@ struct Checkpoint {
 
   State state;
   std::vector<std::uint8_t> broken_flags;  // BondList::broken
+  std::vector<double> node_critical_stretch;  // Model::node_critical_stretch (empty unless α > 0)
 
   // The contact Verlet list: rebuilt at restart from the displacement of its last build.
   std::int64_t contact_rebuilds = 0;

@@ -89,6 +89,7 @@ json describe_case() {
   keys["cracks"] = defaulted("list", json::array());
   keys["cracks[].from"] = required("numbers", {{"length", 3}, {"unit", "m"}});
   keys["cracks[].to"] = required("numbers", {{"length", 3}, {"unit", "m"}});
+  keys["breaking_order"] = defaulted("string", c.breaking_order, {{"choices", {"thesis", "lammps"}}});
   keys["damping"] = defaulted("number", c.damping, {{"minimum", 0.0}, {"unit", "1/s"}});
   keys["contact"] = defaulted("object", json::object());
   keys["contact.enabled"] = defaulted("string", k.enabled, {{"choices", {"auto", "on", "off"}}});

@@ -26,7 +26,7 @@ nlohmann::json describe_material_keys() {
           key = {{"type", "string"}, {"choices", p.choices}, {"default", nullptr}, {"models", nlohmann::json::array()}};
           key["note"] = p.doc + " (default " + p.choices.front() + ")";
         } else {
-          key = {{"type", "number"}, {"unit", p.unit}, {"above", p.lower}, {"models", nlohmann::json::array()}};
+          key = {{"type", "number"}, {"unit", p.unit}, {p.lower_inclusive ? "minimum" : "above", p.lower}, {"models", nlohmann::json::array()}};
           if (std::isfinite(p.upper)) key["below"] = p.upper;
           key["note"] = p.doc;
         }

@@ -36,13 +36,21 @@ struct MaterialParameter {
   std::string unit;  // SI
   std::string doc;   // one line
   bool required = true;
-  // The reader requires lower < value < upper (strict; +inf: no upper bound).
+  // The reader requires lower < value < upper (strict; +inf: no upper bound), or lower ≤ value
+  // when lower_inclusive.
   double lower = 0.0;
   double upper = std::numeric_limits<double>::infinity();
   // Not empty: a text parameter, one of these names (the first is the default), not a number.
   std::vector<std::string> choices = {};
   // Why the range is what it is, appended to the reader's error for a value outside it.
   std::string bounds_reason = {};
+  bool lower_inclusive = false;  // lower ≤ value instead of lower < value
+};
+
+// What a model's own check finds wrong with a block's parameters as a whole (a key and what to do);
+// an empty key: nothing.
+struct ParameterProblem {
+  std::string key, message;
 };
 
 // Bonds broken by one call, each counted once, and the energy they held then [J].
@@ -105,6 +113,9 @@ struct MaterialDefinition {
   // c and s0 of one block from its parameters; thickness h is ignored in 3D.
   PairConstants (*constants)(const BlockMaterial& block, const std::string& analysis, double horizon,
                              double thickness) = nullptr;
+  // Rules that tie one parameter to another (e.g. PMB: E and G0, or c and s0, not a mix), checked by
+  // the case reader after each parameter's own range; null: none.
+  ParameterProblem (*check)(const BlockMaterial& block) = nullptr;
   // The law, built once the bonds exist (so a model may precompute per-node quantities).
   std::shared_ptr<const BondModel> (*make)(const Model& model) = nullptr;
 };

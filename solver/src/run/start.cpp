@@ -33,6 +33,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
     throw Error(where + "the checkpoint belongs to another node file (or " + p.c.nodes_file.string() +
                 " changed since it was written)");
   if (checkpoint.nodes != n || checkpoint.directed_bonds != model.bonds.directed() || checkpoint.broken_flags.size() != model.bonds.directed() ||
+      checkpoint.node_critical_stretch.size() != model.node_critical_stretch.size() ||
       checkpoint.integrator != integrator.name() ||
       (model.contact.pairs && checkpoint.contact_rebuilds > 0 && checkpoint.contact_u_build[0].size() != n))
     throw Error(where + "the checkpoint does not fit this model (" + std::to_string(checkpoint.nodes) + " nodes, " +
@@ -44,6 +45,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   integrator.initialize(s.state, checkpoint.loop.t);
   s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
   model.bonds.broken = std::move(checkpoint.broken_flags);
+  model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
   if (model.contact.pairs)
     model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
                                checkpoint.contact_seconds);
@@ -122,6 +124,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loo
   k.integrator_state = p.integrator->save_state();
   k.state = s.state;
   k.broken_flags = model.bonds.broken;
+  k.node_critical_stretch = model.node_critical_stretch;
   k.contact_rebuilds = model.contact_list.rebuilds();
   k.contact_seconds = model.contact_list.seconds();
   k.contact_u_build = model.contact_list.u_build();

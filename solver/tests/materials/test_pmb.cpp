@@ -43,11 +43,16 @@ pd::Vec3Array jacobian_product(const pd::ForceOperator& op, const pd::State& s, 
 
 TEST(Pmb, IsRegisteredWithItsParameters) {
   const pd::MaterialDefinition& pmb = pd::material_registry().get("pmb");
-  ASSERT_EQ(pmb.parameters.size(), 2u);
-  EXPECT_EQ(pmb.parameters[0].name, "youngs_modulus");
-  EXPECT_TRUE(pmb.parameters[0].required);
-  EXPECT_EQ(pmb.parameters[1].name, "fracture_energy");
-  EXPECT_FALSE(pmb.parameters[1].required);
+  // E and G0, or c and s0 directly (one pair or the other: pmb.check), and LAMMPS's α.
+  ASSERT_EQ(pmb.parameters.size(), 5u);
+  const char* names[] = {"youngs_modulus", "fracture_energy", "micromodulus", "critical_stretch",
+                         "critical_stretch_alpha"};
+  for (std::size_t k = 0; k < 5; ++k) {
+    EXPECT_EQ(pmb.parameters[k].name, names[k]);
+    EXPECT_FALSE(pmb.parameters[k].required);
+  }
+  EXPECT_TRUE(pmb.parameters[4].lower_inclusive);  // α = 0 allowed
+  ASSERT_NE(pmb.check, nullptr);
   try {
     pd::material_registry().get("lps2");
     FAIL() << "no error";

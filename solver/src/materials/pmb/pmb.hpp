@@ -79,6 +79,26 @@ std::int64_t break_bonds_and_add_pmb_force(Model& model, const Vec3Array& u, Vec
                                            double* energy_density = nullptr, double* broken_energy = nullptr,
                                            double* lost_per_node = nullptr);
 
+// True when the model breaks bonds by LAMMPS peri/pmb's rules (Model::break_after_force, or a
+// per-node critical stretch: some α > 0); then break_bonds_lammps_rules is the breaking pass.
+bool uses_lammps_rules(const Model& model);
+
+// One breaking pass by LAMMPS peri/pmb's rules (validation.md F5), and, if f is not null, the force:
+// - a bond breaks when s > min(s0_i, s0_j), s0_i the per-node value left by the previous pass
+//   (Model::node_critical_stretch), or s > s0_ij when every α is 0; never with a no-fail end;
+// - then s0_i ← max_j (s0_ij − α_ij·s_ij) over the bonds intact at the start of the pass
+//   (s0 − α·min_j s_ij for one block: Parks et al., LAMMPS pair peri/pmb);
+// - Model::break_after_force: f gets the force of every bond intact at the start of the pass (a
+//   bond over s0 still pulls in the step it breaks); otherwise the force after breaking, bitwise
+//   what break_bonds_and_add_pmb_force gives when the α rule decides the same bonds.
+// energy_density (if not null, with f) is overwritten with W_i of the bonds that carried force;
+// broken_energy (if not null) gets the energy the broken bonds held; lost_per_node (if not null, a
+// decomposed run) gets each node's share instead, as break_bonds_and_add_pmb_force. Each row writes
+// only its own flags and s0: the same for any thread count. Returns the bonds broken now, each
+// counted once.
+std::int64_t break_bonds_lammps_rules(Model& model, const Vec3Array& u, Vec3Array* f, double* energy_density,
+                                      double* broken_energy, double* lost_per_node = nullptr);
+
 // U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
 // summed serially in node order, so the value does not depend on the thread count.
 double strain_energy(const Model& model, const Vec3Array& u);
@@ -88,8 +108,11 @@ std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u
 // Damage per node: 1 − Σ_intact V_j / Σ_all V_j (0 for a node without bonds).
 std::vector<double> pmb_damage(const Model& model);
 
-// The constants of thesis eqs. 1.11–1.12 for one block (validation.md F1), by analysis.
+// The constants of thesis eqs. 1.11–1.12 for one block (validation.md F1), by analysis; or c and
+// s0 as the block gives them (micromodulus, critical_stretch: a LAMMPS pair_coeff); and its α.
 PairConstants pmb_constants(const BlockMaterial& block, const std::string& analysis, double horizon, double thickness);
+// One pair or the other (E with G0, or c with s0), never a mix; α only with a breakable material.
+ParameterProblem pmb_check(const BlockMaterial& block);
 
 // The linearised PMB force. About the reference configuration (thesis eq. 2.3; Silling & Askari
 // 2005: C(ξ) = c/|ξ|·e⊗e), and at a deformed state u: per intact bond

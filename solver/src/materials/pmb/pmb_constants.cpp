@@ -55,8 +55,30 @@ const Registry<PmbFormula>& pmb_formulas() {
 }  // namespace
 
 PairConstants pmb_constants(const BlockMaterial& block, const std::string& analysis, double horizon, double thickness) {
-  return pmb_formulas().get(analysis)(block.parameter("youngs_modulus").value_or(0.0), block.parameter("fracture_energy"),
-                                      horizon, thickness);
+  PairConstants out;
+  if (const std::optional<double> c = block.parameter("micromodulus")) {
+    // c and s0 as a LAMMPS pair_coeff gives them (validation.md F5): taken as they are.
+    out.micromodulus = *c;
+    out.critical_stretch = block.parameter("critical_stretch").value_or(kInf);
+  } else {
+    out = pmb_formulas().get(analysis)(block.parameter("youngs_modulus").value_or(0.0),
+                                       block.parameter("fracture_energy"), horizon, thickness);
+  }
+  out.critical_stretch_alpha = block.parameter("critical_stretch_alpha").value_or(0.0);
+  return out;
+}
+
+ParameterProblem pmb_check(const BlockMaterial& b) {
+  const bool e = b.parameter("youngs_modulus").has_value(), g0 = b.parameter("fracture_energy").has_value();
+  const bool c = b.parameter("micromodulus").has_value(), s0 = b.parameter("critical_stretch").has_value();
+  const std::string pairs = "give youngs_modulus (and fracture_energy) or micromodulus (and critical_stretch), not a mix";
+  if (e && c) return {"micromodulus", "is given beside youngs_modulus: " + pairs};
+  if (!e && !c) return {"youngs_modulus", "is missing: " + pairs};
+  if (e && s0) return {"critical_stretch", "is given with youngs_modulus: " + pairs + " (fracture_energy gives s0 from E)"};
+  if (c && g0) return {"fracture_energy", "is given with micromodulus: " + pairs + " (critical_stretch is s0 itself)"};
+  if (b.parameter("critical_stretch_alpha").value_or(0.0) > 0.0 && !g0 && !s0)
+    return {"critical_stretch_alpha", "needs a breakable material: give fracture_energy or critical_stretch"};
+  return {};
 }
 
 }  // namespace pd

@@ -15,14 +15,16 @@ void PmbModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, d
 BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                                 bool want_energy, double* lost_per_node) const {
   BreakReport r;
-  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, want_energy && !lost_per_node ? &r.energy : nullptr,
-                                           lost_per_node);
+  double* energy = want_energy && !lost_per_node ? &r.energy : nullptr;
+  if (uses_lammps_rules(model)) r.broken = break_bonds_lammps_rules(model, u, &f, w, energy, lost_per_node);
+  else r.broken = break_bonds_and_add_pmb_force(model, u, f, w, energy, lost_per_node);
   return r;
 }
 
 BreakReport PmbModel::break_bonds(Model& model, const Vec3Array& u, bool want_energy) const {
   BreakReport r;
-  r.broken = update_broken_bonds(model, u, want_energy ? &r.energy : nullptr);
+  if (uses_lammps_rules(model)) r.broken = break_bonds_lammps_rules(model, u, nullptr, nullptr, want_energy ? &r.energy : nullptr);
+  else r.broken = update_broken_bonds(model, u, want_energy ? &r.energy : nullptr);
   return r;
 }
 
@@ -167,11 +169,19 @@ void register_material_pmb(MaterialRegistry& registry) {
   MaterialDefinition d;
   d.doc = "prototype microelastic brittle, bond-based (Silling & Askari 2005); fixes Poisson's ratio "
           "(1/4 in 3D and plane strain, 1/3 in plane stress)";
+  // E and G0 (c and s0 from the F1 formulas), or c and s0 directly as a LAMMPS pair_coeff gives
+  // them; pmb_check rejects a mix.
+  MaterialParameter alpha{"critical_stretch_alpha", "", "α of s0_i = s0 − α·min_j s_ij (LAMMPS); null: 0", false};
+  alpha.lower_inclusive = true;
   d.parameters = {
-      {"youngs_modulus", "Pa", "Young's modulus E", true},
+      {"youngs_modulus", "Pa", "Young's modulus E; or give micromodulus", false},
       {"fracture_energy", "J/m²", "null: unbreakable", false},
+      {"micromodulus", "N/m⁶", "c directly, instead of youngs_modulus", false},
+      {"critical_stretch", "", "s0 directly, with micromodulus; null: unbreakable", false},
+      alpha,
   };
   d.constants = &pmb_constants;
+  d.check = &pmb_check;
   d.make = [](const Model&) -> std::shared_ptr<const BondModel> { return std::make_shared<PmbModel>(); };
   registry.add("pmb", d);
 }
