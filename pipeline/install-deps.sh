@@ -4,8 +4,12 @@
 # Arguments name further packages a target needs (make bench: openmpi-bin). lammps (Debian's lmp,
 # with PERI) is for tests/e2e/test_lammps.py, the side-by-side run of docs/lammps.md: 72 MB with its
 # libraries (apt-get install -s --no-install-recommends lammps: 5 packages).
+# libopenblas0-serial: CHOLMOD's supernodal factorisation and solves run on BLAS; Debian's reference
+# BLAS made them 4-5x slower (pd_linear_solvers 24 10 12, 1 thread: factorisation 2.79 s reference,
+# 0.54 s OpenBLAS; solve 30 ms against 7 ms). The serial build keeps results the same for any
+# OMP_NUM_THREADS; installing it makes it the system's libblas.so.3 (update-alternatives, auto).
 set -eu
-PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev nlohmann-json3-dev zlib1g-dev \
+PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev libopenblas0-serial nlohmann-json3-dev zlib1g-dev \
 libopenmpi-dev openmpi-bin \
 gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
 python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev lammps"
