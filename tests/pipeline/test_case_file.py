@@ -8,20 +8,10 @@ from pipeline import schema
 from pipeline.case import CaseError, load_case
 from pipeline.resolve import check_set_names, resolve
 
+from minimal_case import MINIMAL
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-MINIMAL = """\
-dimension: 2
-thickness: 0.001
-discretization:
-  dx: 0.001
-materials:
-  plate:
-    density: 2000
-    youngs_modulus: 1.0e9
-time:
-  end: 1.0e-3
-"""
 
 
 def write(tmp_path, text, name="plate.yaml"):

@@ -6,18 +6,8 @@ import pytest
 from pipeline.case import CaseError, load_case
 from pipeline.resolve import resolve
 
-MINIMAL = """\
-dimension: 2
-thickness: 0.001
-discretization:
-  dx: 0.001
-materials:
-  plate:
-    density: 2000
-    youngs_modulus: 1.0e9
-time:
-  end: 1.0e-3
-"""
+from minimal_case import MINIMAL
+
 
 
 def load(tmp_path, extra=""):
