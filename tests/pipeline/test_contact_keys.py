@@ -9,7 +9,6 @@ from pipeline.resolve import resolve
 from minimal_case import MINIMAL
 
 
-
 def load(tmp_path, extra=""):
     path = tmp_path / "plate.yaml"
     text = MINIMAL + textwrap.dedent(extra)
