@@ -115,7 +115,9 @@ struct PlateRun {
     dofs.scatter(u0, state.u);
     if (v0) dofs.scatter(*v0, state.v);
     integrator.initialize(state, 0.0);
-    dt = c.implicit.dt_initial.value_or(*c.implicit.dt_max);
+    // Not value_or(*dt_max): its argument is evaluated even when dt_initial is set, and dt_max may be
+    // empty then (caught by libstdc++'s assertions in the ASan build).
+    dt = c.implicit.dt_initial ? *c.implicit.dt_initial : c.implicit.dt_max.value();
   }
   void step() {
     double h = std::min(dt, end - t);
