@@ -161,6 +161,24 @@ TEST(TimeLoop, AnIndenterTooStiffForTheStepIsReportedOnceWithItsDepth) {
   }
 }
 
+TEST(TimeLoop, ASoftRoundIndenterIsStableAtAnyDepthItCanReach) {
+  // A depth bound past the radius means nothing for a sphere or a disk (issue 16: "no node deeper than
+  // 1.007 m" for a 1.5 mm disk): run.log says the step holds at any depth and gives both numbers.
+  const fs::path dir = temp_dir("indenter_round_soft");
+  write_case(dir, R"({"end": 2e-6, "integrator": "verlet", "dt": "stable", "safety_factor": 0.8})",
+             R"(, "indenters": [{"name": "ball", "shape": "cylinder", "radius": 0.0015, "axis": [0, 0, 1], "centre": [-0.002, 0, 0],
+                 "velocity": [500, 0, 0], "stiffness": 1e15}])",
+             "1e-6");
+  ASSERT_EQ(run_solver(dir), 0) << slurp(dir / "log.txt");
+  const std::string log = slurp(dir / "out" / "run.log");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("indenter 'ball': dt stays stable at any depth \\(its stiffness 2K·h "
+                                                   "with eq. 2.5 allows ([0-9.e+-]+) m, more than its radius 0.0015 m\\)")))
+      << log;
+  EXPECT_GE(std::stod(m[1]), 0.0015);
+  EXPECT_EQ(log.find("no node is deeper"), std::string::npos) << log;
+}
+
 TEST(TimeLoop, AdaptiveWithTheExactRuleReusesTheExactLimitForItsDefaultDtMax) {
   // time.dt "exact" already ran the Lanczos estimate; the adaptive default Δt_max
   // min(eq. 2.5, 0.9·Δt_exact/(2φ)) takes that value instead of estimating it again.
