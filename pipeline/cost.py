@@ -4,12 +4,14 @@ disk and time, printed by the preprocess stage; a run above a limit stops there 
 Before, `dx: 2e-5` made 6.25·10⁶ nodes and 879,446 steps (about 25 days here) and wrote 1 GB
 before anyone was told. The figures are estimates from rates measured on this project:
 - time: directed bond updates per second of a whole explicit step, BOND_RATE. The bond kernel
-  alone runs 2.6–5.6·10⁸ per second on 1–2 threads (docs/performance.md); a step also integrates,
-  breaks bonds and writes output, so a third of the kernel's rate is taken;
-- memory: MEMORY_PER_NODE and MEMORY_PER_BOND, the solver's arrays (core/nodes.hpp, core/bonds.hpp:
-  positions, u, v, f and more per node; a 32-bit neighbour, a broken flag and a length per bond);
-- disk: FRAME_BYTES_PER_NODE (float32 displacement and velocity, damage, before zlib) per frame,
-  HISTORY_ROW_BYTES per history.csv row.
+  alone runs 2.6–5.6·10⁸ per second on 1–2 threads (docs/performance.md); whole runs' done: lines
+  gave 2.66·10⁸ (branching) and 1.01·10⁸ (membrane, 2 500 nodes) with 2 threads on a quiet machine;
+- memory: MEMORY_PER_NODE and MEMORY_PER_BOND from the measured peak of docs/performance.md: 723 MB
+  at 10⁶ nodes and 122 directed bonds per node, 5.07 B per directed bond and the rest (≈ 105 B) per
+  node;
+- disk: FRAME_BYTES_PER_NODE per frame, measured on the default float32 + zlib frames: 22 B per node
+  (branching, broken-bond lines included) and 25 B (membrane); HISTORY_ROW_BYTES per history.csv
+  row, measured 132 B (membrane) and 150 B (branching, with its reaction columns).
 The limits are the issue's: more than MAX_HOURS hours, or more than half of the free memory or disk.
 """
 from __future__ import annotations
@@ -23,10 +25,10 @@ import numpy as np
 from .yaml_lines import CaseError
 
 BOND_RATE = 1.5e8            # directed bond updates per second in a whole step (see above)
-MEMORY_PER_NODE = 400.0      # bytes
-MEMORY_PER_BOND = 16.0       # bytes per directed bond
-FRAME_BYTES_PER_NODE = 40.0
-HISTORY_ROW_BYTES = 250.0
+MEMORY_PER_NODE = 105.0      # bytes (measured, see above)
+MEMORY_PER_BOND = 5.07       # bytes per directed bond (measured)
+FRAME_BYTES_PER_NODE = 25.0  # bytes per node and frame (measured)
+HISTORY_ROW_BYTES = 150.0    # bytes per history.csv row (measured)
 MAX_HOURS = 1.0
 
 

@@ -28,7 +28,7 @@ def test_preprocess_on_a_full_disk(tmp_path):
     # The work plan sees the disk is too small for the run's frames and stops before writing ...
     code, _, err, left = run_on_small_disk(out, command, size_kb=16, cwd=ROOT, env=env)
     assert code == 2 and "Traceback" not in err, err
-    assert f"MB of disk, " in err and f"; it writes about 10 MB, more than half of the 0 MB free in {out}" in err
+    assert f"MB of disk, " in err and f"; it writes about 6 MB, more than half of the 0 MB free in {out}" in err
     assert left == []
     # ... and with FORCE=1 the node file itself does not fit.
     code, _, err, left = run_on_small_disk(out, command, size_kb=16, cwd=ROOT, env=dict(env, FORCE="1"))
