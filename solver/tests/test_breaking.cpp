@@ -41,7 +41,7 @@ TEST(Breaking, BondPastCriticalStretchBreaksAndCarriesNoForce) {
   pd::Vec3Array u = stretched(m, 0.99 * s0);
   EXPECT_EQ(pd::update_broken_bonds(m, u), 0);
   EXPECT_GT(force_x_on_0(m, u), 0.0);
-  EXPECT_EQ(pd::pmb_damage(m)[0], 0.0);
+  EXPECT_EQ(pd::bond_damage(m)[0], 0.0);
 
   // Past s0: breaks, both stored copies, counted once.
   u = stretched(m, 1.01 * s0);
@@ -51,7 +51,7 @@ TEST(Breaking, BondPastCriticalStretchBreaksAndCarriesNoForce) {
   EXPECT_EQ(pd::broken_bond_count(m), 1);
   EXPECT_EQ(force_x_on_0(m, u), 0.0);
   EXPECT_EQ(pd::strain_energy(m, u), 0.0);
-  EXPECT_EQ(pd::pmb_damage(m)[0], 1.0);
+  EXPECT_EQ(pd::bond_damage(m)[0], 1.0);
 
   // Permanently: back to the reference or compressed, still no force, and nothing new breaks.
   EXPECT_EQ(force_x_on_0(m, stretched(m, 0.0)), 0.0);

@@ -5,18 +5,7 @@ import pytest
 
 from pipeline.case import CaseError, load_case
 
-BASE = """\
-dimension: 2
-thickness: 0.001
-discretization:
-  dx: 0.001
-materials:
-  plate:
-    density: 2000
-    youngs_modulus: 1.0e9
-time:
-  end: 1.0e-3
-"""
+from minimal_case import MINIMAL as BASE
 
 
 def error_of(tmp_path, extra, base=BASE):

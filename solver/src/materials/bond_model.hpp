@@ -120,6 +120,10 @@ struct MaterialDefinition {
   std::shared_ptr<const BondModel> (*make)(const Model& model) = nullptr;
 };
 
+// Damage per node, 1 − Σ_intact V_j / Σ_all V_j (0 for a node without bonds): what every
+// bond-breaking model's damage() returns (materials/damage.cpp).
+std::vector<double> bond_damage(const Model& model);
+
 using MaterialRegistry = Registry<MaterialDefinition>;
 const MaterialRegistry& material_registry();
 

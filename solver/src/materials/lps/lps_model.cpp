@@ -49,22 +49,7 @@ LpsModel::LpsModel(const Model& model) {
   }
 }
 
-std::vector<double> LpsModel::damage(const Model& m) const {
-  // As PMB's: 1 − Σ_intact V_j / Σ_all V_j (0 for a node without bonds).
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
-  std::vector<double> out(static_cast<std::size_t>(n), 0.0);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    double all = 0.0, intact = 0.0;
-    for (std::int64_t k = m.bonds.offsets[static_cast<std::size_t>(i)]; k < m.bonds.offsets[static_cast<std::size_t>(i) + 1]; ++k) {
-      const double vj = m.nodes.volume[static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)])];
-      all += vj;
-      if (!m.bonds.broken[static_cast<std::size_t>(k)]) intact += vj;
-    }
-    out[static_cast<std::size_t>(i)] = all > 0.0 ? 1.0 - intact / all : 0.0;
-  }
-  return out;
-}
+std::vector<double> LpsModel::damage(const Model& m) const { return bond_damage(m); }  // as PMB's
 
 // Eq. 2.5's term for bond i→j, V_j ν C_ij, with a C_ij whose bond-based (PMB) stiffness dominates the
 // LPS stiffness, so that eq. 2.5, a Gershgorin bound for PMB, bounds LPS's ω_max too. By

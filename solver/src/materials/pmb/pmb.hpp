@@ -105,8 +105,6 @@ double strain_energy(const Model& model, const Vec3Array& u);
 // The same per node, divided by V_i: the strain-energy density W_i [J/m³].
 std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u);
 
-// Damage per node: 1 − Σ_intact V_j / Σ_all V_j (0 for a node without bonds).
-std::vector<double> pmb_damage(const Model& model);
 
 // The constants of thesis eqs. 1.11–1.12 for one block (validation.md F1), by analysis; or c and
 // s0 as the block gives them (micromodulus, critical_stretch: a LAMMPS pair_coeff); and its α.
@@ -126,7 +124,7 @@ class PmbModel : public BondModel {
                                         bool want_energy, double* lost_per_node = nullptr) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
-  std::vector<double> damage(const Model& model) const override { return pmb_damage(model); }
+  std::vector<double> damage(const Model& model) const override { return bond_damage(model); }
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
