@@ -253,3 +253,41 @@ TEST(Mixed, StartedImplicitSavedAndRestoredMidRunContinuesBitwiseInBothModes) {
     EXPECT_EQ(a.model.bonds.broken, b.model.bonds.broken);
   }
 }
+
+TEST(Mixed, StartedImplicitReturnsToImplicitWhenTheCrackArrests) {
+  // The bar's upper half (y > 1.5dx) cannot break (no-fail nodes), and damping calms the motion: the
+  // crack runs through the lower half and stops, Verlet takes it, and the arrest watch hands the
+  // still-loaded bar back to the implicit scheme with its motion kept.
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  c.damping = 1e5;
+  pdtest::clamp_left_pull_right(c, 4e-3 * (kNx - 1) * kDx, kEnd, true);
+  pd::Model model = pd::build_model(c, pdtest::bar_with_grips(kNx, kNy, kNz, kDx));
+  for (std::size_t i = 0; i < model.nodes.size(); ++i) model.no_fail[i] = model.nodes.x[1][i] > 1.5 * kDx;
+  pd::ForceOperator op(model);
+  pd::Mixed mixed(op);
+  mixed.configure(mixed_case("implicit"));
+  pd::State state(model.nodes.size());
+  double t = 0.0, dt = *mixed.initial_dt();
+  mixed.initialize(state, t);
+  std::vector<int> modes;
+  std::vector<std::string> log;
+  while (t < kEnd * (1 - 1e-12)) {
+    double h = std::min(dt, kEnd - t);
+    mixed.step(state, t, h);
+    dt = mixed.last_step().next_dt;
+    modes.push_back(*mixed.step_mode());
+    for (auto& line : mixed.take_log_lines()) log.push_back(line);
+    ASSERT_LT(modes.size(), 100000u);
+  }
+  const auto first_explicit = std::find(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kExplicit));
+  ASSERT_NE(first_explicit, modes.end()) << "never explicit";
+  const auto back = std::find(first_explicit, modes.end(), static_cast<int>(pd::Mixed::kImplicit));
+  ASSERT_NE(back, modes.end()) << "never back to implicit; " << (log.empty() ? "" : log.back());
+  ASSERT_GE(log.size(), 2u);
+  EXPECT_NE(log[1].find("explicit → implicit (the crack arrested"), std::string::npos) << log[1];
+  EXPECT_NE(log[1].find(" of the strain energy) kept"), std::string::npos) << log[1];
+  EXPECT_EQ(mixed.switches(), static_cast<int>(log.size()));
+  for (std::size_t d = 0; d < 3; ++d)
+    for (double u : state.u[d]) ASSERT_TRUE(std::isfinite(u));
+  std::printf("mixed from implicit, arrested crack: %zu steps; %s\n", modes.size(), log[1].c_str());
+}
