@@ -96,7 +96,7 @@ void QuasiStatic::initialize(State& state, double t) {
 bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
   const auto& volume = op_.model().nodes.volume;
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
-    // A law without bond_tangent_row: unpreconditioned CG (identity blocks).
+    // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG.
     block_first_.clear();
     for (std::size_t k = 0; k <= dofs_.size(); ++k) block_first_.push_back(static_cast<std::int64_t>(k));
     blocks_.assign(9 * dofs_.size(), 0.0);
