@@ -143,8 +143,8 @@ CHECKPOINT := $(OUT)/checkpoint.bin
 $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
 	@if [ -f '$(CHECKPOINT)' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/case.json' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/nodes.vtu' ] \
 	    && [ '$(CHECKPOINT)' -nt '$(SOLVER)' ]; then \
-	  echo "$(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
-	  exec '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
+	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
+	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
 	else \
 	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json"; \
 	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json'; \
