@@ -11,6 +11,7 @@ reads it on any rank count. On the coarse plate of test_mpi_ranks.py (1234 nodes
   the last periodic checkpoint continues the run byte for byte.
 """
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -89,6 +90,18 @@ def test_a_checkpoint_written_on_2_ranks_continues_on_3_and_on_1_bitwise(prepare
     assert result.returncode == 0, result.stderr
     assert (written / "checkpoint.bin").exists()
     assert_same_run(reference, written)  # the checkpoints cost nothing in the results
+    # run.log's traffic lines, one per rank: the pieces cover the nodes once, each sends one halo
+    # message a step of 24 bytes per ghost it fills on the other rank (2 ranks: the same count).
+    traffic = re.findall(r"rank (\d): (\d+) owned nodes, (\d+) ghosts .*?; per step: .*?, ([0-9.]+) messages and ([0-9.e+]+) "
+                         r"bytes sent, .* ms in communication .*; peak memory ([0-9.]+) MB", (written / "run.log").read_text())
+    assert [t[0] for t in traffic] == ["0", "1"]
+    nodes = int(re.search(r"nodes (\d+),", (written / "run.log").read_text()).group(1))
+    assert sum(int(t[1]) for t in traffic) == nodes > 1000
+    for rank, _, _, messages, sent, peak in traffic:
+        assert float(messages) == 1.0
+        other_ghosts = int(traffic[1 - int(rank)][2])  # what this rank sends is what the other rank receives
+        assert 24 * other_ghosts <= float(sent) <= 24 * other_ghosts * 1.01  # (+ the start's evaluation, over ~270 steps)
+        assert float(peak) > 0.0
     for name, ranks in (("ckpt_np2_to_np3", 3), ("ckpt_np2_to_serial", None)):
         folder = prepared[0] / name
         shutil.copytree(written, folder)
