@@ -7,7 +7,6 @@ step each rank sends: one halo message of 432 ghosts × 3 doubles = 10 368 bytes
 """
 import os
 import shutil
-import subprocess
 
 import pytest
 

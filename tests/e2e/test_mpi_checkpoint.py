@@ -20,7 +20,8 @@ import time
 import pytest
 
 from e2e_support import SOLVER  # noqa: E402
-from test_mpi_ranks import (MPI_ENV, MPIEXEC, copy_case, history_without_wall_time,  # noqa: F401
+# prepared: the coarse plate, meshed and preprocessed once per module; pytestmark: skip without MPI.
+from test_mpi_ranks import (MPI_ENV, MPIEXEC, copy_case, history_without_wall_time,  # noqa: F401, F811
                             prepared, pytestmark, solve)
 
 # Within this many seconds of a rank's death mpirun must have ended the others (measured: 2.1 s
