@@ -16,7 +16,8 @@ Per step and rank, with n owned nodes, g ghosts, R ranks, N = R·n nodes in all:
 Pieces are taken as cubes of side a = n^(1/3) node spacings (Morton pieces of R = 8^k ranks of a
 cube are cubes; others are unions of octree cells with up to ~1.5× the surface), an interior
 piece with ghosts g = (a + 2m)³ − a³ (m = 3 layers for δ = 3 dx) and k = 26 neighbours; a piece
-can not be thinner than the horizon, so below a = m the model stops.
+can not be thinner than the horizon, so below a = m the model stops. At few ranks a piece has fewer
+than 26 neighbours (at 8, each touches 7 across 3 faces), so the halo there is overestimated.
 """
 import argparse
 import math
@@ -50,7 +51,7 @@ def step_times(total, ranks, rate, sums):
 
 
 def table(title, rows, rate, sums, base_of):
-    print(title)
+    print(f"**{title}**\n")
     print("| ranks | nodes per rank | piece side a | ghosts per owned node | compute [ms] | halo [ms] | halo bytes per rank | "
           "ordered sums as built [ms] | efficiency as built | with exact sums [ms] | efficiency with exact sums |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
