@@ -131,6 +131,7 @@ def test_sigterm_to_mpirun_writes_a_checkpoint_that_continues_bitwise(prepared, 
     assert process.returncode != 0
     log = (folder / "run.log").read_text()
     assert "interrupted by SIGTERM" in log and "checkpoint written" in log, log + stderr
+    assert "continue with: mpiexec -np R pdsolve" in log  # any rank count R continues it
     result = restart(folder, 3)
     assert result.returncode == 0, result.stderr
     assert restarted_at_step(folder) > 0
