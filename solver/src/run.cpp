@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "parallel/session.hpp"
 #include "run/history_columns.hpp"
 #include "run/loop.hpp"
 #include "run/prepare.hpp"
@@ -44,6 +45,9 @@ int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryC
     } catch (const Error&) {
       // run.log cannot be written either (the same full disk): the message is on stderr already.
     }
+    // An output error is rank 0's alone (it writes every file): the other ranks wait for it in the
+    // next exchange, and MPI_Finalize would wait for them. MPI_Abort ends them all (issue 15).
+    if (p.decomposed) abort_ranks(kRunFailed);
     return kRunFailed;
   }
 }
@@ -65,6 +69,7 @@ int run(const RunOptions& opt) {
     return run_with_output(opt, p, s, columns, out.get());
   } catch (const DiskFull& e) {
     std::cerr << "pdsolve: error: " << e.what() << "\n";
+    if (p.decomposed) abort_ranks(kRunFailed);  // rank 0's alone, as above
     return kRunFailed;
   }
 }

@@ -157,3 +157,18 @@ def test_a_killed_rank_ends_the_run_within_seconds_and_the_last_checkpoint_conti
     assert result.returncode == 0, result.stderr
     assert restarted_at_step(folder) > 0  # from a periodic checkpoint
     assert_same_run(long_reference, folder)
+
+
+def test_a_checkpoint_rank_0_cannot_write_ends_every_rank_with_the_error(prepared):
+    """Rank 0 alone writes files, so only it meets an output error; the other ranks must not wait
+    for it for ever (before: rank 1 waited in the halo exchange and rank 0 in MPI_Finalize)."""
+    folder = copy_case(prepared, "unwritable", with_checkpoints(2.0e-3, 1.0e-4))
+    (folder / "checkpoint.bin.part").mkdir()  # the checkpoint's temporary name: open() fails
+    started = time.monotonic()
+    result = subprocess.run([MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet",
+                             "--threads", "1"], capture_output=True, text=True, timeout=300, env=MPI_ENV)
+    assert result.returncode == 3, result.stderr
+    assert time.monotonic() - started < 300
+    message = "checkpoint.bin.part: cannot open for writing: Is a directory"
+    assert message in result.stderr and message in (folder / "run.log").read_text()
+    assert not (folder / "checkpoint.bin").exists()
