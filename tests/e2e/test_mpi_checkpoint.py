@@ -36,11 +36,11 @@ def with_checkpoints(end, every):
     return change
 
 
-def restart(folder, ranks):
+def restart(folder, ranks, timeout=900):
     command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1", "--restart", str(folder / "checkpoint.bin")]
     if ranks:
         command = [MPIEXEC, "--oversubscribe", "-np", str(ranks)] + command
-    return subprocess.run(command, capture_output=True, text=True, timeout=900, env=MPI_ENV)
+    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=MPI_ENV)
 
 
 def assert_same_run(reference, run):
@@ -172,3 +172,18 @@ def test_a_checkpoint_rank_0_cannot_write_ends_every_rank_with_the_error(prepare
     message = "checkpoint.bin.part: cannot open for writing: Is a directory"
     assert message in result.stderr and message in (folder / "run.log").read_text()
     assert not (folder / "checkpoint.bin").exists()
+
+
+def test_a_restart_rank_0_refuses_is_refused_by_every_rank_at_once(prepared):
+    """Rank 0 alone opens the output, so only it sees that a frame the checkpoint counts is
+    missing; every rank must stop with its message (before: rank 0 in MPI_Finalize, rank 1 in the
+    first halo exchange, for ever)."""
+    folder = copy_case(prepared, "frame_missing", with_checkpoints(3.0e-4, 1.2e-4))
+    assert solve(folder, 2).returncode == 0
+    (folder / "frames" / "frame_000001.vtu").unlink()
+    history = (folder / "history.csv").read_bytes()
+    result = restart(folder, 2, timeout=180)  # before the fix it never returned
+    assert result.returncode == 1, result.stderr
+    assert result.stderr.count("frame_000001.vtu: missing, but the checkpoint counts") == 1  # said once, by rank 0
+    assert "to start the run over instead, delete" in result.stderr
+    assert (folder / "history.csv").read_bytes() == history  # refused before any file changed
