@@ -89,6 +89,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   State& state = s.state;
   LoopState& loop = s.loop;
   const double wall_before = loop.wall_time;  // time loop of the run(s) before a restart
+  const std::int64_t first_step = loop.step;   // steps of this run: loop.step − first_step
   const Schedule schedule(p.c.output, p.c.time.end);
   const std::filesystem::path checkpoint_file = checkpoint_path(p.c);
   Energies energies(*p.op, state);
@@ -151,12 +152,17 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     write();
     end.output_seconds += seconds_since(output_start);
   };
-  // Written atomically (io/checkpoint.hpp), after the history rows so far are on disk.
-  const auto write_restart = [&]() {  // never on a decomposed run (run/prepare.cpp refuses checkpoints)
+  // Written atomically (io/checkpoint.hpp), after the history rows so far are on disk. On a
+  // decomposed run every rank's owned state and rows are gathered on rank 0 in global node order
+  // (the path frames take) at the same step, and rank 0 alone writes the one file, in the format of
+  // a serial run: whole, of one step, and readable on any rank count. Collective.
+  const auto write_restart = [&]() {
+    const State& whole = output_state();
+    if (!out) return;
     out->flush_history();
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
-    write_checkpoint(checkpoint_file, checkpoint_of(p, s, saved, *out));
+    write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out));
   };
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,
@@ -243,12 +249,6 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     if (opt.after_step) opt.after_step(loop.step);
     int signal = pending_signal();
     if (dec) signal = -static_cast<int>(dec->minimum(-signal));  // stop on every rank after the same step
-    if (signal != 0 && dec) {
-      log.error("pdsolve: interrupted by " + std::string(signal_name(signal)) + " after step " +
-                std::to_string(loop.step) + "; no checkpoint: checkpoints are not decomposed over MPI ranks yet");
-      end.status = kInterruptedBase + signal;
-      break;
-    }
     if (signal != 0) {
       end.interrupted = signal;
       write_restart();
@@ -264,6 +264,9 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     if (out) out->finish();
   });
   end.wall = seconds_since(loop_start);
+  // What the ranks exchanged, per step of this run (issue 15's measures; bench/mpi_ranks.py reads them).
+  if (dec)
+    for (const std::string& text : dec->traffic_report(loop.step - first_step)) log.line(text);
   return end;
 }
 
