@@ -4,6 +4,9 @@
 
 #include <cmath>
 
+#include "integrators/integrator.hpp"
+#include "lattice.hpp"
+#include "operator/force_operator.hpp"
 #include "run/history_columns.hpp"
 
 namespace {
@@ -65,4 +68,22 @@ TEST(HistoryColumns, ContactGivesItsEnergyAndTheListBuildsInTheFixedColumns) {
   pd::HistoryRow row;
   columns.fill(row, pd::HistoryInputs{state, 0.0, 0.0});
   EXPECT_EQ(row.extra, (std::vector<double>{0.25, 0.0, 0.0, 0.0, 0.0}));
+}
+
+// `mode` in every history.csv: 1 for a quasi-static load step, 0 for a dynamic one (formats.md §4).
+TEST(HistoryColumns, ModeIsOneForQuasiStaticLoadStepsAndZeroForDynamicSteps) {
+  const pd::Case c = pdtest::lattice_case(2, "plane_stress", 1e-3, 3.015e-3, 1e9, 1000.0, -1.0, 1e-3);
+  pd::Model m = pd::build_model(c, pdtest::cubic_lattice(4, 4, 1, 1e-3, 2, 1e-3));
+  pd::ForceOperator op(m);
+  const std::vector<std::pair<std::string, double>> expected{
+      {"verlet", 0.0}, {"adaptive", 0.0}, {"implicit", 0.0}, {"quasi_static", 1.0}};
+  for (const auto& [name, mode] : expected) {
+    auto integrator = pd::integrator_registry().get(name)(op);
+    const pd::HistoryColumns columns(m, c, integrator.get());
+    ASSERT_EQ(columns.names(), kFixed) << name;
+    pd::HistoryRow row;
+    const pd::State state(m.nodes.size());
+    columns.fill(row, pd::HistoryInputs{state, 0.0, 0.0});
+    EXPECT_EQ(row.extra[4], mode) << name;
+  }
 }
