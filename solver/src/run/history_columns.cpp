@@ -25,8 +25,8 @@ const std::vector<std::string>& fixed_history_columns() {
 
 HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrator* integrator) {
   const Model* m = &model;
-  // A term the case does not have is 0: State clears both energies before every evaluation, and the
-  // broken-bond energy stays 0 when nothing can break.
+  // A term the case does not have is 0: the operator zeroes both energies before its terms add to
+  // them (operator/force_operator.cpp), and the broken-bond energy stays 0 when nothing can break.
   add({"contact_energy", "indenter_energy", "broken_bond_energy"}, [](const HistoryInputs& in, std::vector<double>& out) {
     out.push_back(in.state.contact_energy);
     out.push_back(in.state.indenter_energy);

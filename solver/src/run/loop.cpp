@@ -62,10 +62,9 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   // Rank 0 only (the one with output): stderr's updating line on a terminal, else whole lines on
   // stderr; run.log's lines in both cases (run/progress.hpp).
   ProgressSettings progress_settings;
-  progress_settings.terminal = isatty(fileno(stderr)) != 0;
+  progress_settings.terminal = out && isatty(fileno(stderr)) != 0;
   progress_settings.to_stderr = !opt.quiet;
   progress_settings.interval = out ? opt.progress_interval : 0.0;
-  if (!out) progress_settings.terminal = false;
   Progress progress(progress_settings, p.c.time.end, p.max_steps, p.steps_expected, out ? &log : nullptr);
   LoopEnd end;
 
