@@ -40,6 +40,7 @@ class QuasiStatic : public Integrator {
  public:
   explicit QuasiStatic(ForceOperator& op) : op_(op) {}
   std::string name() const override { return "quasi_static"; }
+  std::optional<int> step_mode() const override { return 1; }  // every step a load step (history.csv `mode`)
   void configure(const Case& c, double dt_exact = 0.0) override;
   void initialize(State& state, double t) override;
   void step(State& state, double& t, double& dt) override;

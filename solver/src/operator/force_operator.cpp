@@ -30,6 +30,7 @@ void ForceOperator::evaluate(State& s, double t) const {
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
   model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
   s.contact_energy = 0.0;
+  s.indenter_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
 }
 
@@ -49,6 +50,7 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
     if (report.broken > 0) report.energy = decomposed_->ordered_sum(lost);
   }
   s.contact_energy = 0.0;
+  s.indenter_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
   return report;
 }

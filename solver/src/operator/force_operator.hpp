@@ -38,7 +38,7 @@ class ForceOperator {
   const Decomposed* decomposed() const { return decomposed_; }
 
   // s.f = force density at (s.u, t) (cleared, then the bonds and every active term add into it);
-  // also s.w (strain-energy density), s.contact_energy and s.indenter_force.
+  // also s.w (strain-energy density), s.contact_energy, s.indenter_energy and s.indenter_force.
   void evaluate(State& s, double t) const;
   // Bonds over their critical stretch at s.u break (thesis §2.2: after the state update, before the
   // force there), then evaluate(s, t) in the same sweep over the bonds. Returns what broke now.
