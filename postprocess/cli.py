@@ -219,6 +219,14 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
         path = os.path.join(fig_dir, "probe.png")
         say(plot_probe(times, probe["values"], case, path, where=probe["where"], position=probe["position"]))
         written.append(path)
+        path = os.path.join(fig_dir, "damage_3d.png")
+        if case.dimension == 3 and damaged:  # a rendered view of where the damage is inside the body
+            from .render3d import render_damage_3d
+            index, t, frame = state["last"]
+            say(render_damage_3d(series[index][1], frame, case, path, time=t))
+            written.append(path)
+        elif os.path.exists(path):  # left from an earlier run of a case that could break
+            os.unlink(path)
         written += _crack_outputs(out_dir, fig_dir, case, times, state["last"][2].points,
                                   crack_masks)
     log(f"postprocess: {case.name}: {len(series)} frames → " +

@@ -5,7 +5,8 @@ crack_path.png, left: the final crack (its nodes, φ > DAMAGED, light grey) seen
 (3D: from above) with each tip's path over it, a dot per frame; right: each tip's speed against
 time, over SPEED_LAG frames. crack_tips.csv: one row per frame and tip, columns time [s], tip (the
 track's name), x, y, z [m], extension (distance of the tip from its origin [m]), speed [m/s] over
-the frames i − 1 … i + 1 (empty at the first and last frame), pipeline/formats.md §4.
+the frames i − 1 … i + 1 (empty at the first and last frame); empty cells where a crack without a
+notch has no tip yet (pipeline/formats.md §4).
 """
 from __future__ import annotations
 
@@ -33,9 +34,11 @@ def tip_table(times, x, crack_masks, tracks: list[Track]) -> list[dict]:
         _, speed = tip_speeds(times, tips)
         for i, t in enumerate(times):
             k = i - half  # the window [i − half, i + half] is speed[k]
+            found = bool(np.all(np.isfinite(tips[i])))
+            v = float(speed[k]) if 0 <= k < len(speed) else np.nan
             rows.append({"time": float(t), "tip": track.name, "x": tips[i, 0], "y": tips[i, 1], "z": tips[i, 2],
-                         "extension": float(np.linalg.norm(tips[i] - track.origin)),
-                         "speed": float(speed[k]) if 0 <= k < len(speed) else None})
+                         "extension": float(np.linalg.norm(tips[i] - track.origin)) if found else np.nan,
+                         "speed": v if np.isfinite(v) else None})
     return rows
 
 
@@ -46,7 +49,7 @@ def write_tip_csv(path: str, rows: list[dict]):
     writer.writerow(CSV_COLUMNS)
     for row in rows:
         writer.writerow([f"{row['time']:.9g}", row["tip"]] +
-                        [f"{row[k]:.9g}" for k in ("x", "y", "z", "extension")] +
+                        ["" if np.isnan(row[k]) else f"{row[k]:.9g}" for k in ("x", "y", "z", "extension")] +
                         ["" if row["speed"] is None else f"{row['speed']:.6g}"])
     write_atomically(path, text.getvalue())
 
@@ -73,10 +76,10 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
         ax_path.plot(tips[:, 0] * length, tips[:, 1] * length, "-", color=colour, lw=1.0, marker=".", ms=3,
                      label=f"tip, {track.name}")
         mid, speed = tip_speeds(times, tips)
-        if len(speed):
+        if np.isfinite(speed).any():
             ax_speed.plot(mid * t_factor, speed, "-", color=colour,
                           marker=".", ms=3, label=track.name)
-            k = int(np.argmax(speed))
+            k = int(np.nanargmax(speed))
             peaks.append(f"{speed[k]:.4g} m/s at {mid[k] * t_factor:.4g} {t_unit} ({track.name})")
     ax_path.set_xlabel(f"x [{length_unit}]")
     ax_path.set_ylabel(f"y [{length_unit}]")

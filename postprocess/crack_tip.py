@@ -36,6 +36,7 @@ class Track:
     origin: np.ndarray            # (3,) [m]: where the crack starts (a notch tip)
     direction: np.ndarray         # (3,) unit: along which the tip runs
     side: np.ndarray | None = None  # (3,) unit: only nodes with (x − origin)·side ≥ 0 (one branch)
+    rests_at_origin: bool = True  # no crack node ahead: the tip is the origin (a notch tip), else NaN
 
 
 def _unit(v) -> np.ndarray:
@@ -51,7 +52,9 @@ def _points3(x) -> np.ndarray:
 def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
     """(frames, 3) tip of `track` in each frame: among the crack nodes (crack_masks[i], a bool per
     node) ahead of the origin ((x − origin)·direction > 0) and on its side, the one farthest along
-    the direction (the first such node on a tie); the origin when there is none."""
+    the direction (the first such node on a tie); when there is none, the origin (a notch tip, from
+    which the crack starts) or NaN (a crack without a notch has no tip before it appears: its
+    first tip lies on the body's edge, and a step from the origin there is no speed)."""
     x = _points3(x)
     relative = x - track.origin
     ahead = relative @ track.direction
@@ -61,7 +64,10 @@ def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
     tips = np.empty((len(crack_masks), 3))
     for i, crack in enumerate(crack_masks):
         candidates = np.flatnonzero(crack & allowed)
-        tips[i] = x[candidates[np.argmax(ahead[candidates])]] if len(candidates) else track.origin
+        if len(candidates):
+            tips[i] = x[candidates[np.argmax(ahead[candidates])]]
+        else:
+            tips[i] = track.origin if track.rests_at_origin else np.nan
     return tips
 
 
@@ -115,5 +121,12 @@ def plan_tracks(x, crack_masks, cracks=()) -> list[Track]:
         # a readable sign: the largest component positive
         direction = _unit(direction * np.sign(direction[np.argmax(np.abs(direction))]))
         axis = "xyz"[int(np.argmax(np.abs(direction)))]
-        tracks += [Track(f"+{axis} end", origin, direction), Track(f"−{axis} end", origin, -direction)]
-    return [t for t in tracks if np.any(tip_positions(x, crack_masks, t) != t.origin)]
+        tracks += [Track(f"+{axis} end", origin, direction, rests_at_origin=False),
+                   Track(f"−{axis} end", origin, -direction, rests_at_origin=False)]
+
+    def moved(track):
+        tips = tip_positions(x, crack_masks, track)
+        found = np.all(np.isfinite(tips), axis=1)
+        return bool(np.any(np.linalg.norm(tips[found] - track.origin, axis=1) > 0.0))
+
+    return [t for t in tracks if moved(t)]

@@ -86,6 +86,7 @@ def test_tracker_without_a_notch_follows_both_ends_at_their_speeds():
     assert np.allclose(tracks[0].origin, [20 * DX, 10.5 * DX, 0.0])  # the centroid of the first damaged nodes
     up = crack_tip.tip_positions(points, masks, tracks[0])
     down = crack_tip.tip_positions(points, masks, tracks[1])
+    assert np.isnan(up[0]).all() and np.isnan(down[0]).all()   # no tip before the crack appears
     assert np.allclose(up[1:, 1], DX * (10 + np.arange(1, frames)))
     assert np.allclose(down[2:, 1], DX * (10 - np.arange(2, frames) // 2))
     _, speed_up = crack_tip.tip_speeds(times[1:], up[1:])
