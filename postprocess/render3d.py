@@ -4,7 +4,8 @@ With ParaView's pvpython on PATH (not a dependency: `apt-get install paraview`),
 rendered offscreen (under xvfb-run when there is no X display: Debian's ParaView needs one) by postprocess/pvpython_damage.py: the body as translucent points, the damaged
 nodes (φ > DAMAGED_SHOWN) as opaque spheres coloured by damage, seen from an oblique camera.
 Without it, or when it fails, matplotlib draws the same: a light, sparse cloud of the body's nodes
-for its shape and the damaged nodes coloured by damage, in the box's true proportions.
+for its shape and the damaged nodes coloured by damage, in the box's proportions (an axis thinner
+than THIN_AXIS of the longest stretched to it, and the title says so).
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ from .casefile import CaseSettings
 from .plotting import DPI, plt, save_figure, short_title, si_scale
 
 DAMAGED_SHOWN = 0.1      # damage above which a node is drawn as damaged (crack nodes: > 0.3)
+THIN_AXIS = 0.2         # matplotlib: an axis drawn at least this share of the longest
 CONTEXT_POINTS = 4000    # nodes of the body drawn (every k-th) to show its shape
 PVPYTHON_TIMEOUT = 300   # s: a rendering that takes longer is abandoned for matplotlib
 SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "pvpython_damage.py")
@@ -43,22 +45,27 @@ def plot_damage_3d_matplotlib(points, damage, case: CaseSettings, path: str, *, 
     shown = damaged_nodes(damage)
     fig = plt.figure(figsize=(8.0, 6.0), dpi=DPI)
     ax = fig.add_subplot(projection="3d")
-    extent = np.maximum(np.ptp(p, axis=0), 1e-3 * np.ptp(p, axis=0).max())
+    # true proportions, except that an axis thinner than THIN_AXIS of the longest is stretched to it
+    # (a 3 mm plate 40 mm long: its z ticks would overlap)
+    true_extent = np.ptp(p, axis=0)
+    extent = np.maximum(true_extent, THIN_AXIS * true_extent.max())
     ax.set_box_aspect(tuple(extent))
+    stretched = [f"{a} ×{e / t:.2g}" for a, e, t in zip("xyz", extent, true_extent) if 0 < t and e > t * (1 + 1e-9)]
     stride = max(1, int(np.ceil(len(p) / CONTEXT_POINTS)))
     ax.scatter(p[::stride, 0], p[::stride, 1], p[::stride, 2], s=1.0, color="0.75", alpha=0.3, linewidths=0,
                depthshade=False, label="body")
     if len(shown):
         scatter = ax.scatter(p[shown, 0], p[shown, 1], p[shown, 2], c=np.asarray(damage)[shown], cmap="inferno_r",
                              vmin=0.0, vmax=1.0, s=4.0, linewidths=0, depthshade=False)
-        fig.colorbar(scatter, ax=ax, shrink=0.6, pad=0.1, label="damage φ [-]")
+        fig.colorbar(scatter, ax=ax, shrink=0.6, pad=0.15, label="damage φ [-]")
     ax.view_init(elev=35.0, azim=-60.0)
     ax.set_xlabel(f"x [{unit}]")
     ax.set_ylabel(f"y [{unit}]")
     ax.set_zlabel(f"z [{unit}]")
     ax.tick_params(labelsize="x-small")
     t_factor, t_unit = si_scale([time], "s")
-    ax.set_title(short_title(case, f"damage at t = {time * t_factor:.4g} {t_unit}"))
+    ax.set_title(short_title(case, f"damage at t = {time * t_factor:.4g} {t_unit}")
+                 + (f"\n(drawn stretched: {', '.join(stretched)})" if stretched else ""))
     save_figure(fig, path)
     return (f"damage_3d.png (matplotlib): {len(shown)} nodes with damage > {DAMAGED_SHOWN:g} of {len(p)}"
             + ("" if shutil.which("pvpython") else "; pvpython not found: ParaView renders it when installed"))
