@@ -117,15 +117,16 @@ def test_frames_and_history_equal_the_serial_run_byte_for_byte(runs, name):
 
 
 def with_loads(case):
-    """Body forces on the whole plate (y, constant; x, ramped) and two indenters with their reaction columns."""
+    """Body forces (the whole plate in y, constant; the left grip in x, ramped) and two indenters: a disk
+    pressing the top edge (y = 0.049 m) and a plane pushing the left edge (x = 0.001 m), both inside from t = 0."""
     case["boundary_conditions"] += [
         {"set": "plate", "kind": "body_force", "component": 1, "times": [0.0], "values": [-4.0e7]},
         {"set": "left", "kind": "body_force", "component": 0, "times": [0.0, 3.0e-4], "values": [0.0, 2.0e8]},
     ]
     case["indenters"] = [
-        {"name": "punch", "shape": "cylinder", "radius": 5.0e-3, "centre": [0.05, 0.0555, 0.0],
+        {"name": "punch", "shape": "cylinder", "radius": 5.0e-3, "centre": [0.05, 0.0538, 0.0],
          "velocity": [0.0, -5.0, 0.0], "axis": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, 0.0], "stiffness": 1.0e14},
-        {"name": "wall", "shape": "plane", "radius": 0.0, "centre": [0.0005, 0.0, 0.0],
+        {"name": "wall", "shape": "plane", "radius": 0.0, "centre": [0.0013, 0.0, 0.0],
          "velocity": [1.0, 0.0, 0.0], "axis": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0], "stiffness": 1.0e14},
     ]
 
