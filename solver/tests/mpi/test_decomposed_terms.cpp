@@ -160,6 +160,11 @@ Outcome run_both(const pd::Model& global_in, const pd::Vec3Array& v0, int steps,
 
 class DecomposedTerms : public ::testing::TestWithParam<int> {};  // threads per rank
 
+// Steps to run: all of them with one thread per rank; a fifth with two, enough to cross the ranks'
+// threaded sweeps many times — 3 ranks × 2 threads on a 2-core machine wait on each other at every
+// parallel region, and the full count took 80 s per test there.
+int steps_for_threads(int steps, int threads) { return threads == 1 ? steps : steps / 5; }
+
 // Gravity-like body forces on two overlapping sets, one in y and one in x with a ramp in time,
 // a clamped face and damping: the external work is the body forces' (and the support's) power.
 TEST_P(DecomposedTerms, BodyForcesGiveTheSerialRunBitwise) {
@@ -176,8 +181,9 @@ TEST_P(DecomposedTerms, BodyForcesGiveTheSerialRunBitwise) {
   c.boundary_conditions.push_back({"upper", "body_force", 0, {0.0, 1e-6}, {0.0, 3.1e7}});
   const pd::Model m = pd::build_model(c, nodes);
   ASSERT_EQ(m.conditions.body_forces.size(), 2u);
-  const Outcome o = run_both(m, wavy_velocity(m, 0.5), 50, 0.8);
-  EXPECT_EQ(o.steps_compared, 50);
+  const int steps = steps_for_threads(50, GetParam());
+  const Outcome o = run_both(m, wavy_velocity(m, 0.5), steps, 0.8);
+  EXPECT_EQ(o.steps_compared, steps);
   EXPECT_NE(o.external_work, 0.0);  // the body forces worked
 }
 
@@ -206,13 +212,14 @@ TEST_P(DecomposedTerms, IndentersAndTheirReactionsGiveTheSerialRunBitwise) {
   c.indenters = {plane, disk};
   const pd::Model m = pd::build_model(c, pdtest::cubic_lattice(n, n, 1, kDx, 2, 1e-3));
   ASSERT_GT(m.nodes.size(), 4096u);
-  const Outcome o = run_both(m, wavy_velocity(m, 0.2), 40, 0.7);
-  EXPECT_EQ(o.steps_compared, 40);
+  const int steps = steps_for_threads(40, GetParam());
+  const Outcome o = run_both(m, wavy_velocity(m, 0.2), steps, 0.7);
+  EXPECT_EQ(o.steps_compared, steps);
   ASSERT_EQ(o.indenter_force.size(), 2u);
   EXPECT_GT(o.indenter_force[0][0], 0.0);  // the wall pushes +x
   EXPECT_LT(o.indenter_force[1][1], 0.0);  // the punch pushes −y
   EXPECT_GT(o.contact_energy, 0.0);
-  EXPECT_EQ(o.limit_nodes_seen, 40);
+  EXPECT_EQ(o.limit_nodes_seen, steps);
 }
 
 // LPS with breaking on a notched 3D lattice torn open by its initial velocities: the ghosts' P
@@ -242,8 +249,9 @@ TEST_P(DecomposedTerms, LpsWithBreakingGivesTheSerialRunBitwise) {
     }
   pd::Vec3Array v0 = wavy_velocity(m, 0.3);
   for (std::size_t i = 0; i < m.nodes.size(); ++i) v0[0][i] += m.nodes.x[0][i] > 6.5 * kDx ? 2.0 : -2.0;
-  const Outcome o = run_both(m, v0, 50, 0.8);
-  EXPECT_EQ(o.steps_compared, 50);
+  const int steps = steps_for_threads(50, GetParam());
+  const Outcome o = run_both(m, v0, steps, 0.8);
+  EXPECT_EQ(o.steps_compared, steps);
   EXPECT_GT(o.broken, 10);  // bonds broke, across ranks too on 2 and 3 of them
 }
 
@@ -267,9 +275,10 @@ TEST_P(DecomposedTerms, AdaptiveStepsGiveTheSerialRunBitwise) {
   const auto adaptive = [](pd::ForceOperator& op) -> std::unique_ptr<pd::Integrator> {
     return std::make_unique<pd::AdaptiveStep>(op);
   };
-  const Outcome o = run_both(m, v0, 30, 1.5, adaptive, &c);
-  EXPECT_EQ(o.steps_compared, 30);
-  EXPECT_GT(o.iterations, 30);  // the fixed-point iteration ran (more than one iterate per step)
+  const int steps = steps_for_threads(30, GetParam());
+  const Outcome o = run_both(m, v0, steps, 1.5, adaptive, &c);
+  EXPECT_EQ(o.steps_compared, steps);
+  EXPECT_GT(o.iterations, steps);  // the fixed-point iteration ran (more than one iterate per step)
   EXPECT_GT(o.broken, 0);       // and bonds broke on accepted states
 }
 
