@@ -32,7 +32,7 @@ COLUMNS = {
     "indenter_energy": ("J", "potential of the rigid indenters, sum of V K h^3/3"),
     "contact_rebuilds": ("1", "Verlet-list builds of the contact search so far"),
     "broken_bond_energy": ("J", "energy the broken bonds held when they broke, sum of 1/2 c s^2 |xi| nu V_i V_j"),
-    "mode": ("1", "kind of the step of the mixed integrator: 1 quasi-static load step, 0 explicit step"),
+    "mode": ("1", "kind of the step of the mixed integrator: 1 quasi-static load step, 2 implicit step, 0 explicit step"),
 }
 # Families of columns, one triple per indenter or node set: (pattern, unit, description template).
 FAMILIES = (

@@ -115,7 +115,8 @@ def _plot_controlled(history: dict, case, path: str) -> str:
     if mixed:
         # The mixed scheme (integrators/mixed.hpp): its load steps and explicit steps differ by
         # orders of magnitude, so Δt is drawn on a log scale with each mode in its own colour.
-        for value, label in ((1, "quasi-static load steps"), (0, "explicit (Verlet) steps")):
+        for value, label in ((1, "quasi-static load steps"), (2, "implicit (generalized-α) steps"),
+                             (0, "explicit (Verlet) steps")):
             chosen = history["mode"] == value
             if np.any(chosen):
                 b.plot(t[chosen], dt[chosen] * factor, ".", markersize=3, label=label)

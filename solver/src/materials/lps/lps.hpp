@@ -91,6 +91,9 @@ class LpsModel : public BondModel {
     return false;  // state-based: f_i depends on the neighbours' neighbours; solvers stay matrix-free
   }
 
+  // ∂f_i/∂u_i per node (lps_tangent.cpp): the bond terms and the dilatation's, derived there.
+  bool jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, std::vector<double>& blocks,
+                                bool definite = false) const override;
   // A decomposed run (issue 15): the piece's law takes m_i, κ, α, a, b of every local node, ghosts
   // too, from this whole-model law (a ghost's row is empty on the piece, so its m could not be
   // summed there), and between the sweeps fills the ghosts' P_j from their owners (one scalar per
