@@ -83,6 +83,8 @@ void check_decomposable(const Prepared& p, const RunOptions& opt) {
     what = "blocks[].model: " + p.model.bond_model->name() + " (a state-based law needs its ghosts' dilatation too)";
   else if (!p.model.node_critical_stretch.empty())
     what = "blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end)";
+  else if (p.model.bonds.corrected())
+    what = "discretization.surface_correction: " + c.surface_correction + " (a piece's bonds would need their factors)";
   else if (c.time.integrator != "verlet") what = "time.integrator: " + c.time.integrator;
   else if (c.time.dt_rule == "exact") what = "time.dt: exact";
   else if (p.model.contact.pairs) what = "contact";

@@ -24,6 +24,12 @@
 // (3Kθ/m) ω|ξ| + (15μ/m) ω e^d = ((3K − 5μ)θ|ξ| + 15μ e) ω/m (LAMMPS); once bonds break, the last term of P keeps f the gradient of the
 // energy (so the energy balance holds exactly and the Jacobian stays symmetric) where LAMMPS and
 // Peridigm, which keep m and drop it, are not.
+//
+// Surface correction (core/surface_correction, discretization.surface_correction: energy): bond q's
+// factor g_q multiplies its weight V_j ν_j in every sum of the law — θ_i, m'_i, the deviatoric sum and
+// the force — but not m_i, the normaliser fixed at the start. The energy stays Σ_i V_i W_i of one
+// symmetric weighting (g_ij = g_ji), so the force is still its exact gradient and J symmetric; the
+// formulas above hold with V_j → g V_j, P_i's last term now active while m'_i ≠ m_i.
 #pragma once
 #include <cfloat>
 #include <cmath>
@@ -84,6 +90,8 @@ class LpsModel : public BondModel {
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override;
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
+  // ½ C11 ε², C11 = K + 4μ/3 (3D) or κ + μ (2D: λ + 2μ in plane strain, E/(1 − ν²) in plane stress).
+  double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const override;
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
@@ -104,6 +112,7 @@ class LpsModel : public BondModel {
   std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
   std::vector<double> a_;      // α_i / m_i
   std::vector<double> b_;      // d κ_i / m_i
+  std::vector<double> rho_;    // m'_i/m_i with the surface factors (Σ g ω|ξ|²V / m_i); empty without
 
   friend struct LpsKernel;
 };

@@ -19,6 +19,7 @@ struct LpsKernel {
   const std::int32_t* neighbour;
   std::uint8_t* broken;  // written only by the breaking sweep, row by row
   VolumeWeight volume_weight;
+  const double* factor;  // surface-correction factor g_k per directed bond; null: none (g = 1)
   const double* x[3];
   const double* u[3];
   const double* volume;
@@ -36,6 +37,7 @@ struct LpsKernel {
     neighbour = model.bonds.neighbour.data();
     broken = const_cast<std::uint8_t*>(model.bonds.broken.data());
     volume_weight = model.bonds.volume_weight;
+    factor = model.bonds.corrected() ? model.bonds.surface_factor.data() : nullptr;
     for (int q = 0; q < 3; ++q) {
       x[q] = model.nodes.x[static_cast<std::size_t>(q)].data();
       u[q] = uu[static_cast<std::size_t>(q)].data();
@@ -53,14 +55,17 @@ struct LpsKernel {
 
   // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, raw = y − |ξ| and the extension ext = raw but
   // 0 where |raw| ≤ kLpsStretchZero·|ξ| (round-off), 1/y (1 for a crushed bond: its
-  // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j.
+  // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j g_q (g_q the
+  // surface-correction factor of bond q: a correction weights the bond in every sum of the law
+  // but m_i, lps.hpp).
   struct Bond {
     double length, e0, e1, e2, y, raw, ext, inv_y, omega, vj;
     // The breaking criterion (PMB's s > s0, without a division): y − |ξ| > s0 |ξ|. Both copies of
     // a bond see bitwise the same y and |ξ|, so they break in the same sweep.
     bool over(double s0) const { return raw > s0 * length; }
   };
-  Bond bond(std::int64_t i, std::int64_t j) const {
+  Bond bond(std::int64_t i, std::int64_t q) const {
+    const std::int64_t j = neighbour[q];
     Bond t;
     const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
     t.length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);  // core/bonds.hpp bond_length
@@ -75,6 +80,7 @@ struct LpsKernel {
     t.inv_y = 1.0 / (t.y > 0.0 ? t.y : 1.0);
     t.omega = influence(kind, t.length, horizon);
     t.vj = volume[j] * volume_weight(t.length);
+    if (factor) t.vj *= factor[q];
     return t;
   }
 
@@ -83,7 +89,7 @@ struct LpsKernel {
     double st = 0.0, sm = 0.0;
     for (std::int64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
       if (broken[k]) continue;
-      const Bond t = bond(i, neighbour[k]);
+      const Bond t = bond(i, k);
       st += t.omega * t.length * t.ext * t.vj;
       sm += t.omega * t.length * t.length * t.vj;
     }
@@ -103,7 +109,7 @@ struct LpsKernel {
     double dev = 0.0;
     for (std::int64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
       if (broken[k]) continue;
-      const Bond t = bond(i, neighbour[k]);
+      const Bond t = bond(i, k);
       const double ed = t.ext - theta * t.length / d;
       dev += t.omega * ed * ed * t.vj;
     }
@@ -141,10 +147,11 @@ PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const
   for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
     std::int64_t jq[kChunk];
-    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk];
+    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk], gq[kChunk];
     for (int q = 0; q < m; ++q) {
       jq[q] = k.neighbour[base + q];
       intact[q] = k.broken[base + q] ? 0.0 : 1.0;
+      gq[q] = k.factor ? k.factor[base + q] : 1.0;  // ×1 is exact: without a correction, the same bits
       if constexpr (kBreaking) s0q[q] = kOneBlock ? s0_row[0] : s0_row[block[jq[q]]];
     }
     for (int q = 0; q < m; ++q) {
@@ -157,7 +164,7 @@ PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const
       const double raw = y - length;
       const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
       const double omega = influence_of<kKind>(length, k.horizon);
-      const double vj = k.volume[j] * k.volume_weight(length);
+      const double vj = k.volume[j] * k.volume_weight(length) * gq[q];
       ta[q] = intact[q] * (omega * length * ext * vj);
       tb[q] = intact[q] * (omega * length * length * vj);
       if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw > s0q[q] * length);  // Bond::over
@@ -186,9 +193,10 @@ PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const 
   for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
     std::int64_t jq[kChunk];
-    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk];
+    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk], gq[kChunk];
     for (int q = 0; q < m; ++q) {
       jq[q] = k.neighbour[base + q];
+      gq[q] = k.factor ? k.factor[base + q] : 1.0;  // ×1 is exact: without a correction, the same bits
       intact[q] = k.broken[base + q] ? 0.0 : 1.0;
       pq[q] = p[jq[q]];
       aq[q] = k.a[jq[q]];
@@ -204,7 +212,7 @@ PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const 
       const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
       const double inv_y = 1.0 / (y > 0.0 ? y : 1.0);
       const double omega = influence_of<kKind>(length, k.horizon);
-      const double vj = k.volume[j] * k.volume_weight(length);
+      const double vj = k.volume[j] * k.volume_weight(length) * gq[q];
       const double tt = omega * (length * (pi + pq[q]) + (ai + aq[q]) * ext);
       const double scale = intact[q] * (tt * vj * inv_y);
       t0[q] = scale * e0;
@@ -249,7 +257,7 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
     const std::int64_t j = k.neighbour[q];
     if (k.broken[q] || br->no_fail[j]) continue;
-    over += k.bond(i, j).over(s0_row[br->block[j]]);
+    over += k.bond(i, q).over(s0_row[br->block[j]]);
   }
   if (over == 0) {
     if (br->lost) br->lost[i] = 0.0;
@@ -259,7 +267,7 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   std::int64_t once = 0;
   for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
     const std::int64_t j = k.neighbour[q];
-    if (k.broken[q] || br->no_fail[j] || !k.bond(i, j).over(s0_row[br->block[j]])) continue;
+    if (k.broken[q] || br->no_fail[j] || !k.bond(i, q).over(s0_row[br->block[j]])) continue;
     k.broken[q] = 1;
     once += i < j;
   }
@@ -411,7 +419,7 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
     for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
       if (k.broken[q]) continue;
       const std::int64_t j = k.neighbour[q];
-      const LpsKernel::Bond t = k.bond(i, j);
+      const LpsKernel::Bond t = k.bond(i, q);
       const double along = t.y > 0.0 ? ((x[0][j] - x[0][i]) * t.e0 + (x[1][j] - x[1][i]) * t.e1 +
                                         (x[2][j] - x[2][i]) * t.e2) * t.inv_y
                                      : 0.0;
@@ -431,7 +439,7 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
       if (k.broken[q]) continue;
       const std::int64_t j = k.neighbour[q];
       const auto ju = static_cast<std::size_t>(j);
-      const LpsKernel::Bond t = k.bond(i, j);
+      const LpsKernel::Bond t = k.bond(i, q);
       if (!(t.y > 0.0)) continue;
       const double n0 = t.e0 * t.inv_y, n1 = t.e1 * t.inv_y, n2 = t.e2 * t.inv_y;
       const double x0 = x[0][ju] - x[0][iu], x1 = x[1][ju] - x[1][iu], x2 = x[2][ju] - x[2][iu];

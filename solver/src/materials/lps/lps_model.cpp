@@ -23,6 +23,7 @@ LpsModel::LpsModel(const Model& model) {
   alpha_.assign(n, 0.0);
   a_.assign(n, 0.0);
   b_.assign(n, 0.0);
+  if (model.bonds.corrected()) rho_.assign(n, 1.0);
   const auto& X = model.nodes.x;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < static_cast<std::int64_t>(n); ++i64) {
@@ -39,6 +40,18 @@ LpsModel::LpsModel(const Model& model) {
            (model.nodes.volume[j] * model.bonds.volume_weight(len));
     }
     m_[i] = m;
+    if (model.bonds.corrected()) {  // m'_i with the factors, for the stable step's bound
+      double mg = 0.0;
+      for (std::int64_t k = model.bonds.offsets[i]; k < model.bonds.offsets[i + 1]; ++k) {
+        const auto ku = static_cast<std::size_t>(k);
+        if (model.bonds.broken[ku]) continue;
+        const auto j = static_cast<std::size_t>(model.bonds.neighbour[ku]);
+        const double len = bond_length(X, i, j);
+        mg += influence(influence_, len, horizon_) * len * len *
+              (model.nodes.volume[j] * model.bonds.volume_weight(len) * model.bonds.surface_factor[ku]);
+      }
+      rho_[i] = m > 0.0 ? mg / m : 1.0;
+    }
     const LpsModuli& mod = per_block.empty() ? LpsModuli{} : per_block[static_cast<std::size_t>(model.block_index[i])];
     kappa_[i] = mod.kappa;
     alpha_[i] = alpha_factor * mod.mu;
@@ -61,13 +74,28 @@ std::vector<double> LpsModel::damage(const Model& m) const { return bond_damage(
 // Neither Peridigm's nor CabanaPD's LPS step (PMB's with c = 18K/(πδ⁴), K only) is a bound for
 // every ν: it exceeds the exact limit for ν below about −0.2 (3D), where μ dominates
 // (tests/materials/test_lps.cpp measures both against the exact limit).
+//
+// With surface factors (weights g V_j, m_i unchanged, ρ_i = m'_i/m_i with m'_i = Σ g ω|ξ|² V_j):
+// θ_i² ≤ (d²/m_i²) m'_i Σ g ω e² V_j, and Σ g ω (e^d)² V_j = Σ g ω e² V_j − θ_i² (2m_i − m'_i)/d²
+// ≤ (1 + max(0, ρ_i(ρ_i − 2))) Σ g ω e² V_j; hence the node term (d²κρ + α(1 + max(0, ρ(ρ − 2))))/m
+// (ρ = 1: the term above), and node_stiffness multiplies the bond's term by g.
 double LpsModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, double length) const {
   const double dd = static_cast<double>(d_) * d_;
   const auto node_term = [&](std::size_t q) {
+    if (!rho_.empty() && m_[q] > 0.0) {
+      const double r = rho_[q];
+      return (dd * kappa_[q] * r + alpha_[q] * (1.0 + std::max(0.0, r * (r - 2.0)))) / m_[q];
+    }
     return m_[q] > 0.0 ? (dd * kappa_[q] + alpha_[q]) / m_[q] : 0.0;  // (d²κ + α)/m
   };
   return m.nodes.volume[j] * m.bonds.volume_weight(length) * influence(influence_, length, horizon_) *
          (node_term(i) + node_term(j));
+}
+
+double LpsModel::uniaxial_energy_density(const Model&, std::size_t i, double eps) const {
+  const double mu = alpha_[i] / (d_ == 3 ? 15.0 : 8.0);  // α = 15μ (3D), 8μ (2D)
+  const double c11 = d_ == 3 ? kappa_[i] + 4.0 * mu / 3.0 : kappa_[i] + mu;
+  return 0.5 * c11 * eps * eps;
 }
 
 namespace {
@@ -101,7 +129,7 @@ void LpsModel::apply_reference_stiffness(const Model& m, const std::array<double
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < n; ++i64) {
     const auto i = static_cast<std::size_t>(i64);
-    double mi = 0.0, sd = 0.0;
+    double mi = 0.0, mg = 0.0, sd = 0.0;
     for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
       const auto ku = static_cast<std::size_t>(k);
       if (m.bonds.broken[ku]) continue;
@@ -109,11 +137,15 @@ void LpsModel::apply_reference_stiffness(const Model& m, const std::array<double
       double xi[3];
       const double len = bond(i, j, xi);
       const double w = influence(influence_, len, horizon_) * m.nodes.volume[j] * m.bonds.volume_weight(len);
+      const double wg = w * m.bonds.factor(ku);  // the surface-corrected weight (lps.hpp); w without one
       mi += w * len * len;
-      sd += w * (xi[0] * (z(0, j) - z(0, i)) + xi[1] * (z(1, j) - z(1, i)) + xi[2] * (z(2, j) - z(2, i)));  // ω|ξ| n·δη V
+      mg += wg * len * len;
+      sd += wg * (xi[0] * (z(0, j) - z(0, i)) + xi[1] * (z(1, j) - z(1, i)) + xi[2] * (z(2, j) - z(2, i)));  // ω|ξ| n·δη V
     }
     a[i] = mi > 0.0 ? alpha_[i] / mi : 0.0;
-    gamma_dtheta[i] = mi > 0.0 ? (d * kappa_[i] / mi - a[i] / d) * (d / mi * sd) : 0.0;
+    double gamma = mi > 0.0 ? d * kappa_[i] / mi - a[i] / d : 0.0;
+    if (m.bonds.corrected() && mi > 0.0) gamma -= a[i] * (mi - mg) / (d * mi);  // P's m'_i term (lps.hpp)
+    gamma_dtheta[i] = mi > 0.0 ? gamma * (d / mi * sd) : 0.0;
   }
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < n; ++i64) {
@@ -129,7 +161,7 @@ void LpsModel::apply_reference_stiffness(const Model& m, const std::array<double
       const double along = n0 * (z(0, j) - z(0, i)) + n1 * (z(1, j) - z(1, i)) + n2 * (z(2, j) - z(2, i));
       const double t = influence(influence_, len, horizon_) *
                        (len * (gamma_dtheta[i] + gamma_dtheta[j]) + (a[i] + a[j]) * along) * m.nodes.volume[j] *
-                       m.bonds.volume_weight(len);
+                       m.bonds.volume_weight(len) * m.bonds.factor(ku);
       s0 += t * n0;
       s1 += t * n1;
       s2 += t * n2;
