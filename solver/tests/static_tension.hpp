@@ -25,6 +25,7 @@ struct Tension {
 // third in x: interior = nodes whose y (and z) index lies in [inner, n − 1 − inner].
 inline Tension static_tension(const pd::Model& m, int nx, int ny, int nz, double dx, double sigma, int inner) {
   const std::size_t n = m.nodes.size();
+  if (static_cast<std::size_t>(nx) * ny * nz != n) return Tension{};  // not this lattice: not converged
   const bool plane = m.nodes.dimension == 2;
   std::vector<std::array<bool, 3>> fixed(n, {false, false, plane});
   for (int k = 0; k < nz; ++k)

@@ -90,7 +90,7 @@ TEST(SurfaceCorrection, MeasureStaticTension) {
         Config s{row.model, row.analysis, row.nu, corr, pv};
         if (only && std::string(only) != std::string(row.model) + "-" + row.analysis) continue;
         const bool plane = s.analysis != "3d";
-        const int nx = 36, ny = plane ? 21 : 15, nz = 15;
+        const int nx = 36, ny = plane ? 21 : 15, nz = plane ? 1 : 15;
         const pd::Model m = build(s, nx, ny, nz);
         const pdtest::Tension t = pdtest::static_tension(m, nx, ny, nz, kDx, sigma, plane ? 7 : 6);
         const double e = axial_modulus(s), r = lateral_ratio(s);
@@ -294,5 +294,44 @@ TEST(SurfaceCorrection, StableStepStillBoundsTheExactLimit) {
                 stable / exact);
     EXPECT_LT(stable, exact) << s.model;
     EXPECT_GT(stable, 0.2 * exact) << s.model;
+  }
+}
+
+namespace {
+
+// E_apparent/E of a thin lattice bar (3D, 30 × 6 × 6 nodes: every node within δ of a lateral face)
+// or a plate (2D, 30 × 10) in static tension: σ over the strain of the whole cross-section.
+double apparent_stiffness(const Config& s) {
+  const bool plane = s.analysis != "3d";
+  const int nx = 30, ny = plane ? 10 : 6, nz = plane ? 1 : 6;
+  const pd::Model m = build(s, nx, ny, nz);
+  const double sigma = 1e6;
+  const pdtest::Tension t = pdtest::static_tension(m, nx, ny, nz, kDx, sigma, 0);
+  EXPECT_TRUE(t.converged) << s.model << " " << s.analysis;
+  return sigma / t.section_xx / axial_modulus(s);
+}
+
+}  // namespace
+
+TEST(SurfaceCorrection, ThinBarAndPlateInTensionHaveTheStiffnessOfTheMaterial) {
+  const char* only = std::getenv("PD_SURFACE_ONLY");
+  for (const Config& base : {Config{"pmb", "3d", 0.25}, Config{"lps", "3d", 0.3}, Config{"pmb", "plane_stress", 0.0},
+                             Config{"lps", "plane_stress", 0.3}}) {
+    if (only && std::string(only) != base.model + "-" + base.analysis) continue;
+    Config with = base;
+    with.correction = "energy";
+    const double without_ratio = apparent_stiffness(base), with_ratio = apparent_stiffness(with);
+    std::printf("[ surface  ] %s %s thin %s: E_apparent/E = %.4f without, %.4f with the energy correction\n",
+                base.model.c_str(), base.analysis.c_str(), base.analysis == "3d" ? "bar" : "plate", without_ratio,
+                with_ratio);
+    // Measured (m = 3, full volumes): without 0.7650, 1.1175, 0.9893, 1.1534; with 1.0387, 1.0116,
+    // 1.0419, 1.0426 (PMB 3D, LPS 3D, PMB plane stress, LPS plane stress). The correction matches
+    // each node's uniaxial-strain energy (C11) to the continuum; a bar in uniaxial stress also
+    // depends on C12, which the m = 3 lattice gets wrong in the bulk (the interior of a thick bar,
+    // MeasureStaticTension) — so 2 % holds for LPS in 3D only, and 4.5 % for all four.
+    EXPECT_NEAR(with_ratio, 1.0, base.model == "lps" && base.analysis == "3d" ? 0.02 : 0.045)
+        << base.model << " " << base.analysis;
+    if (base.model == "lps" || base.analysis == "3d")  // where the surface error is large, it shrinks
+      EXPECT_LT(std::fabs(with_ratio - 1.0), 0.5 * std::fabs(without_ratio - 1.0)) << base.model << " " << base.analysis;
   }
 }

@@ -26,10 +26,14 @@
 // Peridigm, which keep m and drop it, are not.
 //
 // Surface correction (core/surface_correction, discretization.surface_correction: energy): bond q's
-// factor g_q multiplies its weight V_j ν_j in every sum of the law — θ_i, m'_i, the deviatoric sum and
-// the force — but not m_i, the normaliser fixed at the start. The energy stays Σ_i V_i W_i of one
-// symmetric weighting (g_ij = g_ji), so the force is still its exact gradient and J symmetric; the
-// formulas above hold with V_j → g V_j, P_i's last term now active while m'_i ≠ m_i.
+// factor g_q multiplies its weight V_j ν_j in every sum of the law — m_i, θ_i, the deviatoric sum and
+// the force — and node i's moduli κ_i, α_i are multiplied by ḡ_i = m_i(g)/m_i(1), the factors' mean
+// over i's family. So a node whose bonds all carry one g has its energy W_i times g exactly (θ and
+// the deviatoric shape do not change, the moduli do): the energy method's premise, and ν stays the
+// material's; unequal factors reweight the family by direction (a truncated family's θ and
+// deviatoric sum see the missing directions again). One symmetric weighting (g_ij = g_ji), so the
+// force stays the exact gradient of Σ_i V_i W_i and J symmetric; the formulas above hold with
+// V_j → g V_j.
 #pragma once
 #include <cfloat>
 #include <cmath>
@@ -112,7 +116,7 @@ class LpsModel : public BondModel {
   std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
   std::vector<double> a_;      // α_i / m_i
   std::vector<double> b_;      // d κ_i / m_i
-  std::vector<double> rho_;    // m'_i/m_i with the surface factors (Σ g ω|ξ|²V / m_i); empty without
+  std::vector<double> c11_;    // λ + 2μ of i's block, uncorrected (uniaxial_energy_density)
 
   friend struct LpsKernel;
 };
