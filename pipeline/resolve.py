@@ -107,6 +107,7 @@ def resolve(case: dict, *, node_sets: list[str], grid_spacing: float, nodes_file
         "damping": case["damping"],
         "breaking_order": case["breaking_order"],
         "partial_volume": case["discretization"]["partial_volume"],
+        "surface_correction": case["discretization"]["surface_correction"],
         "contact": contact,
         "indenters": indenters,
         "time": time,

@@ -208,3 +208,12 @@ def test_output_format_defaults_are_the_compact_frames(tmp_path):
     assert output["fields"] == ["displacement", "velocity", "damage", "block"]
     assert "precision: 'float16' is not one of 'float32', 'float64'" in \
         error_of(tmp_path, MINIMAL + "output:\n  precision: float16\n")
+
+
+def test_surface_correction_is_none_by_default_and_a_choice(tmp_path):
+    assert load_case(write(tmp_path, MINIMAL))["discretization"]["surface_correction"] == "none"
+    text = MINIMAL.replace("  dx: 0.001\n", "  dx: 0.001\n  surface_correction: volum\n")
+    message = error_of(tmp_path, text)
+    assert "plate.yaml:5: discretization.surface_correction: 'volum' is not one of" in message
+    case = load_case(write(tmp_path, MINIMAL.replace("  dx: 0.001\n", "  dx: 0.001\n  surface_correction: energy\n")))
+    assert case["discretization"]["surface_correction"] == "energy"

@@ -19,6 +19,7 @@ from pipeline.resolve import resolve
 # case.json path → schema path, where the names differ.
 RENAMED = {
     "partial_volume": "discretization.partial_volume",
+    "surface_correction": "discretization.surface_correction",
     "no_fail_sets": "no_fail",
     "blocks": "materials",
     "initial_conditions[].gradient": "initial_conditions[].strain",  # strain_x·x becomes gradient
@@ -55,6 +56,7 @@ thickness: 0.001
 discretization:
   dx: 0.001
   partial_volume: lammps
+  surface_correction: energy
 materials:
   plate: {density: 2000, youngs_modulus: 1.0e9, fracture_energy: 10}
   disk: {density: 7800, youngs_modulus: 2.0e11}

@@ -42,6 +42,13 @@ struct BondList {
   std::vector<std::int32_t> neighbour;  // j, ascending within a row
   std::vector<std::uint8_t> broken;     // 1 once the bond has broken (never heals)
   VolumeWeight volume_weight;           // ν(|ξ|) of every bond; full volumes unless a rule set it
+  // g_k, the surface-correction factor of directed bond k (core/surface_correction: Le & Bobaru
+  // 2018), the same for both copies of a bond; empty without a correction (then g = 1, and no
+  // kernel reads it: results are bitwise those of a build without it). 8 bytes per directed bond.
+  std::vector<double> surface_factor;
+
+  bool corrected() const { return !surface_factor.empty(); }
+  double factor(std::size_t k) const { return surface_factor.empty() ? 1.0 : surface_factor[k]; }
 
   std::size_t nodes() const { return offsets.empty() ? 0 : offsets.size() - 1; }
   std::size_t directed() const { return neighbour.size(); }  // each bond counted twice

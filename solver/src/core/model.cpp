@@ -9,6 +9,7 @@
 #include "core/cracks.hpp"
 #include "core/error.hpp"
 #include "core/partial_volume.hpp"
+#include "core/surface_correction.hpp"
 #include "core/work_plan.hpp"
 
 namespace pd {
@@ -58,6 +59,7 @@ Model build_model(const Case& c, Nodes nodes) {
   Model m;
   m.horizon = c.horizon;
   m.grid_spacing = c.grid_spacing;
+  m.thickness = c.thickness;
   m.damping = c.damping;
   // Every block uses one material model (the reader checks it); its formulas give c and s0.
   m.material = make_material_table(c.blocks, c.analysis, c.horizon, c.thickness);
@@ -91,6 +93,11 @@ Model build_model(const Case& c, Nodes nodes) {
   if (m.material.node_rule()) m.node_critical_stretch = initial_node_critical_stretch(m.material, m.block_index, m.bonds);
   m.nodes = std::move(nodes);
   m.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(m);
+  // Factors from the law's own energy on each node's family (pre-cracks are free surfaces); every
+  // kernel reads them from the bonds.
+  apply_surface_correction(c.surface_correction, m);
+  // A law that precomputes from the weights (LPS's bound of the stable step) is made again with them.
+  if (m.bonds.corrected()) m.bond_model = material_registry().get(c.blocks[0].model).make(m);
   return m;
 }
 
@@ -108,7 +115,7 @@ double node_stiffness(const Model& m, std::size_t i) {
   for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
     const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
     const double length = bond_length(m.nodes.x, i, j);
-    sum += m.bond_model->bond_stiffness(m, i, j, length);
+    sum += m.bond_model->bond_stiffness(m, i, j, length) * m.bonds.factor(static_cast<std::size_t>(k));
     // With contact, a node pressed into a surface meets about as many contact partners as it has
     // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
     // 15c needs extra margin in impacts).

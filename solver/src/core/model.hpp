@@ -26,6 +26,7 @@ struct Model {
   std::shared_ptr<const BondModel> bond_model;  // the material law (materials/<model>/)
   double horizon = 0.0;  // δ [m]
   double grid_spacing = 0.0;  // dx [m]
+  double thickness = 0.0;     // h [m] of a 2D analysis (unused in 3D)
   double damping = 0.0;  // α [1/s]
   std::vector<double> density;             // ρ per node [kg/m³]
   std::vector<std::int32_t> block_index;   // block id − 1 per node (row of the pair tables)

@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "core/partial_volume.hpp"
+#include "core/surface_correction.hpp"
 #include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
 #include "io/output.hpp"
@@ -444,7 +445,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
   static const std::map<std::string, std::vector<std::string>> keys = {
       {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
             "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "breaking_order", "contact",
+            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "surface_correction", "breaking_order", "contact",
             "indenters", "cracks"}},
       {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
       {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
@@ -509,6 +510,11 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
     c.partial_volume = ck.string(*j, "partial_volume");
     if (!partial_volume_registry().contains(c.partial_volume))
       ck.fail("partial_volume", partial_volume_registry().unknown_message(c.partial_volume));
+  }
+  if (const json* j = ck.optional(root, "surface_correction")) {
+    c.surface_correction = ck.string(*j, "surface_correction");
+    if (!surface_correction_registry().contains(c.surface_correction))
+      ck.fail("surface_correction", surface_correction_registry().unknown_message(c.surface_correction));
   }
 
   const json& blocks = ck.array(ck.required(root, "blocks", "blocks"), "blocks");

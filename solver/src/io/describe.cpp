@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/material.hpp"
 #include "core/partial_volume.hpp"
+#include "core/surface_correction.hpp"
 #include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
 #include "io/case_reader.hpp"
@@ -69,6 +70,8 @@ json describe_case() {
   keys["grid_spacing"] = required("number", {{"above", 0.0}, {"unit", "m"}});
   keys["horizon"] = required("number", {{"above", 0.0}, {"unit", "m"}});
   keys["partial_volume"] = defaulted("string", c.partial_volume, {{"choices", partial_volume_registry().keys()}});
+  keys["surface_correction"] = defaulted("string", c.surface_correction,
+                                         {{"choices", surface_correction_registry().keys()}});
   keys["blocks"] = required("list", {{"note", "at least one; blocks[k].id == k + 1"}});
   keys["blocks[].id"] = required("integer", {{"minimum", 1}, {"note", "its position, counted from 1"}});
   keys["blocks[].name"] = required("string");
@@ -192,6 +195,7 @@ json describe_case() {
            {{"analysis", analysis_registry().keys()},
             {"integrator", integrator_registry().keys()},
             {"partial_volume", partial_volume_registry().keys()},
+            {"surface_correction", surface_correction_registry().keys()},
             {"indenter_shape", indenter_shape_registry().keys()}}}};
 }
 

@@ -88,6 +88,10 @@ class BondModel {
   // reference configuration (c/|ξ| for PMB): node i's stable step is √(2ρ_i / Σ_j (this + other
   // terms)), core/model.hpp node_stiffness.
   virtual double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const = 0;
+  // The continuum strain-energy density [J/m³] of node i's material under the uniform extension
+  // u = ε x_d e_d along a coordinate axis (a uniaxial strain): ½ C11 ε², C11 = λ + 2μ of the
+  // analysis. The reference of the energy surface correction (core/surface_correction).
+  virtual double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const = 0;
   // y = M^{-1/2} K M^{-1/2} x with K the stiffness linearised about the reference configuration
   // and M the lumped masses ρ_i V_i (core/stability: its largest eigenvalue is ω_max²). period[d] > 0
   // makes axis d periodic for the bond direction (the tests' infinite lattice).

@@ -2,6 +2,7 @@
 #include "operator/force_operator.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "core/error.hpp"
 #include "core/stability.hpp"
@@ -348,6 +349,13 @@ std::vector<std::string> ForceOperator::work_plan(const Case& c) const {
   lines.push_back("work: bond forces over " + std::to_string((decomposed_ ? decomposed_->total(directed) : directed) / 2) +
                   " bonds, partial volume " +
                   c.partial_volume + (c.dimension == 2 ? "; 2D (cell grids one bin thick)" : "; 3D"));
+  if (model_.bonds.corrected()) {  // only then: run.log of a case without it is unchanged
+    const auto& g = model_.bonds.surface_factor;
+    const auto [lo, hi] = std::minmax_element(g.begin(), g.end());
+    char range[96];
+    std::snprintf(range, sizeof range, "factors g from %.4g to %.4g", *lo, *hi);
+    lines.push_back("work: surface correction " + c.surface_correction + " (Le & Bobaru 2018), bond " + range);
+  }
   const auto& registry = force_term_registry();
   for (std::size_t k = 0; k < registry.size(); ++k) {
     if (built_[k]) {

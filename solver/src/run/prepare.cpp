@@ -84,6 +84,8 @@ void check_decomposable(const Prepared& p) {
     what = "blocks[].model: " + p.model.bond_model->name();
   else if (!p.model.node_critical_stretch.empty())
     what = "blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end)";
+  else if (p.model.bonds.corrected())
+    what = "discretization.surface_correction: " + c.surface_correction + " (a piece's bonds would need their factors)";
   // verlet and adaptive are decomposed (adaptive's norms of eq. 2.6 are ordered sums); quasi_static,
   // implicit and mixed solve with a factorisation or Krylov sums that are not yet.
   else if (c.time.integrator != "verlet" && c.time.integrator != "adaptive")

@@ -24,6 +24,16 @@
 // (3Kθ/m) ω|ξ| + (15μ/m) ω e^d = ((3K − 5μ)θ|ξ| + 15μ e) ω/m (LAMMPS); once bonds break, the last term of P keeps f the gradient of the
 // energy (so the energy balance holds exactly and the Jacobian stays symmetric) where LAMMPS and
 // Peridigm, which keep m and drop it, are not.
+//
+// Surface correction (core/surface_correction, discretization.surface_correction: energy): bond q's
+// factor g_q multiplies its weight V_j ν_j in every sum of the law — m_i, θ_i, the deviatoric sum and
+// the force — and node i's moduli κ_i, α_i are multiplied by ḡ_i = m_i(g)/m_i(1), the factors' mean
+// over i's family. So a node whose bonds all carry one g has its energy W_i times g exactly (θ and
+// the deviatoric shape do not change, the moduli do): the energy method's premise, and ν stays the
+// material's; unequal factors reweight the family by direction (a truncated family's θ and
+// deviatoric sum see the missing directions again). One symmetric weighting (g_ij = g_ji), so the
+// force stays the exact gradient of Σ_i V_i W_i and J symmetric; the formulas above hold with
+// V_j → g V_j.
 #pragma once
 #include <cfloat>
 #include <cmath>
@@ -84,6 +94,8 @@ class LpsModel : public BondModel {
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override;
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
+  // ½ C11 ε², C11 = K + 4μ/3 (3D) or κ + μ (2D: λ + 2μ in plane strain, E/(1 − ν²) in plane stress).
+  double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const override;
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
@@ -115,6 +127,7 @@ class LpsModel : public BondModel {
   std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
   std::vector<double> a_;      // α_i / m_i
   std::vector<double> b_;      // d κ_i / m_i
+  std::vector<double> c11_;    // λ + 2μ of i's block, uncorrected (uniaxial_energy_density)
   // Set once by the operator of a decomposed run (set_decomposed), before any sweep; null: serial.
   mutable const Decomposed* decomposed_ = nullptr;
 

@@ -40,10 +40,11 @@ PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const
   for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
     std::int64_t jq[kChunk];
-    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk];
+    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk], gq[kChunk];
     for (int q = 0; q < m; ++q) {
       jq[q] = k.neighbour[base + q];
       intact[q] = k.broken[base + q] ? 0.0 : 1.0;
+      gq[q] = k.factor ? k.factor[base + q] : 1.0;  // ×1 is exact: without a correction, the same bits
       if constexpr (kBreaking) s0q[q] = kOneBlock ? s0_row[0] : s0_row[block[jq[q]]];
     }
     for (int q = 0; q < m; ++q) {
@@ -56,7 +57,7 @@ PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const
       const double raw = y - length;
       const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
       const double omega = influence_of<kKind>(length, k.horizon);
-      const double vj = k.volume[j] * k.volume_weight(length);
+      const double vj = k.volume[j] * k.volume_weight(length) * gq[q];
       ta[q] = intact[q] * (omega * length * ext * vj);
       tb[q] = intact[q] * (omega * length * length * vj);
       if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw > s0q[q] * length);  // Bond::over
@@ -85,9 +86,10 @@ PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const 
   for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
     std::int64_t jq[kChunk];
-    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk];
+    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk], gq[kChunk];
     for (int q = 0; q < m; ++q) {
       jq[q] = k.neighbour[base + q];
+      gq[q] = k.factor ? k.factor[base + q] : 1.0;  // ×1 is exact: without a correction, the same bits
       intact[q] = k.broken[base + q] ? 0.0 : 1.0;
       pq[q] = p[jq[q]];
       aq[q] = k.a[jq[q]];
@@ -103,7 +105,7 @@ PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const 
       const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
       const double inv_y = 1.0 / (y > 0.0 ? y : 1.0);
       const double omega = influence_of<kKind>(length, k.horizon);
-      const double vj = k.volume[j] * k.volume_weight(length);
+      const double vj = k.volume[j] * k.volume_weight(length) * gq[q];
       const double tt = omega * (length * (pi + pq[q]) + (ai + aq[q]) * ext);
       const double scale = intact[q] * (tt * vj * inv_y);
       t0[q] = scale * e0;
@@ -148,7 +150,7 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
     const std::int64_t j = k.neighbour[q];
     if (k.broken[q] || br->no_fail[j]) continue;
-    over += k.bond(i, j).over(s0_row[br->block[j]]);
+    over += k.bond(i, q).over(s0_row[br->block[j]]);
   }
   if (over == 0) {
     if (br->lost) br->lost[i] = 0.0;
@@ -158,7 +160,7 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
   std::int64_t once = 0;
   for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
     const std::int64_t j = k.neighbour[q];
-    if (k.broken[q] || br->no_fail[j] || !k.bond(i, j).over(s0_row[br->block[j]])) continue;
+    if (k.broken[q] || br->no_fail[j] || !k.bond(i, q).over(s0_row[br->block[j]])) continue;
     k.broken[q] = 1;
     once += i < j;
   }
@@ -314,7 +316,7 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
     for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
       if (k.broken[q]) continue;
       const std::int64_t j = k.neighbour[q];
-      const LpsKernel::Bond t = k.bond(i, j);
+      const LpsKernel::Bond t = k.bond(i, q);
       const double along = t.y > 0.0 ? ((x[0][j] - x[0][i]) * t.e0 + (x[1][j] - x[1][i]) * t.e1 +
                                         (x[2][j] - x[2][i]) * t.e2) * t.inv_y
                                      : 0.0;
@@ -334,7 +336,7 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
       if (k.broken[q]) continue;
       const std::int64_t j = k.neighbour[q];
       const auto ju = static_cast<std::size_t>(j);
-      const LpsKernel::Bond t = k.bond(i, j);
+      const LpsKernel::Bond t = k.bond(i, q);
       if (!(t.y > 0.0)) continue;
       const double n0 = t.e0 * t.inv_y, n1 = t.e1 * t.inv_y, n2 = t.e2 * t.inv_y;
       const double x0 = x[0][ju] - x[0][iu], x1 = x[1][ju] - x[1][iu], x2 = x[2][ju] - x[2][iu];

@@ -20,6 +20,7 @@ struct LpsKernel {
   const std::int32_t* neighbour;
   std::uint8_t* broken;  // written only by the breaking sweep, row by row
   VolumeWeight volume_weight;
+  const double* factor;  // surface-correction factor g_k per directed bond; null: none (g = 1)
   const double* x[3];
   const double* u[3];
   const double* volume;
@@ -37,6 +38,7 @@ struct LpsKernel {
     neighbour = model.bonds.neighbour.data();
     broken = const_cast<std::uint8_t*>(model.bonds.broken.data());
     volume_weight = model.bonds.volume_weight;
+    factor = model.bonds.corrected() ? model.bonds.surface_factor.data() : nullptr;
     for (int q = 0; q < 3; ++q) {
       x[q] = model.nodes.x[static_cast<std::size_t>(q)].data();
       u[q] = uu[static_cast<std::size_t>(q)].data();
@@ -54,14 +56,17 @@ struct LpsKernel {
 
   // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, raw = y − |ξ| and the extension ext = raw but
   // 0 where |raw| ≤ kLpsStretchZero·|ξ| (round-off), 1/y (1 for a crushed bond: its
-  // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j.
+  // direction is e = 0, so it pulls nowhere), ω and the weighted volume V_j ν_j g_q (g_q the
+  // surface-correction factor of bond q: a correction weights the bond in every sum of the law
+  // but m_i, lps.hpp).
   struct Bond {
     double length, e0, e1, e2, y, raw, ext, inv_y, omega, vj;
     // The breaking criterion (PMB's s > s0, without a division): y − |ξ| > s0 |ξ|. Both copies of
     // a bond see bitwise the same y and |ξ|, so they break in the same sweep.
     bool over(double s0) const { return raw > s0 * length; }
   };
-  Bond bond(std::int64_t i, std::int64_t j) const {
+  Bond bond(std::int64_t i, std::int64_t q) const {
+    const std::int64_t j = neighbour[q];
     Bond t;
     const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
     t.length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);  // core/bonds.hpp bond_length
@@ -76,6 +81,7 @@ struct LpsKernel {
     t.inv_y = 1.0 / (t.y > 0.0 ? t.y : 1.0);
     t.omega = influence(kind, t.length, horizon);
     t.vj = volume[j] * volume_weight(t.length);
+    if (factor) t.vj *= factor[q];
     return t;
   }
 
@@ -84,7 +90,7 @@ struct LpsKernel {
     double st = 0.0, sm = 0.0;
     for (std::int64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
       if (broken[k]) continue;
-      const Bond t = bond(i, neighbour[k]);
+      const Bond t = bond(i, k);
       st += t.omega * t.length * t.ext * t.vj;
       sm += t.omega * t.length * t.length * t.vj;
     }
@@ -104,7 +110,7 @@ struct LpsKernel {
     double dev = 0.0;
     for (std::int64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
       if (broken[k]) continue;
-      const Bond t = bond(i, neighbour[k]);
+      const Bond t = bond(i, k);
       const double ed = t.ext - theta * t.length / d;
       dev += t.omega * ed * ed * t.vj;
     }

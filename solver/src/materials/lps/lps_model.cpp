@@ -23,28 +23,39 @@ LpsModel::LpsModel(const Model& model) {
   alpha_.assign(n, 0.0);
   a_.assign(n, 0.0);
   b_.assign(n, 0.0);
+  c11_.assign(n, 0.0);
   const auto& X = model.nodes.x;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < static_cast<std::int64_t>(n); ++i64) {
     const auto i = static_cast<std::size_t>(i64);
     // m_i in row order over the intact bonds, exactly as the kernel sums m'_i: equal bitwise while
     // the family is whole.
-    double m = 0.0;
+    // With surface factors the weights are g V_j ν_j (lps.hpp), m_i too (as the kernel's m'_i), and
+    // m0 is the uncorrected m_i: the node's moduli are scaled by ḡ_i = m_i/m0.
+    double m = 0.0, m0 = 0.0;
     for (std::int64_t k = model.bonds.offsets[i]; k < model.bonds.offsets[i + 1]; ++k) {
       const auto ku = static_cast<std::size_t>(k);
       if (model.bonds.broken[ku]) continue;
       const auto j = static_cast<std::size_t>(model.bonds.neighbour[ku]);
       const double len = bond_length(X, i, j);
-      m += influence(influence_, len, horizon_) * len * len *
-           (model.nodes.volume[j] * model.bonds.volume_weight(len));
+      if (model.bonds.corrected()) {
+        const double w = influence(influence_, len, horizon_) * len * len;
+        m += w * (model.nodes.volume[j] * model.bonds.volume_weight(len) * model.bonds.surface_factor[ku]);
+        m0 += w * (model.nodes.volume[j] * model.bonds.volume_weight(len));
+      } else {
+        m += influence(influence_, len, horizon_) * len * len *
+             (model.nodes.volume[j] * model.bonds.volume_weight(len));
+      }
     }
     m_[i] = m;
     const LpsModuli& mod = per_block.empty() ? LpsModuli{} : per_block[static_cast<std::size_t>(model.block_index[i])];
-    kappa_[i] = mod.kappa;
-    alpha_[i] = alpha_factor * mod.mu;
+    c11_[i] = d_ == 3 ? mod.kappa + 4.0 * mod.mu / 3.0 : mod.kappa + mod.mu;  // λ + 2μ of the analysis
+    const double gbar = model.bonds.corrected() && m0 > 0.0 ? m / m0 : 1.0;
+    kappa_[i] = mod.kappa * gbar;
+    alpha_[i] = alpha_factor * mod.mu * gbar;
     if (m > 0.0) {
-      a_[i] = alpha_factor * mod.mu / m;
-      b_[i] = d_ * mod.kappa / m;
+      a_[i] = alpha_[i] / m;
+      b_[i] = d_ * kappa_[i] / m;
     }
   }
 }
@@ -78,6 +89,8 @@ std::vector<double> LpsModel::damage(const Model& m) const { return bond_damage(
 // Neither Peridigm's nor CabanaPD's LPS step (PMB's with c = 18K/(πδ⁴), K only) is a bound for
 // every ν: it exceeds the exact limit for ν below about −0.2 (3D), where μ dominates
 // (tests/materials/test_lps.cpp measures both against the exact limit).
+// With surface factors the same bound holds for the weights g V_j (m_i, κ_i, α_i the corrected
+// ones, lps.hpp), and node_stiffness multiplies the bond's term by g.
 double LpsModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, double length) const {
   const double dd = static_cast<double>(d_) * d_;
   const auto node_term = [&](std::size_t q) {
@@ -85,6 +98,10 @@ double LpsModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, do
   };
   return m.nodes.volume[j] * m.bonds.volume_weight(length) * influence(influence_, length, horizon_) *
          (node_term(i) + node_term(j));
+}
+
+double LpsModel::uniaxial_energy_density(const Model&, std::size_t i, double eps) const {
+  return 0.5 * c11_[i] * eps * eps;
 }
 
 namespace {
@@ -126,11 +143,13 @@ void LpsModel::apply_reference_stiffness(const Model& m, const std::array<double
       double xi[3];
       const double len = bond(i, j, xi);
       const double w = influence(influence_, len, horizon_) * m.nodes.volume[j] * m.bonds.volume_weight(len);
-      mi += w * len * len;
-      sd += w * (xi[0] * (z(0, j) - z(0, i)) + xi[1] * (z(1, j) - z(1, i)) + xi[2] * (z(2, j) - z(2, i)));  // ω|ξ| n·δη V
+      const double wg = w * m.bonds.factor(ku);  // the surface-corrected weight (lps.hpp); w without one
+      mi += wg * len * len;
+      sd += wg * (xi[0] * (z(0, j) - z(0, i)) + xi[1] * (z(1, j) - z(1, i)) + xi[2] * (z(2, j) - z(2, i)));  // ω|ξ| n·δη V
     }
     a[i] = mi > 0.0 ? alpha_[i] / mi : 0.0;
-    gamma_dtheta[i] = mi > 0.0 ? (d * kappa_[i] / mi - a[i] / d) * (d / mi * sd) : 0.0;
+    const double gamma = mi > 0.0 ? d * kappa_[i] / mi - a[i] / d : 0.0;
+    gamma_dtheta[i] = mi > 0.0 ? gamma * (d / mi * sd) : 0.0;
   }
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < n; ++i64) {
@@ -146,7 +165,7 @@ void LpsModel::apply_reference_stiffness(const Model& m, const std::array<double
       const double along = n0 * (z(0, j) - z(0, i)) + n1 * (z(1, j) - z(1, i)) + n2 * (z(2, j) - z(2, i));
       const double t = influence(influence_, len, horizon_) *
                        (len * (gamma_dtheta[i] + gamma_dtheta[j]) + (a[i] + a[j]) * along) * m.nodes.volume[j] *
-                       m.bonds.volume_weight(len);
+                       m.bonds.volume_weight(len) * m.bonds.factor(ku);
       s0 += t * n0;
       s1 += t * n1;
       s2 += t * n2;

@@ -41,7 +41,7 @@ bool LpsModel::jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, 
     double st = 0.0, sm = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
     for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
       if (k.broken[q]) continue;
-      const LpsKernel::Bond t = k.bond(i, k.neighbour[q]);
+      const LpsKernel::Bond t = k.bond(i, q);
       st += t.omega * t.length * t.ext * t.vj;
       sm += t.omega * t.length * t.length * t.vj;
       if (!(t.y > 0.0)) continue;
@@ -63,10 +63,11 @@ bool LpsModel::jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, 
       if (k.broken[q]) continue;
       const std::int64_t j = k.neighbour[q];
       const auto ju = static_cast<std::size_t>(j);
-      const LpsKernel::Bond t = k.bond(i, j);
+      const LpsKernel::Bond t = k.bond(i, q);
       if (!(t.y > 0.0)) continue;
       const double nv[3] = {t.e0 * t.inv_y, t.e1 * t.inv_y, t.e2 * t.inv_y};
-      const double vi = k.volume[i] * k.volume_weight(t.length);  // V_i^(j)
+      // V_i^(j), times the bond's surface-correction factor (both copies of a bond carry the same g)
+      const double vi = k.volume[i] * k.volume_weight(t.length) * (k.factor ? k.factor[q] : 1.0);
       const double dilatation_j = k.m[j] > 0.0 ? gamma[ju] * (k.d / k.m[j]) * t.omega * t.length * t.length * vi : 0.0;
       double along = t.omega * ((k.a[i] + k.a[j]) + dilatation_j);
       double turn = t.omega * (t.length * (p[iu] + p[ju]) + (k.a[i] + k.a[j]) * t.ext) * t.inv_y;  // T/y

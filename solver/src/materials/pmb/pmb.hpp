@@ -28,6 +28,7 @@ struct PmbArrays {
   const double* volume;
   const std::int32_t* block;   // block index (0-based) per node
   const double* c_pair;        // micromodulus per block pair
+  const double* factor;        // surface-correction factor g_k per directed bond; null: none (g = 1)
   std::int64_t blocks;
   std::int64_t nodes;
 };
@@ -126,6 +127,9 @@ class PmbModel : public BondModel {
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override { return bond_damage(model); }
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
+  // ¼ c ε² ∫ n_d⁴ |ξ| dV over the full horizon: c ε² πδ⁴/20 (3D), c ε² h πδ³/16 (2D) — ½(6E/5)ε²,
+  // ½(9E/8)ε², ½(6E/5)ε² in 3D, plane stress, plane strain with F1's c.
+  double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const override;
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;

@@ -20,6 +20,7 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
   a.volume = m.nodes.volume.data();
   a.block = m.block_index.data();
   a.c_pair = m.material.micromodulus_pair.data();
+  a.factor = m.bonds.corrected() ? m.bonds.surface_factor.data() : nullptr;
   a.blocks = m.material.blocks;
   a.nodes = static_cast<std::int64_t>(m.nodes.size());
   return a;
@@ -87,7 +88,9 @@ std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i
     ++set;
     if (i < j) {
       ++once;
-      lost += broken_bond_energy(c_row[a.block[j]], s0, b.length, a.volume_weight(b.length), a.volume[i], a.volume[j]);
+      double e = broken_bond_energy(c_row[a.block[j]], s0, b.length, a.volume_weight(b.length), a.volume[i], a.volume[j]);
+      if (a.factor) e *= a.factor[k];  // the surface correction scales c of this bond
+      lost += e;
     }
   }
   if (br.lost) br.lost[i] = lost;
@@ -116,9 +119,11 @@ struct RowSums {
 };
 
 // Row i of the kernel from the current flags; kBreaking also counts the bonds over their critical
-// stretch, kOneBlock skips the gathers of the far end's block. Compile-time switches, so that the
-// loop has no branch in it and vectorises in every variant.
-template <bool kBreaking, bool kOneBlock>
+// stretch, kOneBlock skips the gathers of the far end's block, kCorrected multiplies each bond's c
+// by its surface-correction factor g_k (core/surface_correction). Compile-time switches, so that the
+// loop has no branch in it and vectorises in every variant (and without a correction it is the
+// same code, bitwise, as before there was one).
+template <bool kBreaking, bool kOneBlock, bool kCorrected = false>
 PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
   const double* c_row = a.c_pair + a.block[i] * a.blocks;
   const double* s0_row = kBreaking ? s0_pair + a.block[i] * a.blocks : nullptr;
@@ -133,11 +138,12 @@ PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const doubl
     // narrowest type, so one byte load in it would make it 32 bonds wide under AVX2 and spill
     // most of its registers; with only 64-bit types it is 4 bonds wide (docs/performance.md §2).
     std::int64_t j_q[kChunk], block_q[kChunk];
-    double intact_q[kChunk];
+    double intact_q[kChunk], g_q[kChunk];
     for (int q = 0; q < m; ++q) {
       j_q[q] = a.neighbour[k0 + q];
       intact_q[q] = a.broken[k0 + q] == 0 ? 1.0 : 0.0;
       if constexpr (!kOneBlock) block_q[q] = a.block[j_q[q]];
+      if constexpr (kCorrected) g_q[q] = a.factor[k0 + q];
     }
     double t0[kChunk], t1[kChunk], t2[kChunk], te[kChunk];
     for (int q = 0; q < m; ++q) {
@@ -147,7 +153,8 @@ PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const doubl
       const double intact = intact_q[q];
       if constexpr (kBreaking) over += over_critical(intact > 0.0, b.s, s0_row[bj]);
       // Broken bonds are multiplied by 0 rather than skipped: no branch, so the loop vectorises.
-      const double c_vj = intact * c_row[bj] * a.volume[j] * a.volume_weight(b.length);
+      double c_vj = intact * c_row[bj] * a.volume[j] * a.volume_weight(b.length);
+      if constexpr (kCorrected) c_vj *= g_q[q];
       const double scale = c_vj * b.s * b.inv_y;  // c s ν V_j / y
       t0[q] = scale * b.e0;
       t1[q] = scale * b.e1;
@@ -164,6 +171,13 @@ PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const doubl
   return RowSums{sum0, sum1, sum2, energy, over};
 }
 
+// pmb_row with the switches of this row and model.
+template <bool kBreaking>
+RowSums pmb_row_of(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
+  if (a.factor) return a.blocks == 1 ? pmb_row<kBreaking, true, true>(a, i, s0_pair) : pmb_row<kBreaking, false, true>(a, i, s0_pair);
+  return a.blocks == 1 ? pmb_row<kBreaking, true>(a, i, s0_pair) : pmb_row<kBreaking, false>(a, i, s0_pair);
+}
+
 }  // namespace
 
 std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w,
@@ -173,14 +187,13 @@ std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, d
 #pragma omp parallel for schedule(static) reduction(+ : newly)
   for (std::int64_t i = 0; i < a.nodes; ++i) {
     const bool test_breaking = breaking != nullptr && breaking->no_fail[i] == 0;
-    RowSums r;
-    if (a.blocks == 1) r = test_breaking ? pmb_row<true, true>(a, i, s0_pair) : pmb_row<false, true>(a, i, s0_pair);
-    else r = test_breaking ? pmb_row<true, false>(a, i, s0_pair) : pmb_row<false, false>(a, i, s0_pair);
+    RowSums r = test_breaking ? pmb_row_of<true>(a, i, s0_pair) : pmb_row_of<false>(a, i, s0_pair);
     if (r.over > 0) {  // rare: near a crack tip or a no-fail set
       // A bond that breaks now adds no force (it breaks before the force at this state, thesis
       // §2.2 order): the row again, from the new flags, so the result is bitwise that of
       // update_broken_bonds followed by the force.
-      if (break_row(a, *breaking, i, newly) > 0) r = pmb_row<false, false>(a, i, s0_pair);
+      if (break_row(a, *breaking, i, newly) > 0)
+        r = a.factor ? pmb_row<false, false, true>(a, i, s0_pair) : pmb_row<false, false>(a, i, s0_pair);
     } else if (breaking && breaking->lost) {
       breaking->lost[i] = 0.0;
     }
@@ -263,7 +276,7 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
     const auto iu = static_cast<std::size_t>(i);
     RowSums r{0.0, 0.0, 0.0, 0.0, 0};
     // LAMMPS order: the force of every bond intact at the start of the pass, those breaking now too.
-    if (f && force_first) r = pmb_row<false, false>(a, i, nullptr);
+    if (f && force_first) r = a.factor ? pmb_row<false, false, true>(a, i, nullptr) : pmb_row<false, false>(a, i, nullptr);
     const double* c_row = a.c_pair + a.block[i] * a.blocks;
     const double* s0_row = s0_pair + a.block[i] * a.blocks;
     const double* alpha_row = alpha_pair + a.block[i] * a.blocks;
@@ -289,13 +302,15 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
       broken[k] = 1;
       if (i < j) {
         ++newly;
-        lost_i += broken_bond_energy(c_row[bj], s0, b.length, a.volume_weight(b.length), a.volume[i], a.volume[j]);
+        double e = broken_bond_energy(c_row[bj], s0, b.length, a.volume_weight(b.length), a.volume[i], a.volume[j]);
+        if (a.factor) e *= a.factor[k];  // the surface correction scales c of this bond
+        lost_i += e;
       }
     }
     if (node_rule) s0_next[iu] = next;
     if (lost_out) lost_out[iu] = lost_i;
     // Thesis order: the force from the flags after breaking (a bond over s0 adds no force).
-    if (f && !force_first) r = pmb_row<false, false>(a, i, nullptr);
+    if (f && !force_first) r = a.factor ? pmb_row<false, false, true>(a, i, nullptr) : pmb_row<false, false>(a, i, nullptr);
     if (f) {
       (*f)[0][iu] += r.f0;
       (*f)[1][iu] += r.f1;
@@ -324,7 +339,9 @@ std::vector<double> strain_energy_density(const Model& m, const Vec3Array& u) {
       const BondTerms b = bond_terms(a, xi, yi, j);
       // ¼ c s² |ξ| V_j: each bond is visited from both ends, so each end takes half of the
       // bond's ½ c s² |ξ| V_i V_j (validation.md C4).
-      sum += 0.25 * c_row[a.block[j]] * b.s * b.s * b.length * a.volume[j] * a.volume_weight(b.length);
+      double e = 0.25 * c_row[a.block[j]] * b.s * b.s * b.length * a.volume[j] * a.volume_weight(b.length);
+      if (a.factor) e *= a.factor[k];
+      sum += e;
     }
     w[static_cast<std::size_t>(i)] = sum;
   }

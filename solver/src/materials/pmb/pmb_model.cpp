@@ -40,6 +40,17 @@ double PmbModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, do
   return m.nodes.volume[j] * m.bonds.volume_weight(length) * micromodulus / length;
 }
 
+double PmbModel::uniaxial_energy_density(const Model& m, std::size_t i, double eps) const {
+  constexpr double kPi = 3.14159265358979323846;
+  const auto nb = static_cast<std::size_t>(m.material.blocks);
+  const auto bi = static_cast<std::size_t>(m.block_index[i]);
+  const double c = m.material.micromodulus_pair[bi * nb + bi];
+  const double delta = m.horizon;
+  // ∫ n_x⁴ dΩ = 4π/5 over the sphere, ∫ cos⁴φ dφ = 3π/4 over the circle; ∫ r³ dr = δ⁴/4, ∫ r² dr = δ³/3.
+  if (m.nodes.dimension == 3) return c * eps * eps * kPi * std::pow(delta, 4) / 20.0;
+  return c * eps * eps * m.thickness * kPi * std::pow(delta, 3) / 16.0;
+}
+
 namespace {
 
 // Minimum image of a bond component on a periodic axis (period p > 0); unchanged otherwise.
@@ -73,7 +84,7 @@ void PmbModel::apply_reference_stiffness(const Model& m, const std::array<double
       // partial-volume factor of validation.md F3, from |ξ|)
       const double nu = m.bonds.volume_weight(len);
       const double kij = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] * nu *
-                         m.nodes.volume[i] * m.nodes.volume[j] / len;
+                         m.nodes.volume[i] * m.nodes.volume[j] / len * m.bonds.factor(ku);  // g: surface correction
       const double d0 = x[0][i] * inv_sqrt_mi - x[0][j] * inv_sqrt_mj;
       const double d1 = x[1][i] * inv_sqrt_mi - x[1][j] * inv_sqrt_mj;
       const double d2 = x[2][i] * inv_sqrt_mi - x[2][j] * inv_sqrt_mj;
@@ -126,7 +137,7 @@ void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Ve
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
       const double length = bond_length(X, i, j);
       const double c_vj = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] *
-                          m.nodes.volume[j] * m.bonds.volume_weight(length);
+                          m.nodes.volume[j] * m.bonds.volume_weight(length) * m.bonds.factor(ku);
       double b[9];
       bond_block(c_vj, length, (X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2, b);
       // δf_i = B (δu_j − δu_i)
@@ -157,7 +168,7 @@ bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t 
     const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
     const double length = bond_length(X, i, j);
     const double c_vj = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] *
-                        m.nodes.volume[j] * m.bonds.volume_weight(length);
+                        m.nodes.volume[j] * m.bonds.volume_weight(length) * m.bonds.factor(ku);
     bond_block(c_vj, length, (X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2, b,
                definite);
   }
