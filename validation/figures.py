@@ -1,6 +1,8 @@
 """One PNG per case for out/validate/: the quantity each check is about, against its target."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from postprocess.plotting import new_figure, save_figure
@@ -57,10 +59,10 @@ def branching_figure(out_dir: str, path: str):
     fig, axes = new_figure()
     ax = axes[0, 0]
     ax.plot(t * 1e6, speed, "o-", ms=3, label="crack tip (upper branch)")
-    ax.axhline(branching.RAYLEIGH, color="r", ls="--", label="Rayleigh speed c_R")
+    ax.axhline(branching.rayleigh_speed(run), color="r", ls="--", label="Rayleigh speed c_R")
     ax.set_xlabel("time [µs]")
     ax.set_ylabel(f"tip speed over {branching.SPEED_WINDOW * 1e6:g} µs [m/s]")
-    ax.set_title("branching: crack-tip speed")
+    ax.set_title(f"{os.path.basename(os.path.normpath(out_dir))}: crack-tip speed")
     ax.legend()
     ax.grid(alpha=0.3)
     save_figure(fig, path)
