@@ -12,7 +12,7 @@ import subprocess
 import sys
 import time
 
-from . import branching, convergence, drum, plate_with_hole, static, traction, wave
+from . import branching, convergence, drum, plate_with_hole, static, traction, wave, wave_lps
 from .figures import FIGURES
 from .runner import ROOT
 
@@ -22,7 +22,8 @@ CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks
 CONFIGS = {"branching-lps": ("branching", "lps")}
 # Checks that run their own small models (validation/models/) into out/validate/work/<name>/ and
 # draw their own PNG: validate(report_dir) -> rows.
-MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.validate, "static": static.validate}
+MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.validate, "wave_lps": wave_lps.validate,
+                "static": static.validate}
 
 
 def main(argv: list[str]) -> int:
