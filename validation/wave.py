@@ -78,8 +78,9 @@ class Chain:
 
     def omega_space(self, k: float) -> float:
         """ω_s(k) of the semi-discrete chain (exact in space, continuous in time)."""
-        return float(np.sqrt(chain_omega_squared(k, model=self.model, E=self.E, rho=self.rho, h=self.h, dx=self.dx,
-                                                 delta=self.delta, nu=self.nu)))
+        # max(·, 0): at k → 0 LPS's two O(k²) terms cancel to round-off, which can dip below zero
+        return float(np.sqrt(max(0.0, chain_omega_squared(k, model=self.model, E=self.E, rho=self.rho, h=self.h,
+                                                          dx=self.dx, delta=self.delta, nu=self.nu))))
 
     def c0(self) -> float:
         """The long-wave speed lim_{k→0} ω_s(k)/k: Σ_j cV·jΔx/ρ (pmb), 4κ/ρ (lps, chain_omega_squared)."""
