@@ -12,12 +12,13 @@ import subprocess
 import sys
 import time
 
-from . import branching, convergence, drum, plate_with_hole, static, traction, wave, wave_lps
+from . import branching, convergence, drum, plate_with_hole, static, three_point_bending, traction, wave, wave_lps
 from .figures import FIGURES
 from .runner import ROOT
 
 CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks,
-          "branching-lps": functools.partial(branching.checks, case="branching-lps"), "drum": drum.checks}
+          "branching-lps": functools.partial(branching.checks, case="branching-lps"), "drum": drum.checks,
+          "three_point_bending": three_point_bending.checks}
 # Checks of a case's variant: name -> (case, config), run by `make case=CASE config=CONFIG` into out/NAME/.
 CONFIGS = {"branching-lps": ("branching", "lps")}
 # Checks that run their own small models (validation/models/) into out/validate/work/<name>/ and

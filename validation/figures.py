@@ -7,7 +7,7 @@ import numpy as np
 
 from postprocess.plotting import new_figure, save_figure
 
-from . import branching, drum, plate_with_hole, traction
+from . import branching, drum, plate_with_hole, three_point_bending, traction
 from .common import Run
 
 
@@ -101,5 +101,28 @@ def drum_figure(out_dir: str, path: str):
     save_figure(fig, path)
 
 
-FIGURES = {"plate_with_hole": plate_with_hole_figure, "traction": traction_figure, "branching": branching_figure,
+def three_point_bending_figure(out_dir: str, path: str):
+    """Load against the beam axis's deflection and the load-point displacement, with the elastic
+    line of Timoshenko + the E399 notch compliance and LEFM's peak load."""
+    run = Run(out_dir)
+    spec = three_point_bending.Specimen(run, out_dir)
+    u, force = three_point_bending.load_curve(run)
+    delta = three_point_bending.axis_deflection(run, spec)
+    p_frames = np.interp(run.times, run.history["time"], force)
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    ax.plot(delta * 1e3, p_frames / 1e3, "o-", ms=3, label="P against the axis deflection δ (frames)")
+    ax.plot(u * 1e3, force / 1e3, "-", lw=1, label="P against the load-point displacement")
+    d = np.linspace(0.0, max(delta.max(), 1e-12), 50)
+    ax.plot(d * 1e3, spec.stiffness() * d / 1e3, "k--", lw=1, label="Timoshenko beam + E399 notch compliance")
+    ax.axhline(spec.lefm_peak() / 1e3, color="r", ls=":", label="LEFM P_c (K_Ic = √(G0 E'))")
+    ax.set_xlabel("displacement [mm]")
+    ax.set_ylabel("load P [kN]")
+    ax.set_title("three_point_bending: steel SENB, LPS ν = 0.29")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    save_figure(fig, path)
+
+
+FIGURES = {"plate_with_hole": plate_with_hole_figure, "three_point_bending": three_point_bending_figure, "traction": traction_figure, "branching": branching_figure,
            "drum": drum_figure}
