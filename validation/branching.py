@@ -90,9 +90,11 @@ def mirror_agreement(run: Run, index: int = -1) -> float:
 
 
 def energy_balance(run: Run) -> tuple[float, float]:
-    """(|KE + U + broken-bond energy + damping work − W_ext| at the end / W_ext at the end, W_ext)."""
+    """(|KE + U + contact + indenter + broken-bond energy + damping work − W_ext| at the end / W_ext
+    at the end, W_ext). Every history.csv has these columns since issue 16 (0 for a term the case lacks)."""
     h = run.history
-    total = h["kinetic_energy"] + h["strain_energy"] + h["broken_bond_energy"] + h["damping_work"]
+    total = (h["kinetic_energy"] + h["strain_energy"] + h["contact_energy"] + h["indenter_energy"]
+             + h["broken_bond_energy"] + h["damping_work"])
     work = h["external_work"]
     return float(abs(total[-1] - work[-1]) / abs(work[-1])), float(work[-1])
 
