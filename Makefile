@@ -6,7 +6,7 @@
 #   make FORCE=1 case=X       run even when preprocess's work plan is above its limits (> 1 h, or
 #                             more than half the free memory or disk: pipeline/cost.py)
 #   make test                 build everything and run every test (then test-asan)
-#   make validate             full plate_with_hole, traction, branching, drum runs, wave and static models + checks → out/validate/report.md
+#   make validate             full plate_with_hole, traction, branching (and config=lps), three_point_bending, drum runs, wave, wave_lps and static models + checks → out/validate/report.md
 #   make test-asan            the solver's tests under AddressSanitizer + UBSan (build/solver-asan)
 #   make fuzz                 libFuzzer on the solver's readers, then the case-file loader's mutation
 #                             fuzzer (pipeline/fuzz_case.py) and pdsolve's command line

@@ -158,11 +158,36 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
                             contact=contact_stiffness_factor(resolved, block), sample=sample, lps=lps)
 
 
+def _orientation(o, a, b):
+    """Twice the signed area of the triangle o, a, b (core/cracks.cpp orientation), per row."""
+    return (a[..., 0] - o[..., 0]) * (b[..., 1] - o[..., 1]) - (a[..., 1] - o[..., 1]) * (b[..., 0] - o[..., 0])
+
+
+def crosses_cracks(points: np.ndarray, i: np.ndarray, j: np.ndarray, cracks: list) -> np.ndarray:
+    """Per bond i→j: does its reference segment properly cross a pre-crack segment in the xy plane?
+    The solver's test (core/cracks.cpp segments_cross), with the lower-index end first as it does,
+    so that both copies of a bond and the solver agree bitwise."""
+    out = np.zeros(len(i), dtype=bool)
+    if not cracks or len(i) == 0:
+        return out
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    p, q = points[lo, :2], points[hi, :2]
+    for crack in cracks:
+        a = np.broadcast_to(np.asarray(crack["from"][:2], dtype=np.float64), p.shape)
+        b = np.broadcast_to(np.asarray(crack["to"][:2], dtype=np.float64), p.shape)
+        ab_p, ab_q = _orientation(a, b, p), _orientation(a, b, q)
+        pq_a, pq_b = _orientation(p, q, a), _orientation(p, q, b)
+        out |= (((ab_p > 0) & (ab_q < 0)) | ((ab_p < 0) & (ab_q > 0))) & \
+               (((pq_a > 0) & (pq_b < 0)) | ((pq_a < 0) & (pq_b > 0)))
+    return out
+
+
 def lps_node_terms(cloud, block: np.ndarray, moduli: list, analysis: str, horizon: float, kind: str,
                    resolved: dict, tree: cKDTree | None = None, chunk: int = SAMPLE) -> np.ndarray:
     """q_i = (d²κ_i + α_i)/m_i per node, m_i = Σ_j ω|ξ|²ν V_j over the whole family (α = 15μ in 3D,
-    8μ in 2D), in chunks of nodes. Pre-cracks are not cut here, so m_i is never smaller than the
-    solver's and the step never smaller: "too many steps" is never a false alarm."""
+    8μ in 2D), in chunks of nodes. Bonds crossing a pre-crack (case.json `cracks`) are left out of
+    m_i, as LpsModel computes m on the bonds intact at the start (core/cracks.cpp cuts them first):
+    a node beside a notch has a smaller m, a larger q and so a shorter step."""
     points, volume = np.asarray(cloud.points), np.asarray(cloud.volume)
     tree = tree if tree is not None else cKDTree(points)
     dx = float(resolved["grid_spacing"])
@@ -175,7 +200,8 @@ def lps_node_terms(cloud, block: np.ndarray, moduli: list, analysis: str, horizo
         keep = pairs.data > 0
         r, cols, dist = pairs.row[keep], pairs.col[keep], pairs.data[keep]
         nu = np.clip((horizon + 0.5 * dx - dist) * (1.0 / dx), 0.0, 1.0) if shell else 1.0
-        m[rows] += np.bincount(r, weights=influence(kind, dist, horizon) * dist * dist * nu * volume[cols],
+        intact = ~crosses_cracks(points, rows[r], cols, resolved.get("cracks") or [])
+        m[rows] += np.bincount(r, weights=influence(kind, dist, horizon) * dist * dist * nu * volume[cols] * intact,
                                minlength=len(rows))
     d = 3 if analysis == "3d" else 2
     per_block = np.array([d * d * k + (15.0 if d == 3 else 8.0) * mu for k, mu in moduli])

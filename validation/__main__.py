@@ -6,20 +6,25 @@ Exit status 1 if any check fails.
 """
 from __future__ import annotations
 
+import functools
 import os
 import subprocess
 import sys
 import time
 
-from . import branching, convergence, drum, plate_with_hole, static, traction, wave
+from . import branching, convergence, drum, plate_with_hole, static, three_point_bending, traction, wave, wave_lps
 from .figures import FIGURES
 from .runner import ROOT
 
 CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks,
-          "drum": drum.checks}
+          "branching-lps": functools.partial(branching.checks, case="branching-lps"), "drum": drum.checks,
+          "three_point_bending": three_point_bending.checks}
+# Checks of a case's variant: name -> (case, config), run by `make case=CASE config=CONFIG` into out/NAME/.
+CONFIGS = {"branching-lps": ("branching", "lps")}
 # Checks that run their own small models (validation/models/) into out/validate/work/<name>/ and
 # draw their own PNG: validate(report_dir) -> rows.
-MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.validate, "static": static.validate}
+MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.validate, "wave_lps": wave_lps.validate,
+                "static": static.validate}
 
 
 def main(argv: list[str]) -> int:
@@ -54,9 +59,10 @@ def main(argv: list[str]) -> int:
         # `make validate` leaves PDSOLVE unset, so its cases follow build/solver like `make case=X`.)
         solver = ([f"SOLVER={os.environ['PDSOLVE']}", "-o", os.environ["PDSOLVE"]]
                   if os.environ.get("PDSOLVE") else [])
-        make = subprocess.run(["make", "--no-print-directory", f"case={case}", *solver], cwd=ROOT)
+        target = [f"case={CONFIGS[case][0]}", f"config={CONFIGS[case][1]}"] if case in CONFIGS else [f"case={case}"]
+        make = subprocess.run(["make", "--no-print-directory", *target, *solver], cwd=ROOT)
         if make.returncode != 0:
-            lines.append(f"| {case} | the run | `make case={case}` succeeds | exit {make.returncode} | **NO** |")
+            lines.append(f"| {case} | the run | `make {' '.join(target)}` succeeds | exit {make.returncode} | **NO** |")
             failed += 1
             continue
         out = os.path.join(ROOT, "out", case)
@@ -65,7 +71,7 @@ def main(argv: list[str]) -> int:
             failed += not row.passed
             if row.note:
                 notes.append(f"- {case}, {row.quantity}: {row.note}")
-        FIGURES[case](out, os.path.join(report_dir, f"{case}.png"))
+        FIGURES[CONFIGS[case][0] if case in CONFIGS else case](out, os.path.join(report_dir, f"{case}.png"))
         with open(os.path.join(out, "run.log"), encoding="utf-8") as stream:
             done = [l for l in stream if l.startswith(("done", "stopped"))]
         notes.append(f"- {case}: {done[-1].strip() if done else 'no solver summary'} "

@@ -1,11 +1,13 @@
 """One PNG per case for out/validate/: the quantity each check is about, against its target."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from postprocess.plotting import new_figure, save_figure
 
-from . import branching, drum, plate_with_hole, traction
+from . import branching, drum, plate_with_hole, three_point_bending, traction
 from .common import Run
 
 
@@ -57,10 +59,10 @@ def branching_figure(out_dir: str, path: str):
     fig, axes = new_figure()
     ax = axes[0, 0]
     ax.plot(t * 1e6, speed, "o-", ms=3, label="crack tip (upper branch)")
-    ax.axhline(branching.RAYLEIGH, color="r", ls="--", label="Rayleigh speed c_R")
+    ax.axhline(branching.rayleigh_speed(run), color="r", ls="--", label="Rayleigh speed c_R")
     ax.set_xlabel("time [µs]")
     ax.set_ylabel(f"tip speed over {branching.SPEED_WINDOW * 1e6:g} µs [m/s]")
-    ax.set_title("branching: crack-tip speed")
+    ax.set_title(f"{os.path.basename(os.path.normpath(out_dir))}: crack-tip speed")
     ax.legend()
     ax.grid(alpha=0.3)
     save_figure(fig, path)
@@ -99,5 +101,28 @@ def drum_figure(out_dir: str, path: str):
     save_figure(fig, path)
 
 
-FIGURES = {"plate_with_hole": plate_with_hole_figure, "traction": traction_figure, "branching": branching_figure,
+def three_point_bending_figure(out_dir: str, path: str):
+    """Load against the beam axis's deflection and the load-point displacement, with the elastic
+    line of Timoshenko + the E399 notch compliance and LEFM's peak load."""
+    run = Run(out_dir)
+    spec = three_point_bending.Specimen(run, out_dir)
+    u, force = three_point_bending.load_curve(run)
+    delta = three_point_bending.axis_deflection(run, spec)
+    p_frames = np.interp(run.times, run.history["time"], force)
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    ax.plot(delta * 1e3, p_frames / 1e3, "o-", ms=3, label="P against the axis deflection δ (frames)")
+    ax.plot(u * 1e3, force / 1e3, "-", lw=1, label="P against the load-point displacement")
+    d = np.linspace(0.0, max(delta.max(), 1e-12), 50)
+    ax.plot(d * 1e3, spec.stiffness() * d / 1e3, "k--", lw=1, label="Timoshenko beam + E399 notch compliance")
+    ax.axhline(spec.lefm_peak() / 1e3, color="r", ls=":", label="LEFM P_c (K_Ic = √(G0 E'))")
+    ax.set_xlabel("displacement [mm]")
+    ax.set_ylabel("load P [kN]")
+    ax.set_title("three_point_bending: steel SENB, LPS ν = 0.29")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    save_figure(fig, path)
+
+
+FIGURES = {"plate_with_hole": plate_with_hole_figure, "three_point_bending": three_point_bending_figure, "traction": traction_figure, "branching": branching_figure,
            "drum": drum_figure}

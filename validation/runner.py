@@ -34,10 +34,11 @@ def deep_update(base: dict, changes: dict) -> dict:
 
 
 def run_case(case: str, work: str, changes: dict | None = None, *, figures: bool = True,
-             timeout: float = 1800.0, source: str | None = None) -> tuple[str, float]:
+             timeout: float = 1800.0, source: str | None = None, config: str | None = None) -> tuple[str, float]:
     """Copy cases/<case>/<case>.geo and the .yaml with `changes` merged in to work/cases/<case>/,
     run every stage into work/out/<case>/, and return (out_dir, solver wall seconds).
-    source: another folder holding <case>.geo and <case>.yaml (validation/models/)."""
+    source: another folder holding <case>.geo and <case>.yaml (validation/models/); config: the
+    variant <config>.yaml of that folder instead of <case>.yaml (as `make case=X config=Y`)."""
     solver = solver_path()
     if not os.path.exists(solver):
         raise FileNotFoundError(f"{solver} is missing: build it with `make solver` (make test does)")
@@ -45,7 +46,7 @@ def run_case(case: str, work: str, changes: dict | None = None, *, figures: bool
     case_dir = os.path.join(work, "cases", case)
     os.makedirs(case_dir, exist_ok=True)
     shutil.copy(os.path.join(source, f"{case}.geo"), case_dir)
-    with open(os.path.join(source, f"{case}.yaml"), encoding="utf-8") as stream:
+    with open(os.path.join(source, f"{config or case}.yaml"), encoding="utf-8") as stream:
         data = yaml.safe_load(stream)
     yaml_path = os.path.join(case_dir, f"{case}.yaml")
     with open(yaml_path, "w", encoding="utf-8") as stream:

@@ -32,12 +32,44 @@ def base_model() -> dict:
         return yaml.safe_load(stream)
 
 
+def chain_omega_squared(k: float, *, model: str, E: float, rho: float, h: float, dx: float, delta: float,
+                        nu: float | None = None) -> float:
+    """ω_s(k)² of the semi-discrete chain (one row of a plane-stress lattice, bonds j = 1..M = ⌊δ/Δx⌋
+    on each side, V = Δx²h, ω = 1, full volumes), exact in space and continuous in time.
+
+    pmb (validation.md C2): ρω² = Σ_{j≤M} 2cV(1 − cos kjΔx)/(jΔx), c = 9E/(πhδ³).
+
+    lps: the linearised LPS (materials/lps/lps.hpp) on the chain. With e_j = n_j·(u_j − u_i) and
+    W_i = (κ/2)θ_i² + (α/(2m)) Σ_j ω(e_j − θ_i|ξ_j|/d)²V (Silling et al. 2007, eq. 92; Mitchell's
+    ordinary state-based form), expanding the square with θ_i = (d/m) Σ_j ω|ξ_j| e_j V gives
+    W_i = (κ/2 − α/(2d²))θ_i² + (α/(2m)) Σ_j ω e_j² V. A plane wave u_i = U e^{ik·x_i} has
+    θ = i(d/m) S·U, S = Σ_j ω|ξ_j| V n_j sin(k·ξ_j), and |e_j|² = 2(1 − cos k·ξ_j)(n_j·U)², so the
+    dynamical matrix (ρω²U = D U, D the Fourier symbol of the energy's Hessian per volume) is
+        D(k) = (κ − α/d²)(d/m)² S Sᵀ + (α/m) Σ_j ω V 2(1 − cos k·ξ_j) n_j n_jᵀ.
+    On the chain (n = ±x, both sides of the node): m = 2Σ_{j≤M} (jΔx)²V, S = 2Σ (jΔx)V sin(kjΔx),
+    D = (κ − α/4)(2S/m)² + (α/m)·2Σ 2V(1 − cos kjΔx), with plane stress's κ = E/(2(1 − ν)),
+    α = 8μ, d = 2. Its long-wave limit is ρc0² = 4κ (not E: the chain's family is one line, while
+    m, d and α are the plane's); in a bulk 2D lattice the same D gives the continuum κ + μ
+    (longitudinal) and μ (transverse)."""
+    r = np.arange(1, int(np.floor(delta / dx + 1e-9)) + 1) * dx
+    V = dx * dx * h
+    if model != "lps":
+        c = 9.0 * E / (np.pi * h * delta ** 3)      # plane stress, validation.md F1
+        return float(np.sum(2 * c * V * (1 - np.cos(k * r)) / r) / rho)
+    kappa, alpha, d = E / (2 * (1 - nu)), 8.0 * E / (2 * (1 + nu)), 2.0
+    m = 2 * np.sum(r * r * V)
+    S = 2 * np.sum(r * V * np.sin(k * r))
+    D = (kappa - alpha / d ** 2) * (d * S / m) ** 2 + alpha / m * 2 * np.sum(2 * V * (1 - np.cos(k * r)))
+    return float(D / rho)
+
+
 class Chain:
-    """The chain's lattice sums from a finished run (case.json): c, V, Δx, partners j ≤ δ/Δx."""
+    """The chain's lattice sums from a finished run (case.json): the material, V, Δx, partners j ≤ δ/Δx."""
 
     def __init__(self, run: Run):
         block = run.case["blocks"][0]
         self.rho, self.E = block["density"], block["youngs_modulus"]
+        self.model, self.nu = block.get("model", "pmb"), block.get("poisson_ratio")
         self.h, self.dx, self.delta = run.case["thickness"], run.dx, run.horizon
         self.c = 9.0 * self.E / (np.pi * self.h * self.delta ** 3)      # plane stress, validation.md F1
         self.V = self.dx ** 2 * self.h
@@ -46,10 +78,14 @@ class Chain:
 
     def omega_space(self, k: float) -> float:
         """ω_s(k) of the semi-discrete chain (exact in space, continuous in time)."""
-        r = self.j * self.dx
-        return float(np.sqrt(np.sum(2 * self.c * self.V * (1 - np.cos(k * r)) / r) / self.rho))
+        # max(·, 0): at k → 0 LPS's two O(k²) terms cancel to round-off, which can dip below zero
+        return float(np.sqrt(max(0.0, chain_omega_squared(k, model=self.model, E=self.E, rho=self.rho, h=self.h,
+                                                          dx=self.dx, delta=self.delta, nu=self.nu))))
 
     def c0(self) -> float:
+        """The long-wave speed lim_{k→0} ω_s(k)/k: Σ_j cV·jΔx/ρ (pmb), 4κ/ρ (lps, chain_omega_squared)."""
+        if self.model == "lps":
+            return float(np.sqrt(4 * self.E / (2 * (1 - self.nu)) / self.rho))
         return float(np.sqrt(np.sum(self.c * self.V * self.j * self.dx) / self.rho))
 
     def k_of_omega(self, omega: float, verlet: bool = True) -> float:
@@ -67,22 +103,25 @@ def drive_table(omega: float, amplitude: float, end: float) -> list[list[float]]
     return [[float(a), float(b)] for a, b in zip(t, amplitude * ramp * np.sin(omega * t))]
 
 
-def sinusoid_changes(dx: float = 1.0e-3, length: float = 1.5) -> tuple[dict, float]:
-    """(case changes, ω) for the driven sinusoid at kδ = K_DELTA (ω from the semi-discrete relation)."""
+def sinusoid_changes(dx: float = 1.0e-3, length: float = 1.5, k_delta: float = K_DELTA,
+                     material: dict | None = None) -> tuple[dict, float]:
+    """(case changes, ω) for the driven sinusoid at kδ = k_delta (ω from the semi-discrete relation);
+    material: changes to the chain's material (e.g. {model: lps, poisson_ratio: 0.3})."""
     m = base_model()
+    bar = dict(m["materials"]["bar"], **(material or {}))
     delta = m["discretization"]["horizon_factor"] * dx
-    E, rho, h = (float(v) for v in (m["materials"]["bar"]["youngs_modulus"], m["materials"]["bar"]["density"],
-                                    m["thickness"]))
-    c, V = 9.0 * E / (np.pi * h * delta ** 3), dx * dx * h
-    r = np.arange(1, int(np.floor(delta / dx + 1e-9)) + 1) * dx
-    k = K_DELTA / delta
-    omega = float(np.sqrt(np.sum(2 * c * V * (1 - np.cos(k * r)) / r) / rho))
-    c0 = float(np.sqrt(np.sum(c * V * r) / rho))
+    E, rho, h = float(bar["youngs_modulus"]), float(bar["density"]), float(m["thickness"])
+    sums = dict(model=bar.get("model", "pmb"), E=E, rho=rho, h=h, dx=dx, delta=delta, nu=bar.get("poisson_ratio"))
+    k = k_delta / delta
+    omega = float(np.sqrt(chain_omega_squared(k, **sums)))
+    c0 = float(np.sqrt(chain_omega_squared(1e-3 / delta, **sums)) / (1e-3 / delta))   # ≈ Chain.c0 (1e-7)
     end = 0.95 * length / c0          # the front (group speed < c0) stays inside the bar
     changes = {"geometry": {"parameters": {"Lx": length, "H": dx, "lc": max(dx, length / 2000)}},
                "discretization": {"dx": dx},
                "boundary_conditions": [{"set": "left", "displacement": {"x": drive_table(omega, 1e-6, end)}}],
                "time": {"end": end}, "output": {"every_steps": None, "every_time": end / 40}}
+    if material:
+        changes["materials"] = {"bar": material}
     return changes, omega
 
 
@@ -135,9 +174,11 @@ PULSE_WIDTH = 0.02          # m: the Gaussian's c0·τ
 PULSE_TRAVEL = 0.4          # m between the two compared shapes
 
 
-def pulse_changes(dx: float, horizon_factor: float | None = None) -> tuple[dict, tuple[float, float]]:
+def pulse_changes(dx: float, horizon_factor: float | None = None,
+                  material: dict | None = None) -> tuple[dict, tuple[float, float]]:
     """(case changes, (t1, t2)): the left end's layer δ driven by a Gaussian pulse of width
-    PULSE_WIDTH; its centre passes x = 0.1 m at t1 and x = 0.1 m + PULSE_TRAVEL at t2."""
+    PULSE_WIDTH; its centre passes x = 0.1 m at t1 and x = 0.1 m + PULSE_TRAVEL at t2.
+    material: changes to the chain's material (as sinusoid_changes)."""
     m = base_model()
     factor = horizon_factor or m["discretization"]["horizon_factor"]
     delta = factor * dx
@@ -146,6 +187,8 @@ def pulse_changes(dx: float, horizon_factor: float | None = None) -> tuple[dict,
     c, V = 9.0 * E / (np.pi * h * delta ** 3), dx * dx * h
     r = np.arange(1, int(np.floor(delta / dx + 1e-9)) + 1) * dx
     c0 = float(np.sqrt(np.sum(c * V * r) / rho))
+    if material and material.get("model") == "lps":      # Chain.c0 of LPS: 4κ/ρ
+        c0 = float(np.sqrt(4 * E / (2 * (1 - material["poisson_ratio"])) / rho))
     tau = PULSE_WIDTH / c0
     t0 = 4 * tau
     length = 0.1 + PULSE_TRAVEL + 8 * PULSE_WIDTH + 0.05
@@ -154,12 +197,15 @@ def pulse_changes(dx: float, horizon_factor: float | None = None) -> tuple[dict,
     t = np.linspace(0.0, 2 * t0, 161)
     table = [[float(a), float(1e-6 * np.exp(-((a - t0) / tau) ** 2))] for a in t]
     table[-1][1] = 0.0
-    return {"geometry": {"parameters": {"Lx": length, "H": dx, "lc": max(dx, length / 2000)}},
-            "discretization": {"dx": dx, "horizon_factor": factor},
-            "node_sets": {"left": {"layer": delta}},
-            "boundary_conditions": [{"set": "left", "displacement": {"x": table}}],
-            "time": {"end": t2}, "output": {"every_time": t2 / 100, "every_steps": None,
-                                            "history_every": 10}}, (t1, t2)
+    changes = {"geometry": {"parameters": {"Lx": length, "H": dx, "lc": max(dx, length / 2000)}},
+               "discretization": {"dx": dx, "horizon_factor": factor},
+               "node_sets": {"left": {"layer": delta}},
+               "boundary_conditions": [{"set": "left", "displacement": {"x": table}}],
+               "time": {"end": t2}, "output": {"every_time": t2 / 100, "every_steps": None,
+                                               "history_every": 10}}
+    if material:
+        changes["materials"] = {"bar": material}
+    return changes, (t1, t2)
 
 
 def pulse_error(out_dir: str, times: tuple[float, float]) -> float:

@@ -51,3 +51,15 @@ def test_energy_balance_with_breakage_converges_with_dt(runs):
     half, _ = branching.energy_balance(Run(runs[1]))
     assert full < 0.002
     assert full / half > 3.0
+
+
+def test_c7_criteria_with_lps(tmp_path):
+    """cases/branching/lps.yaml (LPS, glass's ν = 0.22) at δ = 2 mm: the same C7 criteria, with the
+    Rayleigh speed of ν = 0.22 (3156 m/s, plane stress) as the bound on the tip speed."""
+    out, _ = run_case("branching", str(tmp_path), CHANGES, figures=False, config="lps")
+    run = Run(out)
+    assert run.case["blocks"][0]["model"] == "lps"
+    assert branching.rayleigh_speed(run) == pytest.approx(3156.2, abs=0.5)
+    rows = branching.checks(out, case="branching-lps")
+    assert all(r.passed for r in rows), "\n".join(r.row() for r in rows)
+    assert 40.0e-3 < branching.branch_point(run) < 90.0e-3

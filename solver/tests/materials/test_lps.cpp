@@ -601,6 +601,102 @@ TEST(Lps, VerletFreeVibrationConservesEnergyToSecondOrder) {
 
 namespace {
 
+// An nx × ny × nz lattice periodic along every axis with more than one node (δ = 3.015 dx, so an
+// axis of n ≥ 7 nodes gives each bond one minimum image), its bond list made by hand as
+// periodic_lattice's: every node has the whole family (3D: 122 bonds, 2D: 28).
+Periodic periodic_box(int dimension, const char* analysis, int nx, int ny, int nz, const Lps& p) {
+  Periodic out;
+  out.model = pd::build_model(lps_case(dimension, analysis, p), pdtest::cubic_lattice(nx, ny, nz, kDx, dimension, 1e-3));
+  out.period = {nx * kDx, ny * kDx, nz > 1 ? nz * kDx : 0.0};
+  pd::BondList& bonds = out.model.bonds;
+  bonds = pd::BondList{};
+  bonds.offsets.push_back(0);
+  const auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+  const int cz = nz > 1 ? 3 : 0;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        for (int a = -3; a <= 3; ++a)
+          for (int b = -3; b <= 3; ++b)
+            for (int c = -cz; c <= cz; ++c)
+              if (a * a + b * b + c * c > 0 && a * a + b * b + c * c <= 9) {
+                bonds.neighbour.push_back(static_cast<std::int32_t>(
+                    pdtest::node_index(wrap(i + a, nx), wrap(j + b, ny), wrap(k + c, nz), nx, ny)));
+                bonds.broken.push_back(0);
+              }
+        bonds.offsets.push_back(static_cast<std::int64_t>(bonds.neighbour.size()));
+      }
+  return out;
+}
+
+}  // namespace
+
+TEST(Lps, PlaneWavesOnTheInfiniteLatticeFollowTheDiscreteDispersionRelation) {
+  // The discrete LPS dispersion relation of a bulk lattice (validation/wave.py chain_omega_squared
+  // derives it from the linearised energy, Silling et al. 2007): a plane wave u = U cos(k·x) is an
+  // eigenvector of the stiffness with ρω²U = D(k)U,
+  //   D(k) = (κ − α/d²)(d/m)² S Sᵀ + (α/m) Σ_j ω V 2(1 − cos k·ξ_j) n_j n_jᵀ,  S = Σ_j ω|ξ_j| V n_j sin(k·ξ_j),
+  // D diagonal for k along a lattice axis. Here the solver's own linear operator (the reference
+  // stiffness, whose largest eigenvalue sets the exact stable step) is applied to the wave on a
+  // periodic 3D and plane-stress lattice, long (kδ = 0.53) and shorter (kδ = 1.58) waves,
+  // longitudinal and transverse: it returns ω²·u to 1e-12, and the shorter wave is slower. The
+  // printed long-wave speeds differ from the continuum's √((K + 4μ/3)/ρ), √(μ/ρ) (3D) and
+  // √((κ + μ)/ρ), √(μ/ρ) (plane stress) by the lattice's anisotropy at m = 3 (the discrete family's
+  // fourth moments are not isotropic, as for PMB in validation.md C1/C3): measured −3.9 % and +5.0 %
+  // (3D), +0.01 % and −2.2 % (plane stress) at kδ = 0.53.
+  struct Setup {
+    int dimension;
+    const char* analysis;
+    int nx, ny, nz;
+  };
+  const double rho = 1000.0, delta = 3.015 * kDx;
+  for (const Setup& s : {Setup{3, "3d", 36, 7, 7}, Setup{2, "plane_stress", 36, 7, 1}}) {
+    const Periodic p = periodic_box(s.dimension, s.analysis, s.nx, s.ny, s.nz, {0.3, "one"});
+    const std::size_t n = p.model.nodes.size();
+    const pd::LpsModuli mod = pd::lps_moduli(kE, 0.3, s.analysis);
+    const double d = s.dimension, alpha = (s.dimension == 3 ? 15.0 : 8.0) * mod.mu;
+    const double v = p.model.nodes.volume[0];
+    const double continuum[2] = {
+        std::sqrt((s.dimension == 3 ? mod.kappa + 4.0 * mod.mu / 3.0 : mod.kappa + mod.mu) / rho),
+        std::sqrt(mod.mu / rho)};
+    double long_speed[2] = {0, 0}, short_speed[2] = {0, 0};
+    for (int q : {1, 3}) {
+      const double k = 2.0 * kPi * q / (s.nx * kDx);
+      // D's diagonal from the family of one node (lattice sums, independent of the solver's code)
+      double m = 0.0, sx = 0.0, dxx = 0.0, dyy = 0.0;
+      const int cz = s.dimension == 3 ? 3 : 0;
+      for (int a = -3; a <= 3; ++a)
+        for (int b = -3; b <= 3; ++b)
+          for (int c = -cz; c <= cz; ++c) {
+            const int r2 = a * a + b * b + c * c;
+            if (r2 == 0 || r2 > 9) continue;
+            const double len = kDx * std::sqrt(double(r2)), nx = a * kDx / len, ny = b * kDx / len;
+            m += len * len * v;
+            sx += len * v * nx * std::sin(k * a * kDx);
+            dxx += v * 2.0 * (1.0 - std::cos(k * a * kDx)) * nx * nx;
+            dyy += v * 2.0 * (1.0 - std::cos(k * a * kDx)) * ny * ny;
+          }
+      const double omega2[2] = {((mod.kappa - alpha / (d * d)) * (d / m) * (d / m) * sx * sx + alpha / m * dxx) / rho,
+                                alpha / m * dyy / rho};
+      for (int polar = 0; polar < 2; ++polar) {
+        pd::Vec3Array x = pd::make_vec3(n), y = pd::make_vec3(n);
+        for (std::size_t i = 0; i < n; ++i) x[polar][i] = std::cos(k * p.model.nodes.x[0][i]);
+        p.model.bond_model->apply_reference_stiffness(p.model, p.period, x, y);
+        for (std::size_t i = 0; i < n; ++i) x[polar][i] *= omega2[polar];
+        EXPECT_LT(pdtest::distance(y, x), 1e-12 * pdtest::norm(x)) << s.analysis << " q=" << q << " polar " << polar;
+        const double speed = std::sqrt(omega2[polar]) / k;
+        (q == 1 ? long_speed : short_speed)[polar] = speed;
+        std::printf("[ lps      ] %s %s kδ=%.3f: phase speed %.2f m/s (continuum %.2f, %+.4f)\n", s.analysis,
+                    polar ? "transverse" : "longitudinal", k * delta, speed, continuum[polar],
+                    speed / continuum[polar] - 1.0);
+      }
+    }
+    for (int polar = 0; polar < 2; ++polar) EXPECT_LT(short_speed[polar], long_speed[polar]) << s.analysis;
+  }
+}
+
+namespace {
+
 // ∂f_i/∂u_i by central differences of the force: node i alone moved by ±h along each axis.
 std::array<double, 9> node_block_by_difference(const pd::Model& m, const pd::Vec3Array& u, std::size_t i, double h) {
   std::array<double, 9> out{};
