@@ -174,8 +174,11 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       log.line("removed " + std::to_string(dropped) + " frame(s) written from step " + std::to_string(first_step) +
                " on, " + while_what + "; the last frame kept, at t = " + format("%.6g", keep_until) + " s, is the last before the growth");
   };
+  // An explicit run is judged by the step it was given (dt, safety_factor), not by a step shortened
+  // to land on an output time.
   const auto likely_cause = [&](double h) {
-    return BlowUpWatch::likely_cause(h, p.exact_limit(), p.dt_stable, integrator.explicit_step(), model.contact.pairs);
+    const double step = integrator.explicit_step() && p.dt > 0.0 ? std::max(h, p.dt) : h;
+    return BlowUpWatch::likely_cause(step, p.exact_limit(), p.dt_stable, integrator.explicit_step(), model.contact.pairs);
   };
   const std::string while_growing = "while the energy grew ×" + format("%g", BlowUpWatch::kGrowthPerStep) + " a step";
   const std::string while_unbalanced = "while the energy held was more than " + format("%g", EnergyBalanceWatch::kSuspect) +
