@@ -197,8 +197,8 @@ def check_mesh_cost(case: dict, geo: str, probe: dict, out_dir: str, force: bool
             found.append(f"gmsh would need about {need / 1e6:.0f} MB, more than half of the {memory / 1e6:.0f} MB "
                          "available")
         if n * MSH_BYTES_PER_NODE > 0.5 * disk:
-            found.append(f"the mesh file would be about {n * MSH_BYTES_PER_NODE / 1e6:.0f} MB, more than half of "
-                         f"the {disk / 1e6:.0f} MB free")
+            found.append(f"the mesh file would be about {n * MSH_BYTES_PER_NODE / 1e6:.3g} MB, more than half of "
+                         f"the {disk / 1e6:.3g} MB free")
         if found:
             reasons += found
             where = (line, "make the mesh size larger (for a lattice case the mesh only outlines the body: "
