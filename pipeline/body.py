@@ -89,6 +89,25 @@ def _inside(inner: list, outer: list, dimension: int) -> bool:
                for i in range(dimension))
 
 
+def _outside_points(points, polygon, tolerance: float) -> int:
+    """How many of `points` lie outside `polygon` (both [[x, y], ...]) by more than `tolerance`:
+    an even-odd ray cast, with points within `tolerance` of an edge counted as inside."""
+    import numpy as np
+
+    p = np.asarray(points, dtype=float)
+    a = np.asarray(polygon, dtype=float)
+    b = np.roll(a, -1, axis=0)
+    x, y = p[:, 0:1], p[:, 1:2]
+    crosses = ((a[:, 1] > y) != (b[:, 1] > y)) & \
+        (x < (b[:, 0] - a[:, 0]) * (y - a[:, 1]) / np.where(b[:, 1] == a[:, 1], 1.0, b[:, 1] - a[:, 1]) + a[:, 0])
+    inside = crosses.sum(axis=1) % 2 == 1
+    d = b - a
+    length2 = np.maximum((d ** 2).sum(axis=1), 1e-300)
+    s = np.clip(((x - a[:, 0]) * d[:, 0] + (y - a[:, 1]) * d[:, 1]) / length2, 0.0, 1.0)
+    distance = np.hypot(x - (a[:, 0] + s * d[:, 0]), y - (a[:, 1] + s * d[:, 1])).min(axis=1)
+    return int(np.count_nonzero(~inside & (distance > tolerance)))
+
+
 def check_body(case: dict, geo: str, probe: dict):
     """The body exists, its groups are there and not empty, gmsh built it without an error, holes
     lie inside their outer boundary."""
@@ -114,6 +133,16 @@ def check_body(case: dict, geo: str, probe: dict):
                               f"{entity['loops'][0]}: a hole larger than the body or crossing its edge "
                               f"(hole x {box[0]:g}…{box[3]:g}, y {box[1]:g}…{box[4]:g}; body x {outer[0]:g}…"
                               f"{outer[3]:g}, y {outer[1]:g}…{outer[4]:g}); make the hole smaller or the body larger")
+            elif dim == 2 and "loop_points" in entity:
+                # Inside the outer loop's box but perhaps not inside the loop (an L-shaped plate
+                # with the hole in its missing corner: gmsh meshes that without a word).
+                size = max(outer[3] - outer[0], outer[4] - outer[1])
+                out = _outside_points(entity["loop_points"][k + 1], entity["loop_points"][0], 1e-6 * size)
+                if out:
+                    errors.append(f"{where}: in {geo}{given}, surface {entity['tag']} has a hole (its boundary "
+                                  f"{entity['loops'][k + 1]}) partly or wholly outside its outer boundary "
+                                  f"{entity['loops'][0]} ({out} of {len(entity['loop_points'][k + 1])} points of the "
+                                  "hole's outline lie outside the body): move the hole into the body or make it smaller")
     groups = probe["groups"]
     lines = case["_lines"]
     for name in case["materials"]:

@@ -84,7 +84,18 @@ def cmd_mesh(args):
     plan = check_mesh_cost(case, args.geo, probe, os.path.dirname(os.path.abspath(args.out)))
     if plan:
         print(f"{args.case}: {plan}")
-    mesh_geo(args.geo, args.out, case["dimension"], case["geometry"]["parameters"])
+    try:
+        mesh_geo(args.geo, args.out, case["dimension"], case["geometry"]["parameters"])
+    except Exception as err:
+        # A body the checks before meshing let through (a hole inside the outer loop's box but
+        # outside a non-convex outline) still fails here: named at the parameters' line too.
+        if type(err).__name__ != "PreprocessError" or "gmsh failed" not in str(err) or not case["geometry"]["parameters"]:
+            raise
+        lines = case["_lines"]
+        line = lines.get(("geometry", "parameters"), lines.get(("geometry",), 1))
+        given = ", ".join(f"{k} = {v:g}" for k, v in case["geometry"]["parameters"].items())
+        raise CaseError(f"{case['_path']}:{line}: geometry.parameters: gmsh could not mesh the body with {given}; "
+                        f"check that they describe a sound body:\n{err}") from err
 
 
 def check_geometry(case: dict, geo: str) -> dict:

@@ -8,7 +8,8 @@ the .geo, so that a body that the parameters break (a hole larger than the plate
 and a mesh that would take for ever (`lc: 2e-6`, item 11) are caught before gmsh meshes anything.
 
 The JSON holds, for the top-dimension entities (surfaces of a 2D case, volumes of a 3D one):
-  entities: [{tag, bbox, loops: [[curve or surface tags], ...]}], loops[0] the outer boundary;
+  entities: [{tag, bbox, loops: [[curve or surface tags], ...], loop_boxes, loop_points}], loops[0]
+    the outer boundary, loop_points (2D) each loop as a polygon [[x, y], ...];
   bbox: the union of their bounding boxes [xmin, ymin, zmin, xmax, ymax, zmax];
   groups: {name: [dim, number of entities]} of every physical group;
   errors: gmsh's error and warning lines while it read the geometry;
@@ -61,6 +62,19 @@ def _loops(gmsh, dim: int, tag: int) -> list[list[int]]:
     return [s[1] for s in shells]
 
 
+def _loop_points(gmsh, loop: list[int], per_curve: int = 32) -> list[list[float]]:
+    """A closed loop of curves as a polygon [[x, y], ...]: each curve sampled at per_curve + 1
+    parameter values (gmsh.model.getValue), in the loop's direction."""
+    points: list[list[float]] = []
+    for signed in loop:
+        low, high = (b[0] for b in gmsh.model.getParametrizationBounds(1, abs(signed)))
+        ts = [low + (high - low) * k / per_curve for k in range(per_curve + 1)]
+        xyz = gmsh.model.getValue(1, abs(signed), ts)
+        curve = [[xyz[3 * k], xyz[3 * k + 1]] for k in range(len(ts))]
+        points += curve if signed > 0 else curve[::-1]
+    return points
+
+
 def probe(geo: str, dimension: int, parameters: dict[str, float]) -> dict:
     import gmsh
 
@@ -85,7 +99,10 @@ def probe(geo: str, dimension: int, parameters: dict[str, float]) -> dict:
                     lb = list(b) if lb is None else [min(lb[i], b[i]) for i in range(3)] + \
                         [max(lb[i + 3], b[i + 3]) for i in range(3)]
                 loop_boxes.append(lb)
-            entities.append({"tag": tag, "bbox": bbox, "loops": loops, "loop_boxes": loop_boxes})
+            entity = {"tag": tag, "bbox": bbox, "loops": loops, "loop_boxes": loop_boxes}
+            if dim == 2:
+                entity["loop_points"] = [_loop_points(gmsh, loop) for loop in loops]
+            entities.append(entity)
             box = bbox if box is None else [min(box[i], bbox[i]) for i in range(3)] + \
                 [max(box[i + 3], bbox[i + 3]) for i in range(3)]
         groups = {}

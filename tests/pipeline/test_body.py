@@ -109,3 +109,38 @@ def test_every_shipped_case_passes(yaml):
     result = run("check", yaml)
     assert result.returncode == 0, result.stderr
     assert "is sound" in result.stdout
+
+
+L_SHAPED_GEO = """\
+// An L-shaped plate (the corner x > 0.05, y > 0.05 cut away) with a round hole at (c, 0.075).
+DefineConstant[ r = {0.01, Name "Parameters/hole radius [m]"}, c = {0.02, Name "Parameters/hole centre x [m]"} ];
+Point(1) = {0, 0, 0, 0.005}; Point(2) = {0.1, 0, 0, 0.005}; Point(3) = {0.1, 0.05, 0, 0.005};
+Point(4) = {0.05, 0.05, 0, 0.005}; Point(5) = {0.05, 0.1, 0, 0.005}; Point(6) = {0, 0.1, 0, 0.005};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 5}; Line(5) = {5, 6}; Line(6) = {6, 1};
+Point(7) = {c, 0.075, 0, 0.005}; Point(8) = {c + r, 0.075, 0, 0.005}; Point(9) = {c - r, 0.075, 0, 0.005};
+Circle(7) = {8, 7, 9}; Circle(8) = {9, 7, 8};
+Curve Loop(1) = {1, 2, 3, 4, 5, 6}; Curve Loop(2) = {7, 8};
+Plane Surface(1) = {1, 2};
+Physical Surface("plate") = {1};
+"""
+
+
+@pytest.mark.parametrize("c, outside", [(0.02, None), (0.08, "66 of 66"), (0.05, "of 66")])
+def test_a_hole_in_the_missing_corner_of_an_l_shaped_plate(tmp_path, c, outside):
+    """Inside the outer loop's box but not inside the loop: gmsh meshed it without a word; the
+    hole's outline, sampled, is tested against the outer loop as a polygon."""
+    from minimal_case import MINIMAL
+
+    folder = tmp_path / "ell"
+    folder.mkdir()
+    (folder / "ell.geo").write_text(L_SHAPED_GEO)
+    (folder / "ell.yaml").write_text(MINIMAL.replace("discretization:", f"geometry:\n  parameters: {{r: 0.01, c: {c}}}\n"
+                                                     "discretization:"))
+    result = run("check", folder / "ell.yaml")
+    if outside is None:
+        assert result.returncode == 0, result.stderr
+        return
+    assert result.returncode == 2, result.stdout
+    assert "ell.yaml:4: in " in result.stderr and "surface 1 has a hole (its boundary [-8, -7]) partly or wholly " \
+        "outside its outer boundary [1, 2, 3, 4, 5, 6] (" in result.stderr
+    assert f"{outside} points of the hole's outline lie outside the body): move the hole into the body" in result.stderr
