@@ -143,8 +143,8 @@ CHECKPOINT := $(OUT)/checkpoint.bin
 $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
 	@if [ -f '$(CHECKPOINT)' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/case.json' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/nodes.vtu' ] \
 	    && [ '$(CHECKPOINT)' -nt '$(SOLVER)' ]; then \
-	  echo "$(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
-	  exec '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
+	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
+	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
 	else \
 	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json"; \
 	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json'; \
@@ -210,12 +210,15 @@ fuzz: $(SOLVER) | $(DEPS)
 # (BENCH_SIDES to change), then the cost of output in the built cases. Prints the load average.
 # LAMMPS (Debian's, with PERI) runs the same 40³ brick for comparison.
 BENCH_SIDES ?= 40 46 100
+# MPI rows (issue 15): 1 and 2 ranks × 1 and 2 threads beside LAMMPS on 2 ranks (bench/mpi_ranks.py).
+BENCH_MPI_SIDES ?= 40 100
 BENCH_DEPS  := build/.bench-deps-ok
 $(BENCH_DEPS): pipeline/install-deps.sh
 	sh pipeline/install-deps.sh lammps openmpi-bin
 	@mkdir -p $(@D) && touch $@
 bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
 	$(PY) -m bench.speed --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
+	$(PY) -m bench.mpi_ranks --build build/solver --sides $(BENCH_MPI_SIDES) --out out/bench/mpi.csv
 
 # Error against run time and force evaluations (issue 3): Verlet at several safety factors and at the
 # exact limit, the adaptive step over a sweep of TOL, on a wave and on a fracture problem, against a

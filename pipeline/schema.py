@@ -255,9 +255,9 @@ CASE = {
         linear_solver=Key("string", "the linear solve of each Newton iteration: direct (CHOLMOD "
                           "factorisation of the assembled tangent), cg (matrix-free conjugate "
                           "gradients with a block-Jacobi preconditioner, solved only as far as "
-                          "Newton needs: Eisenstat–Walker), or auto (cg when a term has no "
-                          "assembled tangent, i.e. contact, or the model is large: run.log says "
-                          "which and why)", default="auto", choices=("auto", "direct", "cg")),
+                          "Newton needs: Eisenstat–Walker), or auto (cg when a term or the "
+                          "material has no assembled tangent, i.e. contact or model lps, or the "
+                          "model is large: run.log says which and why); lps cannot use direct", default="auto", choices=("auto", "direct", "cg")),
         cg_max_iterations=Key("integer", "CG iterations in one Newton iteration; then Newton goes "
                               "on with the iterate reached", default=5000, minimum=1,
                               maximum=100000000),
@@ -299,18 +299,28 @@ CASE = {
     ),
     "mixed": section(
         "the mixed scheme (time.integrator: mixed): quasi-static load steps (the quasi_static "
-        "section) while the body is in equilibrium, explicit Verlet steps of time.dt while it is not; "
+        "section), or implicit generalized-α steps (the implicit section; start: implicit), while the "
+        "body is in equilibrium or moves slowly, explicit Verlet steps of time.dt while it is not; "
         "time is physical, so the boundary conditions are loading rates; history.csv's mode column is "
-        "1 for a quasi-static step, 0 for an explicit one, and run.log says every switch",
+        "1 for a quasi-static step, 2 for an implicit one, 0 for an explicit one, and run.log says "
+        "every switch",
+        start=Key("string", "the scheme the run starts with and returns to once a crack has arrested: "
+                  "quasi_static (equilibrium load steps, the kinetic energy given up on return) or "
+                  "implicit (generalized-α dynamics, the motion kept; no damping needed); implicit "
+                  "leaves for explicit when a step fails down to implicit.dt_min or when bonds break "
+                  "in more than unstable_rounds implicit steps in a row", default="quasi_static", choices=("quasi_static", "implicit")),
         unstable_rounds=Key("integer", "to explicit when a load step needs more re-solves than this "
                             "while bonds keep breaking (unstable crack growth), or does not converge "
-                            "down to quasi_static.dt_min (default there: 10 explicit steps)",
+                            "down to quasi_static.dt_min (default there: 10 explicit steps); with "
+                            "start: implicit, when bonds break in more than this many implicit steps "
+                            "in a row",
                             default=3, minimum=1, maximum=100000000),
-        kinetic_fraction=Key("number", "back to quasi-static when the kinetic energy has stayed below "
+        kinetic_fraction=Key("number", "back to the start scheme when the kinetic energy has stayed below "
                              "this fraction of the strain energy ...", default=0.05, above=0.0,
                              below=1.0),
         arrest_steps=Key("integer", "... for this many explicit steps in a row without a bond breaking "
-                         "(the crack arrested); the kinetic energy left is given up, as damping work",
+                         "(the crack arrested); back to quasi_static, the kinetic energy left is given up, as "
+                         "damping work (implicit keeps it)",
                          default=200, minimum=1, maximum=1000000000),
     ),
     "output": section(

@@ -390,11 +390,19 @@ def _check_materials(case: dict, checker: _Checker):
     if len(models) > 1:
         checker.error(("materials",), f"every block must use the same model, got {', '.join(sorted(models))}")
     integrator = case["time"]["integrator"]
-    if "lps" in models and integrator in ("quasi_static", "mixed"):
-        # The solver's Newton solves factorise an assembled tangent; a state-based law has none
-        # (solver/src/materials/bond_model.hpp bond_tangent_row), so the run would stop at its first step.
-        checker.error(("time", "integrator"), f"{integrator} needs an assembled tangent stiffness, which the "
-                      "state-based model lps does not have; use verlet or adaptive")
+    if "lps" in models:
+        # A state-based law has no assembled tangent (solver/src/materials/bond_model.hpp
+        # bond_tangent_row: its force on a node depends on the neighbours' neighbours). Its Newton
+        # solves run matrix-free: CG with the law's diagonal blocks (quasi_static, mixed); what
+        # factorises the tangent (implicit, linear_solver: direct) is refused, as the solver does.
+        starts_implicit = integrator == "mixed" and case["mixed"].get("start") == "implicit"
+        if integrator == "implicit" or starts_implicit:
+            where = ("mixed", "start") if starts_implicit else ("time", "integrator")
+            checker.error(where, "implicit factorises the assembled tangent stiffness, which the state-based model "
+                          "lps does not have; use time.integrator: verlet, quasi_static or mixed (mixed.start: quasi_static)")
+        elif integrator in ("quasi_static", "mixed") and case["quasi_static"].get("linear_solver") == "direct":
+            checker.error(("quasi_static", "linear_solver"), "direct factorises the assembled tangent stiffness, which "
+                          "the state-based model lps does not have; use linear_solver: cg (or auto)")
     influences = {m.get("influence") or "one" for m in materials.values() if m["model"] == "lps"}
     if len(influences) > 1:
         checker.error(("materials",), f"every block must use the same influence function, got {', '.join(sorted(influences))}")

@@ -23,6 +23,7 @@ class CaseSettings:
     gmsh: str = "figures"           # `output.gmsh`: frames copied to gmsh/results.msh: all | figures | none
     integrator: str | None = None   # `time.integrator`: what timestep.png shows (None: not in case.json)
     breakable: bool = True          # some block has a fracture_energy: else no damage maps
+    cracks: list = dataclasses.field(default_factory=list)  # `cracks`: pre-cracks as (from, to) [m]
     probe: list | str | None = None  # `figures.probe`: a point [m], a node-set name, or None (the centre)
 
     @property
@@ -91,11 +92,18 @@ def load_case_settings(path: str) -> CaseSettings:
     integrator = time.get("integrator") if isinstance(time, dict) else None
     if integrator is not None and not isinstance(integrator, str):
         fail("time.integrator", f"expected a name, got {integrator!r}")
+    cracks = case.get("cracks") or []
+    if not isinstance(cracks, list) or not all(
+            isinstance(c, dict) and all(isinstance(c.get(k), list) and len(c[k]) in (2, 3)
+                                        and all(_is_number(v) for v in c[k]) for k in ("from", "to"))
+            for c in cracks):
+        fail("cracks", f"expected a list of {{from: [x, y, z], to: [x, y, z]}} in m, got {cracks!r}")
+    cracks = [([float(v) for v in c["from"]], [float(v) for v in c["to"]]) for c in cracks]
     blocks = case.get("blocks") or []
     block_names = {b["id"]: b["name"] for b in blocks if isinstance(b, dict)
                    and isinstance(b.get("id"), int) and isinstance(b.get("name"), str)}
     return CaseSettings(name=name, dimension=dimension, title=title,
                         grid_spacing=None if spacing is None else float(spacing),
                         times=times, component=int(component), block_names=block_names, gmsh=gmsh,
-                        integrator=integrator, probe=probe,
+                        integrator=integrator, probe=probe, cracks=cracks,
                         breakable=any(isinstance(b, dict) and b.get("fracture_energy") is not None for b in blocks))

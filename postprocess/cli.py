@@ -22,6 +22,7 @@ from pipeline.atomic import DISK_FULL_EXIT, WriteError
 
 from .casefile import load_case_settings
 from .errors import PostprocessError
+from .crack_tip import DAMAGED
 from .history import read_history
 from .series import read_frame, read_series
 from .plotting import say
@@ -71,6 +72,27 @@ def _remove_stale_maps(directory: str, count: int, keep_damage: bool = True):
             os.unlink(path)
 
 
+def _crack_outputs(out_dir, fig_dir, case, times, points, crack_masks) -> list[str]:
+    """crack_path.png and crack_tips.csv when bonds can break and a crack grew; else none (and
+    those of an earlier run removed)."""
+    from .crack_plot import plot_crack_path, tip_table, write_tip_csv
+    from .crack_tip import plan_tracks
+
+    paths = [os.path.join(fig_dir, "crack_path.png"), os.path.join(out_dir, "crack_tips.csv")]
+    tracks = plan_tracks(points, crack_masks, case.cracks) if case.breakable and points is not None else []
+    if not tracks:
+        for stale in paths:
+            if os.path.exists(stale):
+                os.unlink(stale)
+        if case.breakable:
+            say("crack_path.png: none, no crack grew (no node's damage passed "
+                f"{DAMAGED:g} beyond the pre-cracks)")
+        return []
+    write_tip_csv(paths[1], tip_table(times, points, crack_masks, tracks))
+    say(plot_crack_path(times, points, crack_masks, tracks, case, paths[0]))
+    return paths
+
+
 def run(out_dir: str, case_json: str | None = None, only: str | None = None, log=print) -> list[str]:
     """Write the outputs of one case; returns the paths written."""
     case_json = case_json or os.path.join(out_dir, "case.json")
@@ -101,6 +123,9 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
     probe: dict = {"values": [], "nodes": None, "where": "", "position": None}
     nodes_file = os.path.join(out_dir, "nodes.vtu")
     state: dict = {"last": None, "count": None}
+    # crack nodes (φ > DAMAGED) of every frame, for the crack-tip tracks: a bool per node and frame
+    # (plate_with_hole: 55 × 78 760 bytes), only when something can break
+    crack_masks: list = []
 
     def frames():
         """Each frame once: feeds the probe, keeps the frames the maps need, and yields for Gmsh."""
@@ -115,6 +140,8 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
                 raise PostprocessError(f"{path}: {len(frame.points)} points, the first frame "
                                        f"{series[0][1]} has {state['count']}")
             probe["values"].append(float(np.mean(frame.displacement[probe["nodes"], case.component])))
+            if case.breakable:
+                crack_masks.append(frame.damage > DAMAGED)
             if index in selected:
                 kept[index] = frame
             state["last"] = (index, t, frame)
@@ -192,6 +219,16 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
         path = os.path.join(fig_dir, "probe.png")
         say(plot_probe(times, probe["values"], case, path, where=probe["where"], position=probe["position"]))
         written.append(path)
+        path = os.path.join(fig_dir, "damage_3d.png")
+        if case.dimension == 3 and damaged:  # a rendered view of where the damage is inside the body
+            from .render3d import render_damage_3d
+            index, t, frame = state["last"]
+            say(render_damage_3d(series[index][1], frame, case, path, time=t))
+            written.append(path)
+        elif os.path.exists(path):  # left from an earlier run of a case that could break
+            os.unlink(path)
+        written += _crack_outputs(out_dir, fig_dir, case, times, state["last"][2].points,
+                                  crack_masks)
     log(f"postprocess: {case.name}: {len(series)} frames → " +
         ", ".join(os.path.relpath(p, out_dir) for p in written) + f" in {out_dir}")
     return written

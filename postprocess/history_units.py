@@ -1,7 +1,7 @@
 """history.json: the unit and meaning of every column of a run's history.csv, for people and programs.
 
 Written by postprocess beside history.csv from its header (the solver's columns are not touched):
-{"format_version": 1, "file": "history.csv",
+{"format_version": 2, "file": "history.csv", "fixed_columns": [names every history.csv has],
  "columns": {"<name>": {"unit": "J", "description": "…"}, …}}   (header order)
 Units are SI symbols; "1" marks a count or a ratio (formats.md §4 writes it "–"). The table below
 is formats.md §4's; tests/postprocess/test_post_history_json.py checks the two agree.
@@ -13,7 +13,13 @@ import re
 
 from pipeline.atomic import atomic_path
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: fixed_columns (issue 16)
+
+# The columns every history.csv has since issue 16, whatever the case (formats.md §4): the solver's
+# base columns, then the terms a case may lack, written as 0 (solver/src/run/history_columns.cpp).
+FIXED_COLUMNS = ("step", "time", "dt", "iterations", "rejected", "kinetic_energy", "strain_energy", "external_work",
+                 "damping_work", "broken_bonds", "wall_time", "contact_energy", "indenter_energy",
+                 "broken_bond_energy", "contact_rebuilds", "mode")
 
 # name → (unit, description), formats.md §4 in its order.
 COLUMNS = {
@@ -28,11 +34,13 @@ COLUMNS = {
     "damping_work": ("J", "energy removed by damping, integral of sum rho alpha V |v|^2 dt"),
     "broken_bonds": ("1", "broken bonds, each counted once"),
     "wall_time": ("s", "wall-clock seconds since the time loop started"),
-    "contact_energy": ("J", "potential of the contact pairs (and of the indenters, where the solver adds them here)"),
-    "indenter_energy": ("J", "potential of the rigid indenters, sum of V K h^3/3"),
-    "contact_rebuilds": ("1", "Verlet-list builds of the contact search so far"),
-    "broken_bond_energy": ("J", "energy the broken bonds held when they broke, sum of 1/2 c s^2 |xi| nu V_i V_j"),
-    "mode": ("1", "kind of the step of the mixed integrator: 1 quasi-static load step, 0 explicit step"),
+    "contact_energy": ("J", "potential of the short-range contact pairs (0 without contact)"),
+    "indenter_energy": ("J", "potential of the rigid indenters, sum of V K h^3/3 (0 without indenters)"),
+    "broken_bond_energy": ("J", "energy the broken bonds held when they broke, sum of 1/2 c s0^2 |xi| nu V_i V_j "
+                                "at the critical stretch s0 each crossed (0 when nothing can break)"),
+    "contact_rebuilds": ("1", "Verlet-list builds of the contact search so far (0 without contact)"),
+    "mode": ("1", "kind of step: 1 quasi-static load step, 2 implicit step of mixed (mixed.start: implicit), "
+                   "0 any other dynamic (explicit or implicit) step"),
 }
 # Families of columns, one triple per indenter or node set: (pattern, unit, description template).
 FAMILIES = (
@@ -69,7 +77,8 @@ def write_history_json(history_csv: str, path: str) -> dict:
     for name in header_of(history_csv):
         unit, description = describe_column(name)
         columns[name] = {"unit": unit, "description": description}
-    content = {"format_version": FORMAT_VERSION, "file": "history.csv", "columns": columns}
+    content = {"format_version": FORMAT_VERSION, "file": "history.csv", "fixed_columns": list(FIXED_COLUMNS),
+               "columns": columns}
     with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as stream:
         json.dump(content, stream, indent=1, ensure_ascii=False)
         stream.write("\n")

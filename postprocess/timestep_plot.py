@@ -59,7 +59,7 @@ def plot_timestep(history: dict, case: CaseSettings, path: str, run_log: str | N
     """Draw timestep.png for the case's integrator; returns a one-line description."""
     history = _taken(history)
     integrator = getattr(case, "integrator", None)
-    if integrator == "verlet" and "mode" not in history:
+    if integrator == "verlet":
         limits = stability_limits(run_log or os.path.join(os.path.dirname(os.path.dirname(path)), "run.log"))
         return _plot_verlet(history, case, path, limits)
     return _plot_controlled(history, case, path)
@@ -101,7 +101,11 @@ def _plot_verlet(history: dict, case, path: str, limits: dict) -> str:
 def _plot_controlled(history: dict, case, path: str) -> str:
     step, dt = history["step"], history["dt"]
     t, t_label = time_axis(history["time"])
-    mixed = "mode" in history
+    # Every history.csv has `mode` since issue 16 (0 for a dynamic step): the mixed scheme is the one
+    # with both kinds of step, or the one the case names.
+    mode = history.get("mode")
+    mixed = getattr(case, "integrator", None) == "mixed" or (
+        mode is not None and bool(np.any(mode == 1)) and bool(np.any(mode == 0)))
     factor, unit = si_scale(dt, "s")
     fig, axes = new_figure(3, 1, size=(7.5, 8.5))
     a, b, c = axes[:, 0]
@@ -115,7 +119,8 @@ def _plot_controlled(history: dict, case, path: str) -> str:
     if mixed:
         # The mixed scheme (integrators/mixed.hpp): its load steps and explicit steps differ by
         # orders of magnitude, so Δt is drawn on a log scale with each mode in its own colour.
-        for value, label in ((1, "quasi-static load steps"), (0, "explicit (Verlet) steps")):
+        for value, label in ((1, "quasi-static load steps"), (2, "implicit (generalized-α) steps"),
+                             (0, "explicit (Verlet) steps")):
             chosen = history["mode"] == value
             if np.any(chosen):
                 b.plot(t[chosen], dt[chosen] * factor, ".", markersize=3, label=label)

@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from postprocess import crack_tip
+
 from .common import Check, Run
 
 RAYLEIGH = 3058.0          # m/s, plane stress ν = 1/3, E = 72 GPa, ρ = 2440 (validation.md C7 [D])
-DAMAGED = 0.3              # damage above which a node belongs to the crack
+DAMAGED = crack_tip.DAMAGED  # damage above which a node belongs to the crack (the normal output's too)
 SPEED_WINDOW = 2.0e-6      # s: tip speed over windows this long (a lattice crack advances in jumps)
 SYMMETRY_MIN = 0.95        # share of crack nodes whose mirror image is a crack node too
 BALANCE_MAX = 0.02         # |KE + U + broken-bond energy − W_ext| / W_ext at the end
@@ -24,24 +26,25 @@ def notch_tip(run: Run) -> np.ndarray:
     return np.array(max((c["from"], c["to"]), key=lambda p: p[0])[:2], dtype=float)
 
 
+def tip_track(run: Run) -> crack_tip.Track:
+    """The upper branch's tip (y ≥ notch line; the lower half mirrors it), running along +x from
+    the notch tip: the shared tracker of the normal output (postprocess/crack_tip.py)."""
+    return crack_tip.Track("upper", np.array([*notch_tip(run), 0.0]), np.array([1.0, 0.0, 0.0]),
+                           side=np.array([0.0, 1.0, 0.0]))
+
+
 def tip_history(run: Run) -> tuple[np.ndarray, np.ndarray]:
-    """(times, tip positions): in each frame the crack node of the upper half (y ≥ notch line;
-    the lower half mirrors it) farthest along x beyond the notch tip, else the notch tip."""
-    yc, tip0 = notch_line(run), notch_tip(run)
-    upper = run.x[:, 1] >= yc
-    tips = []
-    for i in range(len(run.series)):
-        crack = (run.frame(i).damage > DAMAGED) & upper & (run.x[:, 0] > tip0[0])
-        tips.append(run.x[crack][np.argmax(run.x[crack, 0]), :2] if crack.any() else tip0)
-    return run.times, np.array(tips)
+    """(times, tip positions (x, y)): in each frame the crack node of the upper half farthest along
+    x beyond the notch tip, else the notch tip."""
+    masks = [run.frame(i).damage > DAMAGED for i in range(len(run.series))]
+    return run.times, crack_tip.tip_positions(run.x, masks, tip_track(run))[:, :2]
 
 
 def tip_speeds(run: Run) -> tuple[np.ndarray, np.ndarray]:
     """(window mid-times, speeds): |Δ tip| / Δt over SPEED_WINDOW."""
     t, tips = tip_history(run)
     lag = max(1, int(round(SPEED_WINDOW / np.median(np.diff(t)))))
-    speed = np.linalg.norm(tips[lag:] - tips[:-lag], axis=1) / (t[lag:] - t[:-lag])
-    return 0.5 * (t[lag:] + t[:-lag]), speed
+    return crack_tip.tip_speeds(t, tips, lag)
 
 
 def branch_point(run: Run, index: int = -1) -> float | None:
@@ -71,9 +74,11 @@ def mirror_agreement(run: Run, index: int = -1) -> float:
 
 
 def energy_balance(run: Run) -> tuple[float, float]:
-    """(|KE + U + broken-bond energy + damping work − W_ext| at the end / W_ext at the end, W_ext)."""
+    """(|KE + U + contact + indenter + broken-bond energy + damping work − W_ext| at the end / W_ext
+    at the end, W_ext). Every history.csv has these columns since issue 16 (0 for a term the case lacks)."""
     h = run.history
-    total = h["kinetic_energy"] + h["strain_energy"] + h["broken_bond_energy"] + h["damping_work"]
+    total = (h["kinetic_energy"] + h["strain_energy"] + h["contact_energy"] + h["indenter_energy"]
+             + h["broken_bond_energy"] + h["damping_work"])
     work = h["external_work"]
     return float(abs(total[-1] - work[-1]) / abs(work[-1])), float(work[-1])
 

@@ -1,70 +1,118 @@
-// pd_mpi_halo: what a decomposed run exchanges (issue 15), measured on the `make bench` brick (side³
-// simple cubic lattice, δ = 3.0002·dx, PMB). Run under mpiexec -np R; rank 0 prints one CSV row per
-// rank: owned nodes, ghosts, ghosts per owned node, halo messages and bytes it sends per force
-// evaluation, the bytes it sends per ordered sum (8 per owned node, to rank 0), and the wall time
-// of a halo exchange and of a decomposed force evaluation (mean over --steps).
+// pd_mpi_halo: the speed of a decomposed run and what it exchanges (issue 15), on the `make bench`
+// brick (side³ simple cubic lattice, dx = 1 mm, δ = 3.0002·dx, PMB; the top three layers move down
+// at 0.1 m/s, as in pd_speed, so the loop measures the steady state with breaking tested every
+// step). Run under mpiexec -np R with T threads per rank; one rank takes the serial path, as pdsolve
+// does. Times `--steps` velocity-Verlet steps (after one untimed step), each followed by the kinetic
+// and strain energy as pdsolve's loop computes them for its blow-up watch, and prints, from rank 0, one
+// CSV row per rank: the loop's wall time (the slowest rank's) and directed bond updates per second
+// of the whole brick; the rank's owned nodes, ghosts and ghosts per owned node; per step the halo
+// messages and bytes it sent, the ordered sums/gathers and the bytes it sent in them to rank 0, the
+// wall time in communication (halo exchanges and ordered sums, MPI waits included); and its peak
+// resident memory.
 //
-//   mpiexec -np R pd_mpi_halo --side N [--steps S]
+//   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T]
 #include <mpi.h>
+#include <omp.h>
+#include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/model.hpp"
+#include "core/stability.hpp"
+#include "integrators/integrator.hpp"
 #include "lattice.hpp"
 #include "operator/force_operator.hpp"
+#include "parallel/local_model.hpp"
 #include "parallel/mpi_decomposed.hpp"
 
 int main(int argc, char** argv) {
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
-  int side = 40, steps = 20;
+  int side = 40, steps = 20, threads = 0, ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   for (int k = 1; k + 1 < argc; k += 2) {
     const std::string a = argv[k];
     if (a == "--side") side = std::atoi(argv[k + 1]);
     else if (a == "--steps") steps = std::atoi(argv[k + 1]);
+    else if (a == "--threads") threads = std::atoi(argv[k + 1]);
   }
+  if (threads > 0) omp_set_num_threads(threads);
+  threads = omp_get_max_threads();
   const double dx = 1e-3;
   const pd::Case c = pdtest::lattice_case(3, "3d", dx, 3.0002 * dx, 72e9, 2440.0, 4.0);
-  const pd::Model global = pd::build_model(c, pdtest::cubic_lattice(side, side, side, dx, 3));
-  pd::MpiDecomposed dec(MPI_COMM_WORLD, global);
-  pd::ForceOperator op(dec.piece().model);
-  op.set_decomposed(&dec);
-  pd::State s(dec.piece().size());
-  for (std::size_t l = 0; l < s.size(); ++l) s.u[0][l] = 1e-6 * static_cast<double>(dec.piece().global[l] % 7);
+  pd::Model global = pd::build_model(c, pdtest::cubic_lattice(side, side, side, dx, 3));
+  const double dt0 = 0.8 * pd::stable_time_step(global);
+
+  // One rank: the serial path (no decomposition), as pdsolve takes it.
+  std::unique_ptr<pd::MpiDecomposed> dec;
+  if (ranks > 1) dec = std::make_unique<pd::MpiDecomposed>(MPI_COMM_WORLD, global);
+  pd::Model& model = dec ? dec->piece().model : global;
+  pd::ForceOperator op(model);
+  if (dec) op.set_decomposed(dec.get());
+  auto integrator = pd::integrator_registry().get("verlet")(op);
+
+  pd::State whole(global.nodes.size());
+  const double top = (side - 3) * dx - 0.5 * dx;
+  for (std::size_t i = 0; i < global.nodes.size(); ++i)
+    if (global.nodes.x[2][i] > top) whole.v[2][i] = -0.1;
+  pd::State s(model.nodes.size());
+  s.v = dec ? pd::to_local(dec->piece(), whole.v) : whole.v;
+  double t = 0.0;
+  integrator->initialize(s, t);
+  double dt = dt0;
+  integrator->step(s, t, dt);  // untimed: first touches of the arrays
+  const pd::Decomposed::Traffic before = dec ? dec->traffic() : pd::Decomposed::Traffic{};
 
   using Clock = std::chrono::steady_clock;
   MPI_Barrier(MPI_COMM_WORLD);
-  auto t0 = Clock::now();
-  for (int k = 0; k < steps; ++k) dec.update_ghosts(s.u);
-  const double exchange_s = std::chrono::duration<double>(Clock::now() - t0).count() / steps;
-  MPI_Barrier(MPI_COMM_WORLD);
-  t0 = Clock::now();
-  for (int k = 0; k < steps; ++k) op.evaluate(s, 0.0);
-  const double evaluate_s = std::chrono::duration<double>(Clock::now() - t0).count() / steps;
-  MPI_Barrier(MPI_COMM_WORLD);
-  t0 = Clock::now();
-  for (int k = 0; k < steps; ++k) (void)op.strain_energy(s);
-  const double sum_s = std::chrono::duration<double>(Clock::now() - t0).count() / steps;
+  const auto t0 = Clock::now();
+  double energy = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    dt = dt0;
+    integrator->step(s, t, dt);
+    energy += op.kinetic_energy(s) + op.strain_energy(s);  // pdsolve's blow-up watch: 2 ordered sums a step
+  }
+  const double mine = std::chrono::duration<double>(Clock::now() - t0).count();
+  double loop = mine;
+  MPI_Allreduce(&mine, &loop, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  if (!(energy >= 0.0)) std::fprintf(stderr, "pd_mpi_halo: the energy is %g, not finite and ≥ 0\n", energy);
+  const pd::Decomposed::Traffic after = dec ? dec->traffic() : pd::Decomposed::Traffic{};
 
-  const pd::LocalPiece& p = dec.piece();
-  const double row[] = {static_cast<double>(p.owned_local.size()), static_cast<double>(p.ghost_local.size()),
-                        static_cast<double>(p.ghost_local.size()) / static_cast<double>(p.owned_local.size()),
-                        static_cast<double>(dec.halo().messages_sent()), static_cast<double>(dec.halo().bytes_sent()),
-                        8.0 * static_cast<double>(p.owned_local.size()), exchange_s, evaluate_s, sum_s};
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const double per = 1.0 / steps;
+  const double owned = dec ? static_cast<double>(dec->piece().owned_local.size()) : static_cast<double>(global.nodes.size());
+  const double ghosts = dec ? static_cast<double>(dec->piece().ghost_local.size()) : 0.0;
   constexpr int kColumns = 9;
-  std::vector<double> all(static_cast<std::size_t>(kColumns * dec.ranks()));
+  const double row[kColumns] = {owned,
+                                ghosts,
+                                static_cast<double>(after.halo_messages - before.halo_messages) * per,
+                                static_cast<double>(after.halo_bytes - before.halo_bytes) * per,
+                                static_cast<double>(after.reductions - before.reductions) * per,
+                                static_cast<double>(after.reduction_bytes - before.reduction_bytes) * per,
+                                (after.halo_seconds - before.halo_seconds + after.reduction_seconds - before.reduction_seconds) * per,
+                                mine,
+                                static_cast<double>(usage.ru_maxrss) / 1024.0};
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  std::vector<double> all(static_cast<std::size_t>(kColumns * ranks));
   MPI_Gather(row, kColumns, MPI_DOUBLE, all.data(), kColumns, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  if (dec.rank() == 0) {
-    std::printf("rank,nodes,owned,ghosts,ghosts_per_owned,halo_messages_sent,halo_bytes_sent,ordered_sum_bytes_sent,"
-                "halo_exchange_s,force_evaluation_s,ordered_sum_s\n");
-    for (int r = 0; r < dec.ranks(); ++r) {
+  if (rank == 0) {
+    const double directed = static_cast<double>(global.bonds.directed());
+    std::printf("rank,side,nodes,ranks,threads,steps,directed_bonds,loop_s,bond_updates_per_s,owned,ghosts,ghosts_per_owned,"
+                "halo_messages_per_step,halo_bytes_per_step,ordered_sums_per_step,ordered_sum_bytes_per_step,"
+                "communication_s_per_step,communication_share,peak_rss_mb\n");
+    for (int r = 0; r < ranks; ++r) {
       const double* v = &all[static_cast<std::size_t>(kColumns * r)];
-      std::printf("%d,%zu,%.0f,%.0f,%.4f,%.0f,%.0f,%.0f,%.3e,%.3e,%.3e\n", r, global.nodes.size(), v[0], v[1], v[2], v[3],
-                  v[4], v[5], v[6], v[7], v[8]);
+      std::printf("%d,%d,%zu,%d,%d,%d,%.0f,%.4f,%.4e,%.0f,%.0f,%.4f,%.1f,%.0f,%.2f,%.0f,%.4e,%.4f,%.1f\n", r, side,
+                  global.nodes.size(), ranks, threads, steps, directed, loop, directed * steps / loop, v[0], v[1], v[1] / v[0],
+                  v[2], v[3], v[4], v[5], v[6], v[6] * steps / loop, v[8]);
     }
   }
   MPI_Finalize();

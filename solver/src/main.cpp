@@ -25,7 +25,7 @@ namespace {
 
 const char* const kUsage =
     "usage: pdsolve CASE.json [--restart CHECKPOINT] [--threads N] [--end-time T] [--max-steps N] [--quiet]\n"
-    "               [--help] [--version]\n"
+    "               [--progress S] [--help] [--version]\n"
     "       pdsolve --stable-dt CASE.json [--exact] [--threads N]\n"
     "       pdsolve --describe\n"
     "\n"
@@ -39,7 +39,10 @@ const char* const kUsage =
     "  --threads N     OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --end-time T    simulated end time [s], overrides time.end\n"
     "  --max-steps N   stop after step N at most (counted from the start of the run, also on a restart)\n"
-    "  --quiet         print nothing on stdout and no progress line (run.log is still written)\n"
+    "  --quiet         print nothing on stdout and no progress on stderr (run.log is still written)\n"
+    "  --progress S    a progress line (step, t, %, steps/s, ETA) every S seconds of wall time in\n"
+    "                  run.log, and on stderr when it is not a terminal (a terminal gets one updating\n"
+    "                  line); default 10, 0: none\n"
     "  --help          this text\n"
     "  --version       the solver version and how it was built (compiler, flags, OpenMP, sanitizers)\n"
     "  --stable-dt     print, as JSON, the stable step of thesis eq. 2.5 that a run of CASE.json would\n"
@@ -197,6 +200,9 @@ int main(int argc, char** argv) {
       exact = true;
     } else if (arg == "--quiet") {
       options.quiet = true;
+    } else if (arg == "--progress") {
+      const std::string seconds = value();
+      options.progress_interval = seconds == "0" ? 0.0 : parse_number(arg, seconds);  // 0: no lines
     } else if (!arg.empty() && arg[0] == '-') {
       usage_error("unknown option '" + arg + "'");
     } else if (options.case_file.empty()) {

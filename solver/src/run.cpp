@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "parallel/session.hpp"
 #include "run/history_columns.hpp"
 #include "run/loop.hpp"
 #include "run/prepare.hpp"
@@ -44,8 +45,32 @@ int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryC
     } catch (const Error&) {
       // run.log cannot be written either (the same full disk): the message is on stderr already.
     }
+    // An output error is rank 0's alone (it writes every file): the other ranks wait for it in the
+    // next exchange, and MPI_Finalize would wait for them. MPI_Abort ends them all (issue 15).
+    if (p.decomposed) abort_ranks(kRunFailed);
     return kRunFailed;
   }
+}
+
+// open_output on rank 0 (the others write nothing), with its verdict on every rank: a restart whose
+// frames or history.csv do not match the checkpoint is refused by rank 0 alone, and the other ranks
+// must refuse with it rather than wait for it in the first exchange (issue 15). A full disk ends
+// every rank in run() below.
+std::unique_ptr<OutputWriter> open_output_on_ranks(const RunOptions& opt, const Prepared& p, const Start& s,
+                                                   const HistoryColumns& columns) {
+  if (!p.decomposed) return open_output(opt, p, s, columns);
+  std::unique_ptr<OutputWriter> out;
+  std::string failure;
+  try {
+    out = open_output(opt, p, s, columns);
+  } catch (const DiskFull&) {
+    throw;
+  } catch (const Error& e) {
+    failure = e.what();
+  }
+  failure = p.decomposed->broadcast(failure);
+  if (!failure.empty()) throw Error(failure);
+  return out;
 }
 
 }  // namespace
@@ -61,10 +86,11 @@ int run(const RunOptions& opt) {
   // checkpoint (bad input, exit 1, before it changes a file); a full disk there is a failed run.
   const HistoryColumns columns(p.model, p.c, p.integrator.get());
   try {
-    const std::unique_ptr<OutputWriter> out = open_output(opt, p, s, columns);
+    const std::unique_ptr<OutputWriter> out = open_output_on_ranks(opt, p, s, columns);
     return run_with_output(opt, p, s, columns, out.get());
   } catch (const DiskFull& e) {
     std::cerr << "pdsolve: error: " << e.what() << "\n";
+    if (p.decomposed) abort_ranks(kRunFailed);  // rank 0's alone, as above
     return kRunFailed;
   }
 }

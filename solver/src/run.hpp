@@ -12,7 +12,8 @@ struct RunOptions {
   int threads = 0;                        // 0: OpenMP's default
   std::optional<double> end_time;         // overrides time.end
   std::optional<std::int64_t> max_steps;  // caps time.max_steps
-  bool quiet = false;                     // nothing on stdout, no progress line
+  bool quiet = false;                     // nothing on stdout, no progress on stderr (run.log still has it)
+  double progress_interval = 10.0;        // [s] of wall time between progress lines; 0: none (run/progress.hpp's default)
   std::filesystem::path restart;          // a checkpoint.bin to continue from (empty: start at t = 0)
   // Called after every completed step with the step number (tests raise a signal from it).
   std::function<void(std::int64_t step)> after_step;

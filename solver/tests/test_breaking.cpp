@@ -59,6 +59,35 @@ TEST(Breaking, BondPastCriticalStretchBreaksAndCarriesNoForce) {
   EXPECT_EQ(pd::update_broken_bonds(m, stretched(m, 2 * s0)), 0);
 }
 
+// The energy a bond takes with it (history.csv broken_bond_energy, validation.md C4): the PMB bond
+// energy w = ½ c s² |ξ| ν V_i V_j at the critical stretch s0 at which it broke, from the closed forms
+// of validation.md F1 (3D: c = 12E/(πδ⁴), s0 = √(5G0/(9Kδ)), K = E/(3(1 − 2·¼))), whatever stretch
+// past s0 the step that broke it reached. Before issue 16 it was taken at that stretch: 2.25 × here.
+TEST(Breaking, ABrokenBondTakesItsEnergyAtTheCriticalStretch) {
+  const double dx = 1e-3, delta = 1.5 * dx, E = 1e9, G0 = 10.0;
+  const double K = E / (3.0 * (1.0 - 2.0 * 0.25)), c = 12.0 * E / (M_PI * std::pow(delta, 4));
+  const double s0 = std::sqrt(5.0 * G0 / (9.0 * K * delta));
+  for (const bool with_force : {false, true}) {
+    pd::Model m = pair_model(G0);
+    ASSERT_NEAR(m.material.block[0].critical_stretch, s0, 1e-12 * s0);
+    ASSERT_DOUBLE_EQ(m.nodes.volume[0], dx * dx * dx);
+    ASSERT_DOUBLE_EQ(m.nodes.volume[1], dx * dx * dx);
+    const double nu = m.bonds.volume_weight(dx);
+    const double closed_form = 0.5 * c * s0 * s0 * dx * nu * std::pow(dx, 6);
+    const pd::Vec3Array u = stretched(m, 1.5 * s0);  // the step overshot s0 by half
+    pd::BreakReport r;
+    if (with_force) {  // the path of every integrator: breaking and the force in one sweep
+      pd::Vec3Array f = pd::make_vec3(2);
+      r = m.bond_model->break_bonds_and_add_force(m, u, f, nullptr, true);
+    } else {
+      r = m.bond_model->break_bonds(m, u, true);
+    }
+    EXPECT_EQ(r.broken, 1);
+    EXPECT_NEAR(r.energy, closed_form, 1e-12 * closed_form) << (with_force ? "with force" : "breaking only");
+    EXPECT_GT(closed_form, 0.0);
+  }
+}
+
 TEST(Breaking, UnbreakableBlockAndNoFailSetsKeepTheirBonds) {
   pd::Model unbreakable = pair_model(-1.0);  // fracture_energy null
   EXPECT_TRUE(std::isinf(unbreakable.material.block[0].critical_stretch));

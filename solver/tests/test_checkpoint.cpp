@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -485,4 +486,75 @@ TEST(Checkpoint, ADirectoryOrADeviceIsNoCheckpoint) {
   }
   EXPECT_FALSE(fs::exists(dir / "out" / "history.csv"));  // refused before any output
   fs::remove_all(dir);
+}
+
+namespace {
+
+// history.csv's `mode` column, row by row.
+std::vector<int> modes_of(const fs::path& history) {
+  const auto rows = lines(slurp(history));
+  std::vector<std::string> header;
+  {
+    std::istringstream in(rows.front());
+    for (std::string cell; std::getline(in, cell, ',');) header.push_back(cell);
+  }
+  const auto column = static_cast<std::size_t>(std::find(header.begin(), header.end(), "mode") - header.begin());
+  EXPECT_LT(column, header.size()) << "no mode column";
+  std::vector<int> modes;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    std::istringstream in(rows[r]);
+    std::string cell;
+    for (std::size_t k = 0; k <= column && std::getline(in, cell, ','); ++k) {
+    }
+    modes.push_back(static_cast<int>(std::stod(cell)));
+  }
+  return modes;
+}
+
+// The plate of write_case under mixed, started implicit (mixed.start), checkpointed every 7 steps.
+void write_mixed_implicit_case(const fs::path& dir) {
+  write_case(dir, "mixed", false, R"(, "restart_every_steps": 7)");
+  std::string text = slurp(dir / "case.json");
+  replace(text, R"("time": {)", R"("mixed": {"start": "implicit", "unstable_rounds": 2}, "implicit": {"rho_infinity": 0.8},
+    "time": {)");
+  std::ofstream(dir / "case.json") << text;
+}
+
+}  // namespace
+
+TEST(Checkpoint, MixedStartedImplicitShowsItsModesInHistoryAndRestartsBitwise) {
+  // The pulled plate cracks: generalized-α steps (mode 2) first, Verlet (mode 0) once bonds keep
+  // breaking; history.csv's mode column says so, run.log the switch; a run cut off after a periodic
+  // checkpoint and restarted writes the uninterrupted run's frames and rows byte for byte.
+  const fs::path whole = temp_dir("mixed_implicit_whole"), cut = temp_dir("mixed_implicit_cut");
+  write_mixed_implicit_case(whole);
+  write_mixed_implicit_case(cut);
+  ASSERT_EQ(run(whole / "case.json"), pd::kOk) << slurp(whole / "out" / "run.log");
+  const std::vector<int> modes = modes_of(whole / "out" / "history.csv");
+  ASSERT_FALSE(modes.empty());
+  EXPECT_EQ(modes.front(), 2);
+  const auto first_explicit = std::find(modes.begin(), modes.end(), 0);
+  ASSERT_NE(first_explicit, modes.end()) << "never explicit";
+  EXPECT_TRUE(std::all_of(modes.begin(), first_explicit, [](int m) { return m == 2; }));
+  EXPECT_EQ(std::count(modes.begin(), modes.end(), 1), 0);  // no quasi-static step
+  EXPECT_GT(last_value(whole / "out" / "history.csv", "broken_bonds"), 0);
+  const std::string log = slurp(whole / "out" / "run.log");
+  EXPECT_NE(log.find("implicit → explicit"), std::string::npos) << log;
+  EXPECT_NE(log.find("starts implicit (mixed.start)"), std::string::npos) << log;
+  const std::int64_t steps = total_steps(whole / "out" / "history.csv");
+  // Cut off in the implicit phase and in the explicit one.
+  const std::int64_t implicit_rows = first_explicit - modes.begin();
+  std::printf("mixed from implicit, plate: %lld steps, the first %lld rows implicit (history every 3 steps)\n",
+              static_cast<long long>(steps), static_cast<long long>(implicit_rows));
+  for (const std::int64_t stop : {std::int64_t{9}, steps * 2 / 3 + 1}) {
+    fs::remove_all(cut / "out");
+    ASSERT_EQ(run(cut / "case.json", {}, {}, stop), pd::kOk);
+    const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
+    EXPECT_EQ(ck.loop.step, stop / 7 * 7);
+    EXPECT_EQ(ck.integrator, "mixed");
+    ASSERT_EQ(run(cut / "case.json", {}, cut / "out" / "checkpoint.bin"), pd::kOk);
+    expect_same_output(whole / "out", cut / "out");
+  }
+  fs::remove_all(whole);
+  fs::remove_all(cut);
 }

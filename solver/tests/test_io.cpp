@@ -191,6 +191,8 @@ TEST(CaseFile, RejectsBadValuesNamingTheKey) {
                     {"implicit.rho_infinity: must be between 0 and 1 (1: no numerical dissipation), got 1.5"});
   expect_case_error("\"p\": 3.0, \"phi\"", "\"p\": 3.0, \"phi\": 1.0}, \"implicit\": {\"newton_tol\": 2, \"p\"",
                     {"implicit.newton_tol: must be below 1 (a relative error), got 2"});
+  expect_case_error("\"time\": {\"end\"", "\"mixed\": {\"start\": \"verlet\"}, \"time\": {\"end\"",
+                    {"mixed.start: unknown value 'verlet'; known: quasi_static, implicit"});
   expect_case_error("\"p\": 3.0", "\"p\": 3.0, \"pp\": 1", {"adaptive.pp: unknown key (did you mean 'p'?)"});
   expect_case_error("\"dt\": \"stable\"", "\"dt\": -1e-6", {"time.dt: must be > 0"});
   expect_case_error("\"integrator\": \"verlet\"", "\"integrator\": \"rk4\"", {"time.integrator: unknown integrator 'rk4'; known: adaptive, implicit, mixed, quasi_static, verlet"});

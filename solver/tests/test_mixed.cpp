@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/time_step_rule.hpp"
@@ -28,13 +30,16 @@ pd::Model breakable_bar() {
   return pd::build_model(c, std::move(nodes));
 }
 
-pd::Case mixed_case() {
+pd::Case mixed_case(const std::string& start = "quasi_static") {
   pd::Case c;
   c.time.end = kEnd;
   c.time.integrator = "mixed";
   c.quasi_static.dt_max = kEnd / 40;
   c.quasi_static.dt_initial = kEnd / 40;
+  c.implicit.dt_max = kEnd / 40;
+  c.implicit.dt_initial = kEnd / 40;
   c.mixed.arrest_steps = 50;
+  c.mixed.start = start;
   return c;
 }
 
@@ -46,8 +51,8 @@ struct BarRun {
   pd::State state{model.nodes.size()};
   double t = 0.0, dt = 0.0;
   std::vector<std::string> log;
-  BarRun() {
-    mixed.configure(mixed_case());
+  explicit BarRun(const std::string& start = "quasi_static") {
+    mixed.configure(mixed_case(start));
     mixed.initialize(state, 0.0);
     dt = *mixed.initial_dt();
   }
@@ -191,4 +196,98 @@ TEST(TimeStepRule, StableExactAndFixedAndTheErrorWithoutBonds) {
   pd::Mixed mixed(run.op);
   mixed.configure(m);
   EXPECT_EQ(mixed.explicit_dt(), run.op.exact_time_step() * 0.9);
+}
+
+TEST(Mixed, StartsImplicitSwitchesToExplicitWhenTheBarSnapsAndSaysSo) {
+  // mixed.start: implicit: generalized-α steps (mode 2) while the bar is loaded, Verlet once bonds
+  // keep breaking, the switch in run.log's line.
+  BarRun run("implicit");
+  EXPECT_EQ(run.mixed.home(), pd::Mixed::kImplicit);
+  std::vector<int> modes;
+  while (run.t < kEnd * (1 - 1e-12)) {
+    run.step();
+    modes.push_back(*run.mixed.step_mode());
+    ASSERT_LT(modes.size(), 100000u);
+  }
+  EXPECT_EQ(modes.front(), pd::Mixed::kImplicit);
+  EXPECT_EQ(std::count(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kQuasiStatic)), 0);
+  const auto first_explicit = std::find(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kExplicit));
+  ASSERT_NE(first_explicit, modes.end()) << "the bar never went explicit";
+  EXPECT_GE(first_explicit - modes.begin(), 3);
+  std::int64_t broken = 0;
+  for (auto b : run.model.bonds.broken) broken += b;
+  EXPECT_GT(broken, 0);
+  ASSERT_FALSE(run.log.empty());
+  EXPECT_EQ(run.log.front().rfind("mixed: t = ", 0), 0u) << run.log.front();
+  EXPECT_NE(run.log.front().find("implicit → explicit"), std::string::npos) << run.log.front();
+  for (std::size_t d = 0; d < 3; ++d)
+    for (double u : run.state.u[d]) ASSERT_TRUE(std::isfinite(u));
+  EXPECT_GT(run.mixed.factorisations_in_use(), 0);
+  const std::vector<std::string> plan = run.mixed.describe(0.0);
+  EXPECT_NE(plan.front().find("implicit: generalized-α"), std::string::npos) << plan.front();
+  EXPECT_NE(plan.back().find("starts implicit (mixed.start)"), std::string::npos) << plan.back();
+  std::printf("mixed from implicit: %td implicit steps before the first explicit one, %zu steps in all, %lld bonds "
+              "broken; %s\n", first_explicit - modes.begin(), modes.size(), static_cast<long long>(broken),
+              run.log.front().c_str());
+}
+
+TEST(Mixed, StartedImplicitSavedAndRestoredMidRunContinuesBitwiseInBothModes) {
+  for (const bool explicit_phase : {false, true}) {
+    BarRun a("implicit");
+    int steps = 0;
+    while (explicit_phase ? a.mixed.mode() != pd::Mixed::kExplicit || steps < 30 : steps < 3) a.step(), ++steps;
+    if (!explicit_phase) ASSERT_EQ(a.mixed.mode(), pd::Mixed::kImplicit);
+    const std::vector<char> saved = a.mixed.save_state();
+    BarRun b("implicit");
+    b.state = a.state;
+    b.model.bonds.broken = a.model.bonds.broken;
+    b.mixed.load_state(saved);
+    b.t = a.t, b.dt = a.dt;
+    for (int k = 0; k < 20; ++k) {
+      a.step(), b.step();
+      ASSERT_EQ(*a.mixed.step_mode(), *b.mixed.step_mode()) << "step " << k;
+      ASSERT_TRUE(same_bits(a.state.u, b.state.u)) << (explicit_phase ? "explicit" : "implicit") << ", step " << k;
+      ASSERT_TRUE(same_bits(a.state.v, b.state.v)) << (explicit_phase ? "explicit" : "implicit") << ", step " << k;
+      ASSERT_EQ(a.t, b.t);
+    }
+    EXPECT_EQ(a.model.bonds.broken, b.model.bonds.broken);
+  }
+}
+
+TEST(Mixed, StartedImplicitReturnsToImplicitWhenTheCrackArrests) {
+  // The bar's upper half (y > 1.5dx) cannot break (no-fail nodes), and damping calms the motion: the
+  // crack runs through the lower half and stops, Verlet takes it, and the arrest watch hands the
+  // still-loaded bar back to the implicit scheme with its motion kept.
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  c.damping = 1e5;
+  pdtest::clamp_left_pull_right(c, 4e-3 * (kNx - 1) * kDx, kEnd, true);
+  pd::Model model = pd::build_model(c, pdtest::bar_with_grips(kNx, kNy, kNz, kDx));
+  for (std::size_t i = 0; i < model.nodes.size(); ++i) model.no_fail[i] = model.nodes.x[1][i] > 1.5 * kDx;
+  pd::ForceOperator op(model);
+  pd::Mixed mixed(op);
+  mixed.configure(mixed_case("implicit"));
+  pd::State state(model.nodes.size());
+  double t = 0.0, dt = *mixed.initial_dt();
+  mixed.initialize(state, t);
+  std::vector<int> modes;
+  std::vector<std::string> log;
+  while (t < kEnd * (1 - 1e-12)) {
+    double h = std::min(dt, kEnd - t);
+    mixed.step(state, t, h);
+    dt = mixed.last_step().next_dt;
+    modes.push_back(*mixed.step_mode());
+    for (auto& line : mixed.take_log_lines()) log.push_back(line);
+    ASSERT_LT(modes.size(), 100000u);
+  }
+  const auto first_explicit = std::find(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kExplicit));
+  ASSERT_NE(first_explicit, modes.end()) << "never explicit";
+  const auto back = std::find(first_explicit, modes.end(), static_cast<int>(pd::Mixed::kImplicit));
+  ASSERT_NE(back, modes.end()) << "never back to implicit; " << (log.empty() ? "" : log.back());
+  ASSERT_GE(log.size(), 2u);
+  EXPECT_NE(log[1].find("explicit → implicit (the crack arrested"), std::string::npos) << log[1];
+  EXPECT_NE(log[1].find(" of the strain energy) kept"), std::string::npos) << log[1];
+  EXPECT_EQ(mixed.switches(), static_cast<int>(log.size()));
+  for (std::size_t d = 0; d < 3; ++d)
+    for (double u : state.u[d]) ASSERT_TRUE(std::isfinite(u));
+  std::printf("mixed from implicit, arrested crack: %zu steps; %s\n", modes.size(), log[1].c_str());
 }

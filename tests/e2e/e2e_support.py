@@ -21,16 +21,23 @@ def new_case_folder(tmp_path_factory, work_name: str, case_name: str):
     return work, case_dir
 
 
+def _run(args):
+    import subprocess
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+
+
+def prepare_stages(yaml_path, geo_path, out):
+    """The Makefile's first two stages on one case: mesh, then preprocess into out/ (case.json and
+    the node file); each must exit 0 (the failure names the stage and shows its output)."""
+    _run((PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(geo_path), str(out / "mesh.msh")))
+    _run((PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)))
+
+
 def run_stages(yaml_path, geo_path, out):
     """The Makefile's stages on one case, in order: mesh, preprocess, solve, postprocess; each must
     exit 0 (the failure names the stage and shows its output)."""
-    import subprocess
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    for args in (
-        (PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(geo_path), str(out / "mesh.msh")),
-        (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
-        (SOLVER, str(out / "case.json"), "--quiet"),
-        (PY, "-m", "postprocess", str(out)),
-    ):
-        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
-        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+    prepare_stages(yaml_path, geo_path, out)
+    _run((SOLVER, str(out / "case.json"), "--quiet"))
+    _run((PY, "-m", "postprocess", str(out)))

@@ -9,12 +9,11 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import sys
 
 import pytest
 
-from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
+from e2e_support import ROOT, SOLVER, new_case_folder, prepare_stages  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from disk_full import run_on_small_disk  # noqa: E402
@@ -33,14 +32,7 @@ def prepared(tmp_path_factory):
     case["output"] = {"every_time": 2.0e-3 / 40}
     (case_dir / "membrane.yaml").write_text(yaml.safe_dump(case))
     out = work / "prepared"
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    for args in (
-        (PY, "-m", "pipeline.run", "mesh", str(case_dir / "membrane.yaml"), str(case_dir / "membrane.geo"),
-         str(out / "mesh.msh")),
-        (PY, "-m", "pipeline.run", "preprocess", str(case_dir / "membrane.yaml"), str(out / "mesh.msh"), str(out)),
-    ):
-        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
-        assert result.returncode == 0, result.stderr
+    prepare_stages(case_dir / "membrane.yaml", case_dir / "membrane.geo", out)
     resolved = json.loads((out / "case.json").read_text())
     resolved["output_dir"] = "out"
     (out / "case.json").write_text(json.dumps(resolved, indent=1))

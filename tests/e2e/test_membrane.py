@@ -14,6 +14,8 @@ import pytest
 import yaml
 
 from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
+from postprocess.history import read_history  # noqa: E402
+from postprocess.history_units import FIXED_COLUMNS  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -91,11 +93,14 @@ def test_energy_is_dissipated_and_balanced(membrane_run):
 
 
 def test_a_single_body_runs_no_contact_search(membrane_run):
-    # One block, no self_contact, no indenters: the solver plans no contact work and writes no
-    # contact columns (formats.md §4).
+    # One block, no self_contact, no indenters: the solver plans no contact work; its history.csv
+    # still has every fixed column, the absent terms as 0 (formats.md §4, issue 16).
     log = (membrane_run / "run.log").read_text()
     assert "work: no contact search (one body and no self_contact)" in log
     assert "work: no indenters" in log
     assert "work: no breakage test (every block unbreakable)" in log
     header = (membrane_run / "history.csv").read_text().splitlines()[0].split(",")
-    assert "contact_rebuilds" not in header and "contact_energy" not in header
+    assert header == list(FIXED_COLUMNS)  # no indenters, no output.reactions: nothing more
+    history = read_history(str(membrane_run / "history.csv"))
+    for absent in ("contact_energy", "indenter_energy", "broken_bond_energy", "contact_rebuilds", "mode"):
+        assert np.all(history[absent] == 0), absent

@@ -14,7 +14,7 @@ import subprocess
 import pytest
 import yaml
 
-from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
+from e2e_support import ROOT, SOLVER, new_case_folder, prepare_stages  # noqa: E402
 
 MPIEXEC = shutil.which("mpiexec")
 # The CI runs as root, which OpenMPI refuses unless told that it is meant.
@@ -49,13 +49,7 @@ def prepared(tmp_path_factory):
     yaml_path = case_dir / "plate_with_hole.yaml"
     yaml_path.write_text(yaml.safe_dump(case))
     out = work / "prepared"
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    for args in (
-        (PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(case_dir / "plate_with_hole.geo"), str(out / "mesh.msh")),
-        (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
-    ):
-        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
-        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+    prepare_stages(yaml_path, case_dir / "plate_with_hole.geo", out)
     return work, out
 
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
+from e2e_support import ROOT, SOLVER, new_case_folder, prepare_stages  # noqa: E402
 FRAMES = 50  # frames of the whole run: enough that SIGTERM lands mid-run
 
 
@@ -34,13 +34,7 @@ def prepared(tmp_path_factory):
     yaml_path = case_dir / "membrane.yaml"
     yaml_path.write_text(yaml.safe_dump(case))
     out = work / "prepared"
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    for args in (
-        (PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(case_dir / "membrane.geo"), str(out / "mesh.msh")),
-        (PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)),
-    ):
-        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
-        assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
+    prepare_stages(yaml_path, case_dir / "membrane.geo", out)
     return work, out
 
 

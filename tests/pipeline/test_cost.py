@@ -9,29 +9,14 @@ from scipy.spatial import cKDTree
 from pipeline.case import CaseError, load_case
 from pipeline.cost import BOND_RATE, check_cost, estimate, mean_bonds
 from pipeline.stability import BOND_SLACK
-from preprocess.cloud import NodeCloud
+from minimal_case import PMMA_PLATE, lattice_cloud
 
 DX = 0.001
-CASE = """\
-dimension: 2
-thickness: 0.001
-discretization:
-  dx: 0.001
-materials:
-  plate:
-    density: 1190
-    youngs_modulus: 3.2e9
-time:
-  end: {end}
-output:
-  every_time: {every}
-"""
+CASE = PMMA_PLATE.replace("end: 1.0e-4", "end: {end}") + "output:\n  every_time: {every}\n"
 
 
-def cloud(nx=12, ny=10):
-    pts = np.array([[i * DX, j * DX, 0.0] for j in range(ny) for i in range(nx)])
-    return NodeCloud(points=pts, volume=np.full(len(pts), DX ** 3), block=np.ones(len(pts), np.int32),
-                     sets={}, grid_spacing=DX, dimension=2)
+def cloud():
+    return lattice_cloud(dx=DX)
 
 
 def case_of(tmp_path, end, every):

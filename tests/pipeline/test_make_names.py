@@ -103,3 +103,13 @@ def test_ranks_puts_the_solver_under_mpiexec():
     assert not any("mpiexec" in line for line in solve_line())
     assert not any("mpiexec" in line for line in solve_line("RANKS=1"))
     assert any("exec mpiexec --oversubscribe -np 3 'build/solver/pdsolve'" in line for line in solve_line("RANKS=3"))
+
+
+def test_ranks_resumes_a_checkpoint_under_mpiexec_too():
+    """A checkpoint of a decomposed run restarts on any rank count (issue 15): the resume branch of
+    the solve recipe runs under the same mpiexec as a fresh solve."""
+    result = make("-n", "-B", "case=membrane", "RANKS=3", "out/membrane/.solved")
+    resume = [line for line in result.stdout.splitlines() if line.strip().startswith("exec ") and "--restart" in line]
+    assert resume and all("exec mpiexec --oversubscribe -np 3 'build/solver/pdsolve'" in line for line in resume), resume
+    serial = make("-n", "-B", "case=membrane", "out/membrane/.solved")
+    assert not any("mpiexec" in line for line in serial.stdout.splitlines() if "--restart" in line)

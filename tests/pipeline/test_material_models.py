@@ -74,13 +74,28 @@ def test_every_block_uses_one_model_and_one_influence_function(tmp_path):
         load_case(str(path))
 
 
+LPS = "{model: lps, density: 7850, youngs_modulus: 2.1e11, poisson_ratio: 0.29}"
+
+
 @pytest.mark.parametrize("integrator", ["quasi_static", "mixed"])
-def test_lps_with_an_integrator_that_needs_an_assembled_tangent(tmp_path, integrator):
+def test_lps_runs_quasi_static_and_mixed_matrix_free(tmp_path, integrator):
+    """LPS has no assembled tangent, but its Newton solves run by CG with its diagonal blocks."""
     path = tmp_path / "bar.yaml"
-    path.write_text(textwrap.dedent(CASE).format(
-        material="{model: lps, density: 7850, youngs_modulus: 2.1e11, poisson_ratio: 0.29}")
-        + f"  integrator: {integrator}\n")
-    with pytest.raises(CaseError, match=f"bar.yaml:9: time.integrator: {integrator} needs an assembled tangent"):
+    path.write_text(textwrap.dedent(CASE).format(material=LPS) + f"  integrator: {integrator}\n")
+    assert load_case(str(path))["time"]["integrator"] == integrator
+
+
+def test_lps_refuses_what_factorises_the_tangent(tmp_path):
+    path = tmp_path / "bar.yaml"
+    path.write_text(textwrap.dedent(CASE).format(material=LPS) + "  integrator: implicit\n")
+    with pytest.raises(CaseError, match="bar.yaml:9: time.integrator: implicit factorises the assembled tangent"):
+        load_case(str(path))
+    path.write_text(textwrap.dedent(CASE).format(material=LPS) + "  integrator: mixed\nmixed:\n  start: implicit\n")
+    with pytest.raises(CaseError, match="bar.yaml:11: mixed.start: implicit factorises"):
+        load_case(str(path))
+    path.write_text(textwrap.dedent(CASE).format(material=LPS) + "  integrator: quasi_static\n"
+                    "quasi_static:\n  linear_solver: direct\n")
+    with pytest.raises(CaseError, match="bar.yaml:11: quasi_static.linear_solver: direct factorises"):
         load_case(str(path))
 
 

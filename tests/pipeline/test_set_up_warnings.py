@@ -9,29 +9,17 @@ from pipeline.case import CaseError, load_case
 from pipeline.conditions import check_condition_overlaps
 from pipeline.resolve import resolve
 from pipeline.stability import check_discretized_case
-from preprocess.cloud import NodeCloud
+from minimal_case import PMMA_PLATE, lattice_cloud
 
-CASE = """\
-dimension: 2
-thickness: 0.001
-discretization:
-  dx: 0.001
-materials:
-  plate:
-    density: 1190
-    youngs_modulus: 3.2e9
-time:
-  end: 1.0e-4
-"""
+CASE = PMMA_PLATE
 DX = 0.001
 
 
-def cloud(nx=12, ny=10):
-    pts = np.array([[i * DX, j * DX, 0.0] for j in range(ny) for i in range(nx)])
-    n = len(pts)
-    sets = {"left": pts[:, 0] < 2.5 * DX, "bottom": pts[:, 1] < 2.5 * DX, "plate": np.ones(n, bool)}
-    return NodeCloud(points=pts, volume=np.full(n, DX * DX * DX), block=np.ones(n, np.int32), sets=sets,
-                     grid_spacing=DX, dimension=2)
+def cloud():
+    c = lattice_cloud(dx=DX)
+    pts = c.points
+    c.sets = {"left": pts[:, 0] < 2.5 * DX, "bottom": pts[:, 1] < 2.5 * DX, "plate": np.ones(len(pts), bool)}
+    return c
 
 
 def load(tmp_path, text, time_keys=""):

@@ -13,29 +13,11 @@ from pipeline.case import CaseError, load_case
 from pipeline.resolve import resolve
 from pipeline.stability import check_discretized_case, micromodulus, stable_time_step
 from preprocess.cloud import NodeCloud
+from minimal_case import PMMA_PLATE, lattice_cloud
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# A PMMA-like plate: realistic SI values that must pass without any warning.
-CASE = """\
-dimension: 2
-thickness: 0.001
-discretization:
-  dx: 0.001
-materials:
-  plate:
-    density: 1190
-    youngs_modulus: 3.2e9
-time:
-  end: 1.0e-4
-"""
-
-
-def lattice_cloud(nx=12, ny=10, dx=0.001, thickness=0.001, extra=()):
-    pts = np.array([[i * dx, j * dx, 0.0] for j in range(ny) for i in range(nx)] + list(extra))
-    n = len(pts)
-    return NodeCloud(points=pts, volume=np.full(n, dx * dx * thickness), block=np.ones(n, np.int32),
-                     sets={}, grid_spacing=dx, dimension=2)
+CASE = PMMA_PLATE
 
 
 def checked(tmp_path, text, cloud=None):

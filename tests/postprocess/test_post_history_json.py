@@ -5,7 +5,7 @@ import re
 
 import synthetic_output as synth
 from postprocess import cli
-from postprocess.history_units import COLUMNS, describe_column, write_history_json
+from postprocess.history_units import COLUMNS, FIXED_COLUMNS, describe_column, write_history_json
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -33,8 +33,21 @@ def test_the_table_is_formats_md():
         else:
             got, _ = describe_column(name)
         assert got == ("1" if unit == "–" else unit), name
-    # every column the table knows is documented (indenter_energy: the solver's own column, when it has one)
-    assert set(COLUMNS) - set(documented) <= {"indenter_energy"}
+    # every column the table knows is documented
+    assert set(COLUMNS) <= set(documented)
+
+
+def test_fixed_columns_are_formats_md_tables_before_the_named_ones():
+    """history.json's fixed_columns: the names of formats.md §4's tables up to the first family
+    (indenter_<name>_…), in order: what every history.csv has since issue 16."""
+    with open(os.path.join(ROOT, "pipeline", "formats.md"), encoding="utf-8") as stream:
+        text = stream.read()
+    section = text[text.index("## 4. Solver output"):text.index("## 5.")]
+    names = [m.group(1) for m in re.finditer(r"^\s*\| ([^|]+?) \| \S+ \| .* \|$", section, re.MULTILINE)
+             if m.group(1) not in ("column",)]
+    fixed = names[:names.index("indenter_\\<name\\>_fx, _fy, _fz")]
+    assert fixed == list(FIXED_COLUMNS)
+    assert FIXED_COLUMNS[-5:] == ("contact_energy", "indenter_energy", "broken_bond_energy", "contact_rebuilds", "mode")
 
 
 def test_history_json_lists_every_column_in_header_order(run2d):
@@ -56,4 +69,5 @@ def test_postprocess_writes_it_beside_history_csv(run2d):
     cli.run(str(run2d.out), only="figures", log=lambda *_: None)
     content = json.loads((run2d.out / "history.json").read_text())
     assert list(content["columns"]) == synth.HISTORY_HEADER.split(",")
+    assert content["format_version"] == 2 and content["fixed_columns"] == list(FIXED_COLUMNS)
     assert all(column["unit"] for column in content["columns"].values())

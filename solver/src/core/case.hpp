@@ -77,6 +77,7 @@ struct ImplicitSettings {
 // mixed: quasi-static load steps while the body is in equilibrium, Verlet while a crack runs
 // (integrators/mixed.hpp); the quasi_static section sets the load steps, time.dt the explicit ones.
 struct MixedSettings {
+  std::string start = "quasi_static";  // quasi_static | implicit: the scheme away from a running crack
   int unstable_rounds = 3;         // re-solves at one load while bonds break, then explicit
   double kinetic_fraction = 0.05;  // back to quasi-static once kinetic < this × strain energy ...
   std::int64_t arrest_steps = 200;  // ... for this many explicit steps without a bond breaking

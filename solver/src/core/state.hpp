@@ -12,7 +12,8 @@ struct State {
   Vec3Array v;  // velocity [m/s]
   Vec3Array f;  // force density at u of every operator term (bonds, contact, indenters, body force; damping acts in the integrator) [N/m³]
   std::vector<double> w;  // strain-energy density W_i at u, from the last force evaluation [J/m³]
-  double contact_energy = 0.0;  // potential of contact pairs and indenters at u [J]
+  double contact_energy = 0.0;   // potential of the contact pairs at u [J]
+  double indenter_energy = 0.0;  // potential of the rigid indenters at u, Σ V K h³/3 [J]
   std::vector<std::array<double, 3>> indenter_force;  // force of each indenter on the body at u [N]
 
   // Work ledger, integrated with the trapezoidal rule over each step.

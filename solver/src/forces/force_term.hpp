@@ -15,7 +15,7 @@ namespace pd {
 class ForceTerm {
  public:
   virtual ~ForceTerm() = default;
-  // s.f += the term's force density at (s.u, t); adds its potential energy to s.contact_energy
+  // s.f += the term's force density at (s.u, t); adds its potential energy to s.contact_energy (contact pairs) or s.indenter_energy (indenters)
   // and sets what it reports (the indenters' forces on the body). Accumulates; never clears.
   virtual void add_force(State& s, double t) const = 0;
   // p += the power the term puts into the body at (s.u, s.v, t) [W] (0 for a conservative term

@@ -244,7 +244,7 @@ class IndenterTerm : public ForceTerm {
  public:
   explicit IndenterTerm(const Model& model) : model_(model) {}
   void add_force(State& s, double t) const override {
-    s.contact_energy += IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force);
+    s.indenter_energy += IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force);
   }
   // A moving indenter works on the body at the rate (force on the body)·(indenter velocity): the
   // contact potential depends on y − c(t), so d(KE + potential)/dt = F·ċ.

@@ -31,9 +31,24 @@ void Implicit::configure(const Case& c, double) {
   const double scale = std::isfinite(dt_sa) && dt_sa > 0.0 ? dt_sa : c.time.end;
   dt_max_ = settings_.dt_max.value_or(c.time.end / 10.0);
   dt_min_ = settings_.dt_min.value_or(std::min(1e-6 * scale, dt_max_));
+  // The Newton solves factorise the assembled tangent (CHOLMOD), which a state-based law does not
+  // have: refused here, before any work, rather than at the first step.
+  if (const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0); !missing.empty())
+    throw Error(c.file.string() + ": time.integrator: implicit factorises the assembled tangent stiffness, which " +
+                missing + " does not have; use time.integrator: verlet, quasi_static or mixed (mixed.start: quasi_static)");
   if (dt_min_ > dt_max_)
     throw Error(c.file.string() + ": implicit.dt_min = " + message_number(dt_min_) + " s is above dt_max = " +
                 message_number(dt_max_) + " s; lower implicit.dt_min or raise implicit.dt_max");
+}
+
+void Implicit::resume(const State& state) {
+  for (std::size_t q = 0; q < dofs_.size(); ++q) {
+    const auto i = static_cast<std::size_t>(dofs_.node[q]);
+    const std::size_t d = dofs_.component[q];
+    a_[d][i] = state.f[d][i] / op_.density()[i] - op_.damping() * state.v[d][i];
+  }
+  have_factor_ = false;
+  proposal_ = 0.0;
 }
 
 void Implicit::initialize(State& state, double t) {

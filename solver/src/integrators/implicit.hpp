@@ -100,6 +100,12 @@ class Implicit : public Integrator {
   double last_error() const { return last_error_; }
   const Vec3Array& acceleration() const { return a_; }
 
+  // ---- For the mixed integrator (integrators/mixed.hpp), which hands fracture to Verlet.
+  // Take over from another scheme at a state it reached (u, v, f at t; bonds broken meanwhile):
+  // a_n from the equation of motion, as initialize() takes it, and no factorisation or proposal
+  // carried over.
+  void resume(const State& state);
+
  private:
   // Newton for u_{n+1} at t1 from the predictor in s; true when converged (iterations, the last ω).
   bool solve_step(const State& start, State& s, double t1, double h, int& iterations, double& omega);

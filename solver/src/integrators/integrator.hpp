@@ -71,8 +71,8 @@ class Integrator {
   virtual bool controls_step() const { return false; }
   // The first step from the integrator's own settings (adaptive.dt_initial), once configured.
   virtual std::optional<double> initial_dt() const { return std::nullopt; }
-  // The kind of the last step, for a scheme that has several (mixed: 1 quasi-static, 0 explicit);
-  // history.csv then has a `mode` column. Empty for a scheme of one kind.
+  // The kind of the last step for history.csv's `mode` column: 1 a quasi-static load step, 0 a
+  // dynamic one (explicit or implicit). Empty: every step is dynamic (0).
   virtual std::optional<int> step_mode() const { return std::nullopt; }
   // Lines for run.log that the last step produced (a mixed scheme's switches), handed over once.
   virtual std::vector<std::string> take_log_lines() { return {}; }

@@ -1,5 +1,5 @@
-// One step of the mixed scheme: a quasi-static load step or a Verlet step, and the switches
-// between them (integrators/mixed.hpp).
+// One step of the mixed scheme: a quasi-static load step (or an implicit step, mixed.start:
+// implicit) or a Verlet step, and the switches between them (integrators/mixed.hpp).
 #include "integrators/mixed.hpp"
 
 #include <algorithm>
@@ -19,17 +19,30 @@ void Mixed::configure(const Case& c, double dt_exact) {
   if (!(dt_explicit_ > 0.0) || !std::isfinite(dt_explicit_))
     throw Error(c.file.string() + ": time.dt: the mixed scheme's explicit step is not a positive number (" +
                 message_number(dt_explicit_) + " s): the body needs bonds");
+  home_ = settings_.start == "implicit" ? kImplicit : kQuasiStatic;
+  if (home_ == kImplicit) {
+    // implicit.dt_min keeps its own default (1e-6 × eq. 2.5): a load that starts with a jump in
+    // velocity (a displacement ramp) has an O(1) local error at any step until the step is tiny,
+    // and the steps grow again 2× per step once past it. Capped at the explicit step it would
+    // fail at t = 0.
+    implicit_.configure(c, dt_exact);
+    static_dt_ = implicit_.initial_dt().value_or(implicit_.dt_max());
+    return;
+  }
   static_.configure(c, dt_exact);
   static_.limit(settings_.unstable_rounds, c.quasi_static.dt_min.value_or(10.0 * dt_explicit_));
   static_dt_ = static_.initial_dt().value_or(static_.dt_max());
 }
 
 void Mixed::initialize(State& state, double t) {
-  static_.initialize(state, t);  // the prescribed motion, the force and powers at t, the free-body check
+  // The prescribed motion, the force and powers at t (and quasi_static's free-body check).
+  if (home_ == kImplicit) implicit_.initialize(state, t);
+  else static_.initialize(state, t);
   report_ = StepReport{};
-  mode_ = kQuasiStatic;
-  step_mode_ = kQuasiStatic;
+  mode_ = home_;
+  step_mode_ = home_;
   calm_steps_ = 0;
+  breaking_steps_ = 0;
   log_lines_.clear();
 }
 
@@ -38,8 +51,8 @@ void Mixed::to_explicit(State&, double t, const std::string& reason) {
   calm_steps_ = 0;
   cracked_ = false;
   ++switches_;
-  log_lines_.push_back("mixed: t = " + message_number(t) + " s: quasi-static → explicit (" + reason + "); Verlet at dt " +
-                       message_number(dt_explicit_) + " s");
+  log_lines_.push_back("mixed: t = " + message_number(t) + " s: " + (home_ == kImplicit ? "implicit" : "quasi-static") +
+                       " → explicit (" + reason + "); Verlet at dt " + message_number(dt_explicit_) + " s");
 }
 
 void Mixed::to_quasi_static(State& state, double t, double kinetic, double strain) {
@@ -56,8 +69,46 @@ void Mixed::to_quasi_static(State& state, double t, double kinetic, double strai
                        " of the strain energy) given up, booked as damping work");
 }
 
+void Mixed::to_implicit(const State& state, double t, double kinetic, double strain) {
+  mode_ = kImplicit;
+  ++switches_;
+  breaking_steps_ = 0;
+  implicit_.resume(state);  // a_n from the equation of motion here; bonds broke in the explicit steps
+  log_lines_.push_back("mixed: t = " + message_number(t) + " s: explicit → implicit (the crack arrested: no bond broke and " +
+                       "the kinetic energy stayed below " + message_number(settings_.kinetic_fraction) +
+                       " × the strain energy for " + std::to_string(settings_.arrest_steps) + " steps); kinetic energy " +
+                       message_number(kinetic) + " J (" + message_number(strain > 0.0 ? kinetic / strain : 0.0) +
+                       " of the strain energy) kept");
+}
+
+bool Mixed::implicit_step(State& state, double& t, double& dt, int& evaluations, int& rejected) {
+  static_dt_ = dt;
+  try {
+    implicit_.step(state, t, dt);
+  } catch (const StepFailed&) {
+    // The state is still that of t (Implicit::step works on a copy and breaks bonds only in an
+    // accepted step), with its force: Verlet goes on from it.
+    evaluations = implicit_.last_step().force_evaluations;
+    rejected = implicit_.last_step().rejected + 1;
+    to_explicit(state, t, "no implicit step met Newton's and the error's tolerances down to implicit.dt_min = " +
+                              message_number(implicit_.dt_min()) + " s");
+    return false;
+  }
+  report_ = implicit_.last_step();
+  step_mode_ = kImplicit;
+  static_dt_ = report_.next_dt;
+  breaking_steps_ = report_.broken_now > 0 ? breaking_steps_ + 1 : 0;
+  if (breaking_steps_ > settings_.unstable_rounds) {
+    // The accepted step stands (a dynamic state); the next steps are Verlet's.
+    to_explicit(state, t, "bonds broke in " + std::to_string(breaking_steps_) + " implicit steps in a row: a running crack");
+    report_.next_dt = dt_explicit_;
+  }
+  return true;
+}
+
 void Mixed::step(State& state, double& t, double& dt) {
   int evaluations = 0, rejected = 0;
+  if (mode_ == kImplicit && implicit_step(state, t, dt, evaluations, rejected)) return;
   if (mode_ == kQuasiStatic) {
     broken_before_ = op_.model().bonds.broken;
     critical_before_ = op_.model().node_critical_stretch;  // LAMMPS's per-node s0 (empty unless α > 0)
@@ -97,8 +148,13 @@ void Mixed::step(State& state, double& t, double& dt) {
   if (cracked_ && report_.broken_now == 0 && kinetic < settings_.kinetic_fraction * strain) ++calm_steps_;
   else calm_steps_ = 0;
   if (calm_steps_ >= settings_.arrest_steps) {
-    to_quasi_static(state, t, kinetic, strain);
-    report_.next_dt = std::min(std::max(static_dt_, static_.dt_min()), static_.dt_max());
+    if (home_ == kImplicit) {
+      to_implicit(state, t, kinetic, strain);
+      report_.next_dt = std::min(std::max(static_dt_, implicit_.dt_min()), implicit_.dt_max());
+    } else {
+      to_quasi_static(state, t, kinetic, strain);
+      report_.next_dt = std::min(std::max(static_dt_, static_.dt_min()), static_.dt_max());
+    }
   }
 }
 
@@ -111,13 +167,15 @@ std::vector<char> Mixed::save_state() const {
   const int mode = mode_;
   const std::uint8_t cracked = cracked_ ? 1 : 0;
   put(mode), put(step_mode_), put(calm_steps_), put(static_dt_), put(switches_), put(cracked);
-  const std::vector<char> inner = static_.save_state();
+  if (home_ == kImplicit) put(breaking_steps_);  // (a quasi-static start keeps its earlier layout)
+  const std::vector<char> inner = home_ == kImplicit ? implicit_.save_state() : static_.save_state();
   bytes.insert(bytes.end(), inner.begin(), inner.end());
   return bytes;
 }
 
 void Mixed::load_state(const std::vector<char>& bytes) {
-  constexpr std::size_t own = 2 * sizeof(int) + sizeof(std::int64_t) + sizeof(double) + sizeof(int) + 1;
+  const std::size_t own = 2 * sizeof(int) + sizeof(std::int64_t) + sizeof(double) + sizeof(int) + 1 +
+                          (home_ == kImplicit ? sizeof(std::int64_t) : 0);
   if (bytes.size() < kReportBytes + own) throw std::runtime_error("integrator state of the wrong size");
   load_report(std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes)), 0);
   const char* at = bytes.data() + kReportBytes;
@@ -129,12 +187,28 @@ void Mixed::load_state(const std::vector<char>& bytes) {
   std::uint8_t cracked = 0;
   get(mode), get(step_mode_), get(calm_steps_), get(static_dt_), get(switches_), get(cracked);
   cracked_ = cracked != 0;
-  if (mode != kExplicit && mode != kQuasiStatic) throw std::runtime_error("integrator state: unknown mixed mode");
+  if (mode != kExplicit && mode != home_) throw std::runtime_error("integrator state: unknown mixed mode");
   mode_ = static_cast<Mode>(mode);
-  static_.load_state(std::vector<char>(bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes + own), bytes.end()));
+  const std::vector<char> inner(bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes + own), bytes.end());
+  if (home_ == kImplicit) {
+    get(breaking_steps_);
+    implicit_.load_state(inner);
+  } else {
+    static_.load_state(inner);
+  }
 }
 
 std::vector<std::string> Mixed::describe(double dt_exact) const {
+  if (home_ == kImplicit) {
+    std::vector<std::string> lines = implicit_.describe(dt_exact);
+    lines.push_back("mixed: starts implicit (mixed.start); explicit steps of dt " + message_number(dt_explicit_) +
+                    " s when an implicit step fails down to " + message_number(implicit_.dt_min()) +
+                    " s or bonds break in more than " + std::to_string(settings_.unstable_rounds) +
+                    " implicit steps in a row; back to implicit after " + std::to_string(settings_.arrest_steps) +
+                    " steps without breaking and with kinetic energy below " +
+                    message_number(settings_.kinetic_fraction) + " × the strain energy");
+    return lines;
+  }
   std::vector<std::string> lines = static_.describe(dt_exact);
   lines.push_back("mixed: explicit steps of dt " + message_number(dt_explicit_) + " s when a load step fails (more than " +
                   std::to_string(settings_.unstable_rounds) + " re-solves while bonds break, or no equilibrium down to " +

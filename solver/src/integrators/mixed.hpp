@@ -17,6 +17,20 @@
 //   given up (added to the damping work, so that the energy balance still closes, and said in
 //   run.log).
 //
+// mixed.start: implicit puts generalized-α implicit dynamics (integrators/implicit.hpp) in the
+// place of the quasi-static load steps, for loads where inertia matters but is slow next to the
+// explicit limit (a structure shaken or hit gently until it cracks):
+// - implicit → explicit, when an implicit step fails down to implicit.dt_min (Newton or the local
+//   error estimate: a motion the implicit step cannot follow), or when bonds have broken
+//   in more than mixed.unstable_rounds implicit steps in a row (a crack that keeps running: its tip
+//   moves at a wave speed that an implicit step set by the smooth motion does not resolve). The
+//   implicit step that broke bonds was accepted (a dynamic state, as Verlet's), so Verlet goes on
+//   from it; a failed step left the state of t_n, from which Verlet goes on.
+// - explicit → implicit, on the same arrest watch as above; the motion is dynamic in both schemes, so
+//   the kinetic energy is kept (nothing given up), and the implicit scheme takes its acceleration
+//   from the equation of motion at the current state (Implicit::resume).
+// history.csv's mode column is 2 for an implicit step.
+//
 // The explicit step is time.dt's (stable × safety_factor, exact × safety_factor, or a number), the
 // quasi-static steps those of the quasi_static section; quasi_static.dt_min defaults to 10 explicit
 // steps (a load step that must be cut below that is cheaper done explicitly). history.csv's `mode`
@@ -25,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/implicit.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/quasi_static.hpp"
 #include "integrators/verlet.hpp"
@@ -33,9 +48,9 @@ namespace pd {
 
 class Mixed : public Integrator {
  public:
-  enum Mode : int { kExplicit = 0, kQuasiStatic = 1 };
+  enum Mode : int { kExplicit = 0, kQuasiStatic = 1, kImplicit = 2 };
 
-  explicit Mixed(ForceOperator& op) : op_(op), static_(op), explicit_(op) {}
+  explicit Mixed(ForceOperator& op) : op_(op), static_(op), implicit_(op), explicit_(op) {}
   std::string name() const override { return "mixed"; }
   void configure(const Case& c, double dt_exact = 0.0) override;
   void initialize(State& state, double t) override;
@@ -47,31 +62,43 @@ class Mixed : public Integrator {
 
   std::vector<std::string> describe(double dt_exact) const override;
   bool controls_step() const override { return true; }
-  std::optional<double> initial_dt() const override { return static_.initial_dt(); }
+  std::optional<double> initial_dt() const override {
+    return home_ == kImplicit ? implicit_.initial_dt() : static_.initial_dt();
+  }
   std::optional<int> step_mode() const override { return step_mode_; }
   std::vector<std::string> take_log_lines() override { return std::move(log_lines_); }
-  std::string linear_algebra_summary() const override { return static_.linear_algebra_summary(); }
+  std::string linear_algebra_summary() const override {
+    return home_ == kImplicit ? implicit_.linear_algebra_summary() : static_.linear_algebra_summary();
+  }
 
   Mode mode() const { return mode_; }  // the mode of the next step
   double explicit_dt() const { return dt_explicit_; }
   int switches() const { return switches_; }
-  int factorisations_in_use() const { return static_.factorisations(); }
+  int factorisations_in_use() const { return home_ == kImplicit ? implicit_.factorisations() : static_.factorisations(); }
+  Mode home() const { return home_; }  // mixed.start: the scheme away from a running crack
 
  private:
   void to_explicit(State& state, double t, const std::string& reason);
   void to_quasi_static(State& state, double t, double kinetic, double strain);
+  void to_implicit(const State& state, double t, double kinetic, double strain);
+  // One implicit step, and the switch to explicit when it fails or bonds keep breaking; false when
+  // the step fell to Verlet (then evaluations and rejected say what the failed attempt cost).
+  bool implicit_step(State& state, double& t, double& dt, int& evaluations, int& rejected);
 
   ForceOperator& op_;
   QuasiStatic static_;
+  Implicit implicit_;
   VelocityVerlet explicit_;
   MixedSettings settings_;
   double dt_explicit_ = 0.0;
+  Mode home_ = kQuasiStatic;  // mixed.start
   Mode mode_ = kQuasiStatic;
   int step_mode_ = kQuasiStatic;
   std::int64_t calm_steps_ = 0;  // explicit steps in a row with no breaking and low kinetic energy
   bool cracked_ = false;         // a bond has broken in this explicit phase
   double static_dt_ = 0.0;       // the load step proposed when the quasi-static mode was left [s]
   int switches_ = 0;
+  std::int64_t breaking_steps_ = 0;  // implicit steps in a row in which bonds broke
   std::vector<std::uint8_t> broken_before_;  // the bonds' state before a quasi-static attempt
   std::vector<double> critical_before_;      // and the per-node s0 of LAMMPS's α rule
   std::vector<std::string> log_lines_;

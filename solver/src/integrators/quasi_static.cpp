@@ -45,12 +45,14 @@ void QuasiStatic::configure(const Case& c, double) {
 void QuasiStatic::choose_linear_solver(const Case& c) {
   const int dimension = op_.model().nodes.dimension;
   const std::size_t free = FreeDofs::of(op_.size(), dimension, op_.fixed()).size();
-  const bool assembled = op_.has_assembled_stiffness(State(op_.size()), 0.0);
+  const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0);
+  const bool assembled = missing.empty();
+  const bool law_assembled = assembled || missing == "contact";
   const std::string& choice = settings_.linear_solver;
   if (choice == "direct") {
     if (!assembled)
-      throw Error(c.file.string() + ": quasi_static.linear_solver: direct needs an assembled tangent, which contact "
-                  "(or the material) does not have; use linear_solver: cg (or auto)");
+      throw Error(c.file.string() + ": quasi_static.linear_solver: direct needs an assembled tangent, which " + missing +
+                  " does not have; use linear_solver: cg (or auto)");
     use_cg_ = false;
     solver_reason_ = "as the case file asks";
   } else if (choice == "cg") {
@@ -58,7 +60,8 @@ void QuasiStatic::choose_linear_solver(const Case& c) {
     solver_reason_ = "as the case file asks";
   } else if (!assembled) {
     use_cg_ = true;
-    solver_reason_ = "auto: a term (contact) has no assembled tangent";
+    solver_reason_ = law_assembled ? "auto: a term (contact) has no assembled tangent"
+                                   : "auto: the material " + op_.model().bond_model->name() + " has no assembled tangent";
   } else if (dimension == 3 && free >= kCgFromDofs3d) {
     use_cg_ = true;
     solver_reason_ = "auto: " + std::to_string(free) + " free dofs in 3D, at least " + std::to_string(kCgFromDofs3d);
@@ -93,7 +96,7 @@ void QuasiStatic::initialize(State& state, double t) {
 bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
   const auto& volume = op_.model().nodes.volume;
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
-    // A law without bond_tangent_row: unpreconditioned CG (identity blocks).
+    // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG.
     block_first_.clear();
     for (std::size_t k = 0; k <= dofs_.size(); ++k) block_first_.push_back(static_cast<std::int64_t>(k));
     blocks_.assign(9 * dofs_.size(), 0.0);

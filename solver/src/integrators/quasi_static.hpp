@@ -23,7 +23,8 @@
 // linear solve stops at ‖V f − K Δu‖ ≤ η_k ‖V f‖ with the forcing term of Eisenstat & Walker (1996,
 // choice 2), η_k = 0.9 (‖F_k‖/‖F_{k−1}‖)², safeguarded and capped at kEtaMax, and never asked below
 // half the residual tolerance (Kelley 1995, §6.3): Newton's line search and convergence tests are
-// unchanged. It needs no assembled tangent, so contact works; a direction of negative curvature
+// unchanged. It needs no assembled tangent, so contact and the state-based LPS law work (LPS gives
+// its own diagonal blocks: materials/lps/lps_tangent.cpp); a direction of negative curvature
 // (an indefinite tangent after damage) ends CG with its iterate so far (Steihaug 1983).
 #pragma once
 #include <memory>
@@ -39,6 +40,7 @@ class QuasiStatic : public Integrator {
  public:
   explicit QuasiStatic(ForceOperator& op) : op_(op) {}
   std::string name() const override { return "quasi_static"; }
+  std::optional<int> step_mode() const override { return 1; }  // every step a load step (history.csv `mode`)
   void configure(const Case& c, double dt_exact = 0.0) override;
   void initialize(State& state, double t) override;
   void step(State& state, double& t, double& dt) override;

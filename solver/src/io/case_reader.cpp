@@ -395,6 +395,11 @@ MixedSettings read_mixed(const Checker& ck, const json& j) {
   ck.object(j, "mixed");
   ck.known_keys(j, "mixed", case_keys().at("mixed"));
   MixedSettings m;
+  if (const json* v = ck.optional(j, "start")) {
+    m.start = ck.string(*v, "mixed.start");
+    if (m.start != "quasi_static" && m.start != "implicit")
+      ck.fail("mixed.start", "unknown value '" + m.start + "'; known: quasi_static, implicit");
+  }
   if (const json* v = ck.optional(j, "unstable_rounds"))
     m.unstable_rounds = static_cast<int>(ck.integer(*v, "mixed.unstable_rounds", 1, 100000000));
   if (const json* v = ck.optional(j, "kinetic_fraction")) {
@@ -451,7 +456,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
                     "dt_min", "dt_max"}},
-      {"mixed", {"unstable_rounds", "kinetic_fraction", "arrest_steps"}},
+      {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
                   "restart_every_steps", "precision", "compression", "fields", "gmsh"}},

@@ -118,6 +118,7 @@ void fields(IO& io, Checkpoint& c) {
   io.array(c.node_critical_stretch);
   io.scalar(c.contact_rebuilds), io.scalar(c.contact_seconds), io.vec3(c.contact_u_build);
   io.array(c.frame_times), io.scalar(c.history_bytes);
+  io.scalar(s.indenter_energy);  // version 3 (issue 16): before, it was part of contact_energy
 }
 
 }  // namespace

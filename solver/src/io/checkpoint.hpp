@@ -19,7 +19,7 @@
 namespace pd {
 
 // 2: the per-node critical stretch of LAMMPS's α rule after the broken flags (docs/lammps.md).
-constexpr std::uint32_t kCheckpointVersion = 2;
+constexpr std::uint32_t kCheckpointVersion = 3;
 
 struct Checkpoint {
   // What it belongs to: a restart refuses a checkpoint of another case or node file.

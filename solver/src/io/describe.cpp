@@ -153,6 +153,7 @@ json describe_case() {
   keys["implicit.dt_max"] = defaulted("number", value_or_null(im.dt_max), {{"above", 0.0}, {"unit", "s"}});
   const MixedSettings mx{};
   keys["mixed"] = defaulted("object", json::object());
+  keys["mixed.start"] = defaulted("string", mx.start, {{"choices", {"quasi_static", "implicit"}}});
   keys["mixed.unstable_rounds"] = defaulted("integer", mx.unstable_rounds, {{"minimum", 1}, {"maximum", 100000000}});
   keys["mixed.kinetic_fraction"] = defaulted("number", mx.kinetic_fraction, {{"above", 0.0}, {"below", 1.0}});
   keys["mixed.arrest_steps"] = defaulted("integer", mx.arrest_steps, {{"minimum", 1}, {"maximum", 1000000000}});

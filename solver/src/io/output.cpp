@@ -332,6 +332,12 @@ void RunLog::line(const std::string& text) {
   write_file_atomically(path_, text_);
 }
 
+void RunLog::note(const std::string& text) {
+  if (path_.empty()) return;
+  text_ += text + "\n";
+  write_file_atomically(path_, text_);
+}
+
 void RunLog::error(const std::string& text) {
   if (path_.empty()) return;
   std::cerr << text << std::endl;

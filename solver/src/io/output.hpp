@@ -104,6 +104,7 @@ class RunLog {
   RunLog(std::filesystem::path path, bool quiet, bool append = false);
   void line(const std::string& text);
   void error(const std::string& text);  // stderr always, and run.log
+  void note(const std::string& text);   // run.log only (the progress lines: run/progress.hpp)
 
  private:
   std::filesystem::path path_;

@@ -103,6 +103,14 @@ class BondModel {
   // to the same equilibrium, only no longer quadratically (the residual decides, not the matrix).
   virtual bool bond_tangent_row(const Model& model, const Vec3Array& u, std::size_t i, double* blocks,
                                 bool definite = false) const = 0;
+  // For a law without bond_tangent_row (a state-based one): every node's own block of the Jacobian,
+  // blocks[9i..9i+8] = ∂f_i/∂u_i (row-major 3×3) at u, overwritten — what the block-Jacobi
+  // preconditioner of the matrix-free solves needs (linalg/pcg.hpp). definite: leave out the terms
+  // that can make a block indefinite (as bond_tangent_row does). Returns false when the law has no
+  // such form (then its solves run unpreconditioned); a bond-based law's blocks come from its rows.
+  virtual bool jacobian_diagonal_blocks(const Model&, const Vec3Array&, std::vector<double>&, bool = false) const {
+    return false;
+  }
 };
 
 // What the registry holds per model: its parameters (the reader checks them and --describe prints

@@ -30,6 +30,7 @@ void ForceOperator::evaluate(State& s, double t) const {
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
   model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
   s.contact_energy = 0.0;
+  s.indenter_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
 }
 
@@ -49,6 +50,7 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
     if (report.broken > 0) report.energy = decomposed_->ordered_sum(lost);
   }
   s.contact_energy = 0.0;
+  s.indenter_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
   return report;
 }
@@ -70,13 +72,30 @@ bool ForceOperator::has_assembled_stiffness(const State& s, double t) const {
   return true;
 }
 
+std::string ForceOperator::missing_assembled_stiffness(const State& s, double t) const {
+  if (has_assembled_stiffness(s, t)) return "";
+  const Model& m = model_;
+  std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
+  if (!m.bond_model->bond_tangent_row(m, s.u, 0, probe.data()))
+    return "the state-based material " + m.bond_model->name() + " (its force on a node depends on the neighbours' "
+           "neighbours, so its tangent is not assembled)";
+  return "contact";  // the one term without add_tangent_diagonal
+}
+
 bool ForceOperator::stiffness_diagonal_blocks(const State& s, double t, const FreeDofs& dofs,
                                               std::vector<std::int64_t>& first, std::vector<double>& blocks) const {
   const Model& m = model_;
   const std::size_t n = m.nodes.size();
+  // A bond-based law's block is minus the sum of its row's bond blocks; a state-based law gives
+  // every node's block itself (BondModel::jacobian_diagonal_blocks), or none.
+  std::vector<double> law_blocks;
+  bool bond_based = true;
   {
     std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
-    if (n > 0 && !m.bond_model->bond_tangent_row(m, s.u, 0, probe.data(), true)) return false;
+    if (n > 0 && !m.bond_model->bond_tangent_row(m, s.u, 0, probe.data(), true)) {
+      if (!m.bond_model->jacobian_diagonal_blocks(m, s.u, law_blocks, true)) return false;
+      bond_based = false;
+    }
   }
   // Groups: the nodes with free components, in dof order.
   first.clear();
@@ -93,11 +112,16 @@ bool ForceOperator::stiffness_diagonal_blocks(const State& s, double t, const Fr
 #pragma omp for schedule(dynamic, 256)
     for (std::int64_t g = 0; g < groups; ++g) {
       const auto i = static_cast<std::size_t>(node_of[static_cast<std::size_t>(g)]);
-      row.assign(static_cast<std::size_t>(9 * (off[i + 1] - off[i])), 0.0);
-      m.bond_model->bond_tangent_row(m, s.u, i, row.data(), true);
-      double diagonal[9] = {};  // ∂f_i/∂u_i = −Σ_j ∂f_i/∂u_j for a bond-based law
-      for (std::size_t b = 0; b < row.size() / 9; ++b)
-        for (int q = 0; q < 9; ++q) diagonal[q] -= row[9 * b + static_cast<std::size_t>(q)];
+      double diagonal[9] = {};
+      if (bond_based) {
+        row.assign(static_cast<std::size_t>(9 * (off[i + 1] - off[i])), 0.0);
+        m.bond_model->bond_tangent_row(m, s.u, i, row.data(), true);
+        // ∂f_i/∂u_i = −Σ_j ∂f_i/∂u_j for a bond-based law
+        for (std::size_t b = 0; b < row.size() / 9; ++b)
+          for (int q = 0; q < 9; ++q) diagonal[q] -= row[9 * b + static_cast<std::size_t>(q)];
+      } else {
+        std::copy(&law_blocks[9 * i], &law_blocks[9 * i] + 9, diagonal);
+      }
       for (const auto& term : terms_) term->add_jacobian_diagonal(s, t, i, diagonal, true);
       // K's block over the node's free components: −V_i ∂f_i/∂u_i.
       const auto at = static_cast<std::size_t>(first[static_cast<std::size_t>(g)]);

@@ -38,7 +38,7 @@ class ForceOperator {
   const Decomposed* decomposed() const { return decomposed_; }
 
   // s.f = force density at (s.u, t) (cleared, then the bonds and every active term add into it);
-  // also s.w (strain-energy density), s.contact_energy and s.indenter_force.
+  // also s.w (strain-energy density), s.contact_energy, s.indenter_energy and s.indenter_force.
   void evaluate(State& s, double t) const;
   // Bonds over their critical stretch at s.u break (thesis §2.2: after the state update, before the
   // force there), then evaluate(s, t) in the same sweep over the bonds. Returns what broke now.
@@ -58,12 +58,15 @@ class ForceOperator {
   // Whether assemble_stiffness has a form for this scene: the law has bond_tangent_row and every
   // active term an add_tangent_diagonal (not contact).
   bool has_assembled_stiffness(const State& s, double t) const;
+  // What has no assembled form, in words for an error or run.log ("the state-based material lps",
+  // "contact"), or "" when has_assembled_stiffness.
+  std::string missing_assembled_stiffness(const State& s, double t) const;
   // The diagonal blocks of K = −V ∂f/∂u over the free dofs at (s.u, t), the block-Jacobi
   // preconditioner of the matrix-free solves (linalg/pcg.hpp): group g is a node with free
   // components, its dofs first[g] … first[g+1]−1 (FreeDofs numbers a node's dofs together), its block
   // blocks[9g…9g+8] row-major in a 3×3 frame over those dofs. From the law's definite
-  // bond_tangent_row and every term's add_jacobian_diagonal (contact included). False, and nothing
-  // filled, when the law has no bond_tangent_row.
+  // bond_tangent_row (or, for a state-based law, its jacobian_diagonal_blocks) and every term's
+  // add_jacobian_diagonal (contact included). False, and nothing filled, when the law has neither.
   bool stiffness_diagonal_blocks(const State& s, double t, const FreeDofs& dofs, std::vector<std::int64_t>& first,
                                  std::vector<double>& blocks) const;
 

@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/bonds.hpp"
@@ -45,6 +46,22 @@ class Decomposed {
   // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
   // frames' damage reads). Collective.
   virtual void gather_broken(const BondList& local, BondList& global) const = 0;
+  // Rank 0's bytes on every rank (MPI_Bcast): what rank 0 alone read (a checkpoint file, or the
+  // error it met reading it) so that every rank decides alike. Collective.
+  virtual std::string broadcast(const std::string& bytes_on_rank_0) const = 0;
+
+  // What this rank's communication has cost so far (issue 15's per-step measures): halo exchanges
+  // and ordered sums/gathers, with their wall time.
+  struct Traffic {
+    std::int64_t halo_exchanges = 0, halo_messages = 0, halo_bytes = 0;  // sent by this rank
+    std::int64_t reductions = 0, reduction_bytes = 0;                    // ordered sums and gathers, sent to rank 0
+    double halo_seconds = 0.0, reduction_seconds = 0.0;                  // wall time inside MPI calls and packing
+  };
+  virtual Traffic traffic() const = 0;
+  // run.log's lines on the decomposed run's communication: per rank, per step of `steps`, the
+  // messages and bytes it sent, its ghosts per owned node, the time in communication and its peak
+  // memory. Collective; the lines on rank 0 (empty elsewhere).
+  virtual std::vector<std::string> traffic_report(std::int64_t steps) const = 0;
 };
 
 struct Model;

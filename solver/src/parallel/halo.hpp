@@ -26,6 +26,9 @@ class HaloExchange {
   std::int64_t messages_sent() const { return static_cast<std::int64_t>(send_rank_.size()); }
   std::int64_t bytes_sent() const { return static_cast<std::int64_t>(send_node_.size()) * 3 * 8; }
   std::int64_t ghosts() const { return static_cast<std::int64_t>(recv_node_.size()); }
+  // Exchanges so far and the wall time spent in them (packing, MPI, unpacking).
+  std::int64_t exchanges() const { return exchanges_; }
+  double seconds() const { return seconds_; }
 
  private:
   MPI_Comm comm_;
@@ -35,6 +38,8 @@ class HaloExchange {
   std::vector<std::int32_t> send_node_, recv_node_;
   mutable std::vector<double> send_buffer_, recv_buffer_;
   mutable std::vector<MPI_Request> requests_;
+  mutable std::int64_t exchanges_ = 0;
+  mutable double seconds_ = 0.0;
 };
 
 }  // namespace pd

@@ -100,6 +100,16 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   return p;
 }
 
+std::vector<double> to_local(const LocalPiece& piece, const std::vector<double>& a) { return pick(a, piece.global); }
+
+void rows_to_local(const LocalPiece& piece, const BondList& global, BondList& local) {
+  for (std::int32_t l : piece.owned_local) {
+    const auto i = static_cast<std::size_t>(piece.global[static_cast<std::size_t>(l)]);
+    std::copy(global.broken.begin() + global.offsets[i], global.broken.begin() + global.offsets[i + 1],
+              local.broken.begin() + local.offsets[static_cast<std::size_t>(l)]);
+  }
+}
+
 Vec3Array to_local(const LocalPiece& piece, const Vec3Array& a) {
   Vec3Array out;
   for (int d = 0; d < 3; ++d) out[static_cast<std::size_t>(d)] = pick(a[static_cast<std::size_t>(d)], piece.global);

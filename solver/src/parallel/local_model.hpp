@@ -35,5 +35,9 @@ LocalPiece make_local_piece(const Model& global, const std::vector<std::int32_t>
 
 // a_local[l] = a_global[global[l]] for every local node (owned and ghost).
 Vec3Array to_local(const LocalPiece& piece, const Vec3Array& a_global);
+std::vector<double> to_local(const LocalPiece& piece, const std::vector<double>& a_global);
+// The broken flags of the piece's owned rows from the same rows of the whole model's bond list (a
+// restart: the checkpoint holds the whole model's flags). Ghost rows are empty.
+void rows_to_local(const LocalPiece& piece, const BondList& global, BondList& local);
 
 }  // namespace pd

@@ -1,6 +1,11 @@
 // A decomposed run on MPI's ranks (parallel/mpi_decomposed.hpp).
 #include "parallel/mpi_decomposed.hpp"
 
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cstdio>
+
 namespace pd {
 
 namespace {
@@ -31,6 +36,57 @@ double MpiDecomposed::minimum(double local) const {
   double least = local;
   MPI_Allreduce(&local, &least, 1, MPI_DOUBLE, MPI_MIN, comm_);
   return least;
+}
+
+std::string MpiDecomposed::broadcast(const std::string& bytes) const {
+  // The length first (64 bits: a checkpoint may pass 2 GB), then the bytes in chunks MPI's int counts hold.
+  std::uint64_t size = rank_ == 0 ? bytes.size() : 0;
+  MPI_Bcast(&size, 1, MPI_UINT64_T, 0, comm_);
+  std::string out = rank_ == 0 ? bytes : std::string(size, '\0');
+  constexpr std::uint64_t kChunk = 1u << 30;
+  for (std::uint64_t at = 0; at < size; at += kChunk)
+    MPI_Bcast(out.data() + at, static_cast<int>(std::min(kChunk, size - at)), MPI_CHAR, 0, comm_);
+  return out;
+}
+
+Decomposed::Traffic MpiDecomposed::traffic() const {
+  Traffic t;
+  t.halo_exchanges = halo_->exchanges();
+  t.halo_messages = halo_->exchanges() * halo_->messages_sent();
+  t.halo_bytes = halo_->exchanges() * halo_->bytes_sent();
+  t.halo_seconds = halo_->seconds();
+  t.reductions = sum_->calls();
+  t.reduction_bytes = sum_->bytes_sent();
+  t.reduction_seconds = sum_->seconds();
+  return t;
+}
+
+std::vector<std::string> MpiDecomposed::traffic_report(std::int64_t steps) const {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);  // ru_maxrss: this process's (this rank's) peak resident set, in KiB on Linux
+  const Traffic t = traffic();
+  const double per = 1.0 / static_cast<double>(std::max<std::int64_t>(steps, 1));
+  constexpr int kColumns = 10;
+  const double row[kColumns] = {static_cast<double>(piece_.owned_local.size()), static_cast<double>(piece_.ghost_local.size()),
+                                static_cast<double>(t.halo_exchanges) * per, static_cast<double>(t.halo_messages) * per,
+                                static_cast<double>(t.halo_bytes) * per, static_cast<double>(t.reductions) * per,
+                                static_cast<double>(t.reduction_bytes) * per, t.halo_seconds * per, t.reduction_seconds * per,
+                                static_cast<double>(usage.ru_maxrss) / 1024.0};
+  std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(kColumns * ranks()) : 0);
+  MPI_Gather(row, kColumns, MPI_DOUBLE, all.data(), kColumns, MPI_DOUBLE, 0, comm_);
+  std::vector<std::string> lines;
+  for (int r = 0; r < ranks() && rank_ == 0; ++r) {
+    const double* v = &all[static_cast<std::size_t>(kColumns * r)];
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "rank %d: %.0f owned nodes, %.0f ghosts (%.3f per owned node); per step: %.2g halo exchanges, "
+                  "%.3g messages and %.4g bytes sent, %.3g ordered sums/gathers sending %.4g bytes to rank 0, "
+                  "%.4g ms in communication (halo %.4g ms, sums %.4g ms); peak memory %.1f MB",
+                  r, v[0], v[1], v[1] / std::max(v[0], 1.0), v[2], v[3], v[4], v[5], v[6], 1e3 * (v[7] + v[8]), 1e3 * v[7],
+                  1e3 * v[8], v[9]);
+    lines.emplace_back(line);
+  }
+  return lines;
 }
 
 std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global) {

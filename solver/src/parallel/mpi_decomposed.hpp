@@ -39,6 +39,9 @@ class MpiDecomposed : public Decomposed {
   using Decomposed::gather;
   std::vector<double> gather(const std::vector<double>& per_node) const override { return sum_->gather(per_node); }
   void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
+  std::string broadcast(const std::string& bytes_on_rank_0) const override;
+  Traffic traffic() const override;
+  std::vector<std::string> traffic_report(std::int64_t steps) const override;
 
  private:
   MPI_Comm comm_;

@@ -24,6 +24,7 @@ OrderedSum::OrderedSum(MPI_Comm comm, const LocalPiece& piece)
 }
 
 std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) const {
+  const double start = MPI_Wtime();
   for (std::size_t k = 0; k < owned_local_.size(); ++k) send_[k] = per_node[static_cast<std::size_t>(owned_local_[k])];
   MPI_Gatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, received_.data(), counts_.data(),
               starts_.data(), MPI_DOUBLE, 0, comm_);
@@ -32,10 +33,14 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) cons
     out.resize(received_.size());
     for (std::size_t k = 0; k < received_.size(); ++k) out[static_cast<std::size_t>(gathered_node_[k])] = received_[k];
   }
+  ++calls_;
+  bytes_ += static_cast<std::int64_t>(8 * send_.size());
+  seconds_ += MPI_Wtime() - start;
   return out;
 }
 
 void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
+  const double start = MPI_Wtime();
   std::vector<std::uint8_t> flags;
   for (std::int32_t l : owned_local_)
     flags.insert(flags.end(), local.broken.begin() + local.offsets[static_cast<std::size_t>(l)],
@@ -56,6 +61,9 @@ void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
   std::vector<std::uint8_t> all(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
   MPI_Gatherv(flags.data(), static_cast<int>(flags.size()), MPI_UINT8_T, all.data(), counts.data(), starts.data(),
               MPI_UINT8_T, 0, comm_);
+  ++calls_;
+  bytes_ += static_cast<std::int64_t>(flags.size());
+  seconds_ += MPI_Wtime() - start;
   if (rank_ != 0) return;
   std::size_t at = 0;
   for (std::int32_t g32 : gathered_node_) {
@@ -69,7 +77,9 @@ double OrderedSum::sum(const std::vector<double>& per_node, double start) const 
   const std::vector<double> ordered = gather(per_node);
   if (rank_ == 0)
     for (double term : ordered) total += term;  // one by one in node order: the serial loop's bits
+  const double bcast_start = MPI_Wtime();
   MPI_Bcast(&total, 1, MPI_DOUBLE, 0, comm_);
+  seconds_ += MPI_Wtime() - bcast_start;
   return total;
 }
 

@@ -27,6 +27,10 @@ class OrderedSum {
   // The broken flags of the owned rows of `local` (the piece's bond list) into the same rows of
   // `global` (the whole model's), on rank 0. Collective.
   void gather_rows(const BondList& local, BondList& global) const;
+  // Gathers so far (sums included), the bytes this rank sent in them, and their wall time.
+  std::int64_t calls() const { return calls_; }
+  std::int64_t bytes_sent() const { return bytes_; }
+  double seconds() const { return seconds_; }
 
  private:
   MPI_Comm comm_;
@@ -37,6 +41,8 @@ class OrderedSum {
   std::vector<int> counts_, starts_;        // rank 0: per rank, its owned count and offset
   std::vector<std::int32_t> gathered_node_; // rank 0: the global number of each gathered entry
   mutable std::vector<double> send_, received_;
+  mutable std::int64_t calls_ = 0, bytes_ = 0;
+  mutable double seconds_ = 0.0;
 };
 
 }  // namespace pd

@@ -14,14 +14,31 @@ void HistoryColumns::add(std::vector<std::string> names, Fill fill) {
   names_.insert(names_.end(), names.begin(), names.end());
 }
 
+// The fixed columns that every case has, whatever its integrator, contact, indenters or breaking
+// (issue 16 item 6: a program reads the same names from every run), then one triple per indenter
+// and per output.reactions set, which the case names.
+const std::vector<std::string>& fixed_history_columns() {
+  static const std::vector<std::string> names{"contact_energy", "indenter_energy", "broken_bond_energy",
+                                              "contact_rebuilds", "mode"};
+  return names;
+}
+
 HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrator* integrator) {
   const Model* m = &model;
-  if (model.contact.pairs || !model.indenters.empty())
-    add({"contact_energy"}, [](const HistoryInputs& in, std::vector<double>& out) { out.push_back(in.state.contact_energy); });
-  if (model.contact.pairs)
-    add({"contact_rebuilds"}, [m](const HistoryInputs&, std::vector<double>& out) {
-      out.push_back(static_cast<double>(m->contact_list.rebuilds()));
-    });
+  // A term the case does not have is 0: the operator zeroes both energies before its terms add to
+  // them (operator/force_operator.cpp), and the broken-bond energy stays 0 when nothing can break.
+  add({"contact_energy", "indenter_energy", "broken_bond_energy"}, [](const HistoryInputs& in, std::vector<double>& out) {
+    out.push_back(in.state.contact_energy);
+    out.push_back(in.state.indenter_energy);
+    out.push_back(in.broken_energy);  // validation.md C4 with breaking
+  });
+  add({"contact_rebuilds"}, [m](const HistoryInputs&, std::vector<double>& out) {
+    out.push_back(m->contact.pairs ? static_cast<double>(m->contact_list.rebuilds()) : 0.0);
+  });
+  // 1 a quasi-static load step, 0 a dynamic one (explicit or implicit): integrators/integrator.hpp.
+  add({"mode"}, [integrator](const HistoryInputs&, std::vector<double>& out) {
+    out.push_back(integrator ? static_cast<double>(integrator->step_mode().value_or(0)) : 0.0);
+  });
   for (std::size_t k = 0; k < model.indenters.size(); ++k) {
     std::vector<std::string> names;
     for (const char* axis : {"fx", "fy", "fz"}) names.push_back("indenter_" + model.indenters[k].name + "_" + axis);
@@ -30,10 +47,6 @@ HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrat
         out.push_back(k < in.state.indenter_force.size() ? -in.state.indenter_force[k][d] : 0.0);
     });
   }
-  // Energy of broken bonds (validation.md C4 with breaking): when some block pair can break.
-  const bool breakable = model.material.can_break();
-  if (breakable)
-    add({"broken_bond_energy"}, [](const HistoryInputs& in, std::vector<double>& out) { out.push_back(in.broken_energy); });
   for (const auto& set : c.output.reactions) {
     std::vector<std::string> names;
     for (const char* axis : {"fx", "fy", "fz"}) names.push_back("reaction_" + set + "_" + axis);
@@ -41,10 +54,9 @@ HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrat
       for (double component : reaction_force(*m, in.state, set, in.t)) out.push_back(component);
     });
   }
-  if (integrator && integrator->step_mode())
-    add({"mode"}, [integrator](const HistoryInputs&, std::vector<double>& out) {
-      out.push_back(static_cast<double>(integrator->step_mode().value_or(0)));
-    });
+  if (names_.size() < fixed_history_columns().size() ||
+      !std::equal(fixed_history_columns().begin(), fixed_history_columns().end(), names_.begin()))
+    throw Error("history.csv: the fixed columns are out of step with fixed_history_columns()");  // a bug here
 }
 
 void HistoryColumns::fill(HistoryRow& row, const HistoryInputs& in) const {

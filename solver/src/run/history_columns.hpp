@@ -20,11 +20,14 @@ struct HistoryInputs {
   double broken_energy;  // Σ energy of bonds at the moment they broke [J]
 };
 
+// The columns after wall_time that every history.csv has, in order: contact_energy,
+// indenter_energy, broken_bond_energy, contact_rebuilds, mode.
+const std::vector<std::string>& fixed_history_columns();
+
 class HistoryColumns {
  public:
-  // Contact energy with contact or indenters; Verlet-list builds with contact; each indenter's
-  // reaction; the broken-bond energy when some block pair can break; each output.reactions set;
-  // the kind of each step (`mode`) when the integrator has several (integrators/mixed.hpp).
+  // fixed_history_columns() for every case (a term the case lacks is 0), then each indenter's
+  // reaction and each output.reactions set's (formats.md §4).
   HistoryColumns(const Model& model, const Case& c, const Integrator* integrator = nullptr);
   HistoryColumns(const HistoryColumns&) = delete;
   HistoryColumns& operator=(const HistoryColumns&) = delete;

@@ -11,6 +11,7 @@
 #include "forces/indenter.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
+#include "run/progress.hpp"
 #include "run/schedule.hpp"
 #include "run/signals.hpp"
 #include "run/text.hpp"
@@ -23,42 +24,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string duration_text(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "?";
-  char buffer[32];
-  const auto s = static_cast<long long>(seconds + 0.5);
-  if (s >= 3600) std::snprintf(buffer, sizeof buffer, "%lldh%02lldm", s / 3600, (s / 60) % 60);
-  else if (s >= 60) std::snprintf(buffer, sizeof buffer, "%lldm%02llds", s / 60, s % 60);
-  else std::snprintf(buffer, sizeof buffer, "%llds", s);
-  return buffer;
-}
-
-// The progress line on a terminal's stderr, at most twice a second; never in run.log.
-class Progress {
- public:
-  Progress(bool on, double end, std::int64_t max_steps, std::int64_t steps_expected)
-      : on_(on), end_(end), max_steps_(max_steps), steps_expected_(steps_expected) {}
-  void after_step(const LoopState& s, Clock::time_point loop_start) {
-    if (!on_ || seconds_since(last_) <= 0.5) return;
-    last_ = Clock::now();
-    const double elapsed = seconds_since(loop_start);
-    const double fraction = std::max(s.t / end_, static_cast<double>(s.step) / static_cast<double>(max_steps_));
-    std::fprintf(stderr, "\rstep %lld/%lld  t = %.4g s  %5.1f%%  ETA %s   ", static_cast<long long>(s.step),
-                 static_cast<long long>(steps_expected_), s.t, 100.0 * fraction,
-                 duration_text(elapsed * (1.0 - fraction) / std::max(fraction, 1e-12)).c_str());
-    std::fflush(stderr);
-  }
-  void clear() const {
-    if (on_) std::fprintf(stderr, "\r%70s\r", "");
-  }
-
- private:
-  bool on_;
-  double end_;
-  std::int64_t max_steps_, steps_expected_;
-  Clock::time_point last_ = Clock::now();
-};
 
 // Kinetic and strain energy of the current state, computed once per step: the blow-up watch needs
 // them every step and a history row of the same step reuses them.
@@ -89,13 +54,20 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   State& state = s.state;
   LoopState& loop = s.loop;
   const double wall_before = loop.wall_time;  // time loop of the run(s) before a restart
+  const std::int64_t first_step = loop.step;   // steps of this run: loop.step − first_step
   const Schedule schedule(p.c.output, p.c.time.end);
   const std::filesystem::path checkpoint_file = checkpoint_path(p.c);
   Energies energies(*p.op, state);
   BlowUpWatch blow_up(loop.growth);
   EnergyBalanceWatch balance(p.integrator->explicit_step());
   IndenterDepthWatch indenter_depth(p.indenter_watch);
-  Progress progress(out && !opt.quiet && isatty(fileno(stderr)), p.c.time.end, p.max_steps, p.steps_expected);
+  // Rank 0 only (the one with output): stderr's updating line on a terminal, else whole lines on
+  // stderr; run.log's lines in both cases (run/progress.hpp).
+  ProgressSettings progress_settings;
+  progress_settings.terminal = out && isatty(fileno(stderr)) != 0;
+  progress_settings.to_stderr = !opt.quiet;
+  progress_settings.interval = out ? opt.progress_interval : 0.0;
+  Progress progress(progress_settings, p.c.time.end, p.max_steps, p.steps_expected, out ? &log : nullptr);
   LoopEnd end;
 
   // What output reads: the run's state, or on a decomposed run every rank's owned part gathered on
@@ -109,6 +81,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     gathered.f = dec->gather(state.f);
     gathered.w = dec->gather(state.w);
     gathered.contact_energy = state.contact_energy;
+    gathered.indenter_energy = state.indenter_energy;
     gathered.indenter_force = state.indenter_force;
     gathered.external_power = state.external_power;
     gathered.damping_power = state.damping_power;
@@ -152,12 +125,17 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     write();
     end.output_seconds += seconds_since(output_start);
   };
-  // Written atomically (io/checkpoint.hpp), after the history rows so far are on disk.
-  const auto write_restart = [&]() {  // never on a decomposed run (run/prepare.cpp refuses checkpoints)
+  // Written atomically (io/checkpoint.hpp), after the history rows so far are on disk. On a
+  // decomposed run every rank's owned state and rows are gathered on rank 0 in global node order
+  // (the path frames take) at the same step, and rank 0 alone writes the one file, in the format of
+  // a serial run: whole, of one step, and readable on any rank count. Collective.
+  const auto write_restart = [&]() {
+    const State& whole = output_state();
+    if (!out) return;
     out->flush_history();
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
-    write_checkpoint(checkpoint_file, checkpoint_of(p, s, saved, *out));
+    write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out));
   };
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,
@@ -228,7 +206,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       break;
     }
     energies.at(loop.step);
-    const double energy = energies.kinetic + energies.strain + state.contact_energy;
+    const double energy = energies.kinetic + energies.strain + state.contact_energy + state.indenter_energy;
     if (blow_up.grew_too_long(energy)) {
       const State& st = output_state();
       if (out)
@@ -264,19 +242,13 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     if (opt.after_step) opt.after_step(loop.step);
     int signal = pending_signal();
     if (dec) signal = -static_cast<int>(dec->minimum(-signal));  // stop on every rank after the same step
-    if (signal != 0 && dec) {
-      log.error("pdsolve: interrupted by " + std::string(signal_name(signal)) + " after step " +
-                std::to_string(loop.step) + "; no checkpoint: checkpoints are not decomposed over MPI ranks yet");
-      end.status = kInterruptedBase + signal;
-      break;
-    }
     if (signal != 0) {
       end.interrupted = signal;
       write_restart();
       break;
     }
     if (restart_due) write_restart();
-    progress.after_step(loop, loop_start);
+    progress.after_step(loop.t, loop.step, seconds_since(loop_start));
   }
   progress.clear();
   // An interrupted run writes no last frame: the restart goes on with the frames of an uninterrupted run.
@@ -285,6 +257,9 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     if (out) out->finish();
   });
   end.wall = seconds_since(loop_start);
+  // What the ranks exchanged, per step of this run (issue 15's measures; bench/mpi_ranks.py reads them).
+  if (dec)
+    for (const std::string& text : dec->traffic_report(loop.step - first_step)) log.line(text);
   return end;
 }
 

@@ -75,7 +75,7 @@ std::pair<std::int64_t, std::int64_t> isolated_nodes(const Model& model) {
 
 // What is not decomposed yet is refused on several ranks, on every rank alike, before any output:
 // a clear error instead of a silently wrong result (issue 15).
-void check_decomposable(const Prepared& p, const RunOptions& opt) {
+void check_decomposable(const Prepared& p) {
   const Case& c = p.c;
   const std::string ranks = std::to_string(world_ranks().size);
   std::string what;
@@ -88,12 +88,10 @@ void check_decomposable(const Prepared& p, const RunOptions& opt) {
   else if (p.model.contact.pairs) what = "contact";
   else if (!p.model.indenters.empty()) what = "indenters";
   else if (!p.model.conditions.body_forces.empty()) what = "body forces (boundary_conditions kind body_force)";
-  else if (!opt.restart.empty()) what = "--restart";
-  else if (c.output.restart_every_time || c.output.restart_every_steps) what = "output.restart_every_time/_steps (checkpoints)";
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
-                "verlet integrator with bonds, breaking, displacement and velocity conditions, damping, frames and "
-                "history): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
+                "verlet integrator with bonds, breaking, displacement and velocity conditions, damping, frames, "
+                "history, checkpoints and restarts on any rank count): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
 }
 
 }  // namespace
@@ -124,7 +122,7 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   p->max_steps = c.time.max_steps;
   if (opt.max_steps) p->max_steps = std::min(p->max_steps, *opt.max_steps);
   if (world_ranks().size > 1) {
-    check_decomposable(*p, opt);
+    check_decomposable(*p);
     p->decomposed = decompose_over_ranks(p->model);
   }
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);

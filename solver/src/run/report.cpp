@@ -24,11 +24,13 @@ int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, cons
     log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
              std::to_string(loop.step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
              std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
+  // A checkpoint of a decomposed run holds the whole model in node order: any rank count R continues it.
   if (end.interrupted) {
     const std::string checkpoint_file = checkpoint_path(p.c).string();
     log.error("pdsolve: interrupted by " + std::string(signal_name(end.interrupted)) + " after step " +
               std::to_string(loop.step) + " (t = " + format("%.6g", loop.t) + " s); checkpoint written to " +
-              checkpoint_file + "; continue with: pdsolve " + opt.case_file.string() + " --restart " + checkpoint_file);
+              checkpoint_file + "; continue with: " +
+              (p.decomposed ? "mpiexec -np R pdsolve " : "pdsolve ") + opt.case_file.string() + " --restart " + checkpoint_file);
     return kInterruptedBase + end.interrupted;
   }
   if (end.status == kOk && loop.step >= p.max_steps && Schedule(p.c.output, p.c.time.end).before_end(loop.t))

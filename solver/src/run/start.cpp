@@ -2,6 +2,7 @@
 #include "run/start.hpp"
 
 #include "core/conditions.hpp"
+#include "io/read_file.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
 #include "run/text.hpp"
@@ -19,12 +20,47 @@ Error start_over(const RunOptions& opt, const std::exception& e) {
   return Error(std::string(e.what()) + "; to start the run over instead, delete " + opt.restart.string());
 }
 
+// The checkpoint file. On a decomposed run rank 0 alone reads it and broadcasts its bytes (or the
+// error it met): every rank then parses the same bytes and checks them alike, so a bad file is
+// refused by every rank with one message, and no rank waits for another that gave up.
+Checkpoint read_checkpoint_on_ranks(const RunOptions& opt, const Decomposed* d) {
+  if (!d) return read_checkpoint(opt.restart);
+  std::string bytes, failure;
+  if (d->rank() == 0) try {
+      bytes = read_whole_file(opt.restart, "the checkpoint");
+    } catch (const Error& e) {
+      failure = e.what();
+    }
+  failure = d->broadcast(failure);
+  if (!failure.empty()) throw Error(failure);
+  return parse_checkpoint(d->broadcast(bytes), opt.restart.string());
+}
+
+// A decomposed run's piece of the restored state: the checkpoint holds the whole model's state in
+// global node order (whatever rank count wrote it), and each rank takes its owned nodes and their
+// ghosts — exact copies, as a halo exchange would make them — and its rows' broken flags.
+void restore_piece(Prepared& p, State& whole, Start& s) {
+  LocalPiece& piece = p.decomposed->piece();
+  State& local = s.state;  // sized to the piece, initialize()d
+  local.u = to_local(piece, whole.u);
+  local.v = to_local(piece, whole.v);
+  local.f = to_local(piece, whole.f);
+  local.w = to_local(piece, whole.w);
+  local.contact_energy = whole.contact_energy;
+  local.indenter_force = whole.indenter_force;
+  local.external_power = whole.external_power;
+  local.damping_power = whole.damping_power;
+  local.external_work = whole.external_work;
+  local.damping_work = whole.damping_work;
+  rows_to_local(piece, p.model.bonds, piece.model.bonds);
+}
+
 // Replaces the fresh state by the checkpoint's, after checking that it belongs to this case.
 void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
   Integrator& integrator = *p.integrator;
   const std::size_t n = model.nodes.size();
-  Checkpoint checkpoint = read_checkpoint(opt.restart);
+  Checkpoint checkpoint = read_checkpoint_on_ranks(opt, p.decomposed.get());
   const std::string where = opt.restart.string() + ": ";
   if (checkpoint.case_hash != s.case_hash)
     throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
@@ -40,11 +76,18 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
                 std::to_string(checkpoint.directed_bonds / 2) + " bonds, integrator " + checkpoint.integrator + "; here " +
                 std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator.name() + ")");
   if (checkpoint.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
+  if (p.decomposed && model.contact.pairs)  // the Verlet list below is the whole model's, not the piece's
+    throw Error(where + "restarting a decomposed run with contact is not supported yet: restart it on one rank");
+  // Checked before any rank takes its piece: every rank holds the same whole state and decides alike
+  // (a serial run checks after restore, in start_or_restore).
+  if (p.decomposed && first_non_finite(checkpoint.state) >= 0) throw Error(where + "the checkpoint's state is not finite");
   // initialize() sizes the integrator's scratch; then everything it set is replaced by the
   // checkpoint, so the run continues bitwise as if it had never stopped.
+  if (p.decomposed) s.state = State(p.decomposed->piece().size());
   integrator.initialize(s.state, checkpoint.loop.t);
-  s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
   model.bonds.broken = std::move(checkpoint.broken_flags);
+  if (p.decomposed) restore_piece(p, checkpoint.state, s);
+  else s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
   model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
   if (model.contact.pairs)
     model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
@@ -112,7 +155,8 @@ std::string restart_line(const RunOptions& opt, const Start& s) {
          " frames kept (frames after it, history.csv rows after it: dropped)";
 }
 
-Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loop, const OutputWriter& out) {
+Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
+                         const OutputWriter& out) {
   const Model& model = p.model;
   Checkpoint k;
   k.case_hash = s.case_hash;
@@ -122,7 +166,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loo
   k.integrator = p.integrator->name();
   k.loop = loop;
   k.integrator_state = p.integrator->save_state();
-  k.state = s.state;
+  k.state = whole;
   k.broken_flags = model.bonds.broken;
   k.node_critical_stretch = model.node_critical_stretch;
   k.contact_rebuilds = model.contact_list.rebuilds();

@@ -42,6 +42,9 @@ std::string restart_line(const RunOptions& options, const Start& s);
 
 // Everything the loop carries from step to step, for checkpoint.bin. loop.wall_time: the time
 // loop's seconds up to now.
-Checkpoint checkpoint_of(const Prepared& p, const Start& s, const LoopState& loop, const OutputWriter& out);
+// `whole`: the run's state in the whole model's numbering (on a decomposed run, gathered on rank 0;
+// the broken flags are then p.model's, gathered too).
+Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
+                         const OutputWriter& out);
 
 }  // namespace pd

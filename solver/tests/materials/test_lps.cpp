@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -595,4 +597,96 @@ TEST(Lps, VerletFreeVibrationConservesEnergyToSecondOrder) {
   EXPECT_LT(drift[1], 1e-3);
   EXPECT_GT(oscillation[0] / oscillation[1], 3.5);
   EXPECT_LT(oscillation[0] / oscillation[1], 4.5);
+}
+
+namespace {
+
+// ∂f_i/∂u_i by central differences of the force: node i alone moved by ±h along each axis.
+std::array<double, 9> node_block_by_difference(const pd::Model& m, const pd::Vec3Array& u, std::size_t i, double h) {
+  std::array<double, 9> out{};
+  for (int c = 0; c < 3; ++c) {
+    pd::Vec3Array plus = u, minus = u;
+    plus[c][i] += h;
+    minus[c][i] -= h;
+    const pd::Vec3Array fp = force(m, plus), fm = force(m, minus);
+    for (int r = 0; r < 3; ++r) out[static_cast<std::size_t>(3 * r + c)] = (fp[r][i] - fm[r][i]) / (2 * h);
+  }
+  return out;
+}
+
+// The smallest eigenvalue's sign of a symmetric 3×3 block, by its principal minors: true when
+// −block is positive semi-definite (every principal minor of −block ≥ −tol·scale^k).
+bool minus_is_semi_definite(const double* b, double scale) {
+  const auto at = [b](int r, int c) { return -b[3 * r + c]; };
+  const double tol = 1e-12;
+  for (int r = 0; r < 3; ++r)
+    if (at(r, r) < -tol * scale) return false;
+  for (int r = 0; r < 3; ++r)
+    for (int c = r + 1; c < 3; ++c)
+      if (at(r, r) * at(c, c) - at(r, c) * at(c, r) < -tol * scale * scale) return false;
+  const double det = at(0, 0) * (at(1, 1) * at(2, 2) - at(1, 2) * at(2, 1)) -
+                     at(0, 1) * (at(1, 0) * at(2, 2) - at(1, 2) * at(2, 0)) +
+                     at(0, 2) * (at(1, 0) * at(2, 1) - at(1, 1) * at(2, 0));
+  return det >= -tol * scale * scale * scale;
+}
+
+}  // namespace
+
+TEST(Lps, DiagonalBlocksAreTheFiniteDifferenceOfTheForce) {
+  // The block-Jacobi preconditioner's blocks (lps_tangent.cpp) at a deformed state with a broken
+  // bond, on every node of a small brick (corners, edges, faces: b_i ≠ 0 there), both influence
+  // functions and every analysis; ν = 0.2 too, where γ = (3K − 5μ)/m < 0 in 3D.
+  for (const Analysis& a : kAnalyses)
+    for (const char* w : {"one", "gaussian"})
+      for (const double nu : {0.3, 0.2}) {
+        pd::Model m = pd::build_model(lps_case(a.dimension, a.name, {nu, w, 1.0}),
+                                      pdtest::cubic_lattice(6, 5, a.dimension == 3 ? 4 : 1, kDx, a.dimension, 1e-3));
+        const auto j = static_cast<std::size_t>(m.bonds.neighbour[3]);  // break bond 0–j (both copies), as brick() does
+        m.bonds.broken[3] = 1;
+        for (std::int64_t k = m.bonds.offsets[j]; k < m.bonds.offsets[j + 1]; ++k)
+          if (m.bonds.neighbour[static_cast<std::size_t>(k)] == 0) m.bonds.broken[static_cast<std::size_t>(k)] = 1;
+        const pd::State s = deformed(m);
+        std::vector<double> blocks;
+        ASSERT_TRUE(m.bond_model->jacobian_diagonal_blocks(m, s.u, blocks, false));
+        ASSERT_EQ(blocks.size(), 9 * m.nodes.size());
+        double worst = 0.0;
+        for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+          const std::array<double, 9> fd = node_block_by_difference(m, s.u, i, 1e-9);
+          double scale = 0.0, error = 0.0;
+          for (int q = 0; q < 9; ++q) {
+            scale = std::max(scale, std::fabs(fd[static_cast<std::size_t>(q)]));
+            error = std::max(error, std::fabs(blocks[9 * i + static_cast<std::size_t>(q)] - fd[static_cast<std::size_t>(q)]));
+          }
+          ASSERT_LT(error, 1e-6 * scale) << a.name << " ω=" << w << " ν=" << nu << " node " << i;
+          worst = std::max(worst, error / scale);
+        }
+        std::printf("[ lps      ] %s ω=%s ν=%.1f: diagonal blocks against the force's difference, worst %.2e relative\n",
+                    a.name, w, nu, worst);
+      }
+}
+
+TEST(Lps, DefiniteDiagonalBlocksArePositiveAndEqualTheFullOnesInTension) {
+  for (const Analysis& a : kAnalyses) {
+    // Compressed, ν = 0.2 (γ < 0 in 3D): the full blocks may be indefinite, the definite ones not.
+    pd::Model m = lattice(a.dimension, a.name, {0.2, "one"}, 7);
+    pd::State s(m.nodes.size());
+    const pd::Vec3Array wiggle = pdtest::pseudo_random(s.size(), 9);
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (int d = 0; d < a.dimension; ++d) s.u[d][i] = -3e-3 * m.nodes.x[d][i] + 2e-6 * wiggle[d][i];
+    std::vector<double> definite;
+    ASSERT_TRUE(m.bond_model->jacobian_diagonal_blocks(m, s.u, definite, true));
+    double scale = 0.0;
+    for (double v : definite) scale = std::max(scale, std::fabs(v));
+    for (std::size_t i = 0; i < m.nodes.size(); ++i)
+      ASSERT_TRUE(minus_is_semi_definite(&definite[9 * i], scale)) << a.name << " node " << i;
+    // Stretched, ν = 0.4 (γ > 0 in every analysis — plane stress: 2κ − 4μ > 0 needs ν > 1/3 — and
+    // every bond in tension): nothing is left out.
+    pd::Model t = lattice(a.dimension, a.name, {0.4, "one"}, 7);
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (int d = 0; d < a.dimension; ++d) s.u[d][i] = 2e-3 * t.nodes.x[d][i];
+    std::vector<double> full, kept;
+    t.bond_model->jacobian_diagonal_blocks(t, s.u, full, false);
+    t.bond_model->jacobian_diagonal_blocks(t, s.u, kept, true);
+    EXPECT_EQ(full, kept) << a.name;
+  }
 }

@@ -104,8 +104,9 @@ TEST(PmbLammps, InTheLammpsOrderABondOverItsCriticalStretchCarriesItsForceInTheS
     const pd::BreakReport r = m.bond_model->break_bonds_and_add_force(m, u, f, w, true);
     EXPECT_EQ(r.broken, 1) << order;
     EXPECT_TRUE(broken(m, 0, 1) && broken(m, 1, 0)) << order;  // broken after the pass either way
-    // The energy it held when it broke: ½ c s² |ξ| V_0 V_1.
-    EXPECT_DOUBLE_EQ(r.energy, 0.5 * kC * s * s * 1.0);
+    // The energy it held when it broke: ½ c s0² |ξ| V_0 V_1 at the critical stretch s00 it crossed,
+    // not at its stretch s = 0.06 after the pass (issue 16).
+    EXPECT_DOUBLE_EQ(r.energy, 0.5 * kC * kS00 * kS00 * 1.0);
     if (order == "lammps") {
       // f[d][i]: component d of node i
       EXPECT_DOUBLE_EQ(f[0][0], kC * s * 1.0);  // c s V_1 e/|e|, e = +x

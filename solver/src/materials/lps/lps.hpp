@@ -91,6 +91,10 @@ class LpsModel : public BondModel {
     return false;  // state-based: f_i depends on the neighbours' neighbours; solvers stay matrix-free
   }
 
+  // ∂f_i/∂u_i per node (lps_tangent.cpp): the bond terms and the dilatation's, derived there.
+  bool jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, std::vector<double>& blocks,
+                                bool definite = false) const override;
+
   // The dilatation θ_i at u over the intact bonds (for tests and output).
   std::vector<double> dilatation(const Model& model, const Vec3Array& u) const;
   const std::vector<double>& weighted_volume() const { return m_; }

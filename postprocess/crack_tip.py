@@ -1,0 +1,132 @@
+"""Crack-tip tracking: where the tip of a crack is in each frame, and how fast it runs.
+
+A node belongs to the crack when its damage φ (the share of its bonds broken, thesis eq. 2.9)
+exceeds DAMAGED. A crack grows from an origin along a direction; a *track* follows it: in every
+frame its tip is the crack node farthest along the direction among the nodes ahead of the origin
+(and on one side of the crack line when a side is given), else the origin itself. The tip speed is
+|Δ tip| / Δt over `lag` frames: a lattice crack advances in jumps of one node spacing, so a speed
+between neighbouring frames only is noisy (Bobaru & Zhang 2015 measure it the same way, over a few
+µs).
+
+How the tracks are chosen (plan_tracks):
+- a pre-crack (case.json `cracks`): from the end of the notch where new damage appears, along the
+  notch, two tracks: the crack nodes on either side of the notch line (a crack that branches is
+  followed on each branch; validation/branching.py uses the upper one);
+- no pre-crack: from the centroid of the nodes first damaged, along the principal direction of the
+  final crack (the longest axis of its nodes), two tracks: forward and backward (the two cracks
+  from the edge of a hole, or the two ends of a crack that starts inside). A track whose tip never
+  leaves its origin is dropped.
+
+Used by the normal output (postprocess/crack_plot.py: crack_path.png and crack_tips.csv) and by
+`python -m validation branching`.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+DAMAGED = 0.3    # damage above which a node belongs to the crack (validation/branching.py, C7)
+SPEED_LAG = 2    # frames over which the tip speed is measured (branching: 2 × 1 µs, as C7)
+
+
+@dataclasses.dataclass
+class Track:
+    name: str                     # legend and CSV label, e.g. "upper", "+y"
+    origin: np.ndarray            # (3,) [m]: where the crack starts (a notch tip)
+    direction: np.ndarray         # (3,) unit: along which the tip runs
+    side: np.ndarray | None = None  # (3,) unit: only nodes with (x − origin)·side ≥ 0 (one branch)
+    rests_at_origin: bool = True  # no crack node ahead: the tip is the origin (a notch tip), else NaN
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=np.float64)
+    return v / np.linalg.norm(v)
+
+
+def _points3(x) -> np.ndarray:
+    x = np.asarray(x, dtype=np.float64)
+    return x if x.shape[1] == 3 else np.hstack([x, np.zeros((len(x), 3 - x.shape[1]))])
+
+
+def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
+    """(frames, 3) tip of `track` in each frame: among the crack nodes (crack_masks[i], a bool per
+    node) ahead of the origin ((x − origin)·direction > 0) and on its side, the one farthest along
+    the direction (the first such node on a tie); when there is none, the origin (a notch tip, from
+    which the crack starts) or NaN (a crack without a notch has no tip before it appears: its
+    first tip lies on the body's edge, and a step from the origin there is no speed)."""
+    x = _points3(x)
+    relative = x - track.origin
+    ahead = relative @ track.direction
+    allowed = ahead > 0.0
+    if track.side is not None:
+        allowed &= relative @ track.side >= 0.0
+    tips = np.empty((len(crack_masks), 3))
+    for i, crack in enumerate(crack_masks):
+        candidates = np.flatnonzero(crack & allowed)
+        if len(candidates):
+            tips[i] = x[candidates[np.argmax(ahead[candidates])]]
+        else:
+            tips[i] = track.origin if track.rests_at_origin else np.nan
+    return tips
+
+
+def tip_speeds(times, tips, lag: int = SPEED_LAG) -> tuple[np.ndarray, np.ndarray]:
+    """(window mid-times [s], speeds [m/s]): |tip(t_{i+lag}) − tip(t_i)| / (t_{i+lag} − t_i).
+    Fewer than lag + 1 frames: empty arrays."""
+    t = np.asarray(times, dtype=np.float64)
+    tips = np.asarray(tips, dtype=np.float64)
+    if len(t) <= lag:
+        return np.zeros(0), np.zeros(0)
+    speed = np.linalg.norm(tips[lag:] - tips[:-lag], axis=1) / (t[lag:] - t[:-lag])
+    return 0.5 * (t[lag:] + t[:-lag]), speed
+
+
+def _xy_normal(direction: np.ndarray) -> np.ndarray:
+    """The direction turned by +90° about z: the side "above" a crack line in the xy plane."""
+    return _unit([-direction[1], direction[0], 0.0])
+
+
+def plan_tracks(x, crack_masks, cracks=()) -> list[Track]:
+    """The tracks of a run (see the module docstring): [] when no crack grew beyond the pre-cracks.
+    `cracks`: the pre-cracks as (from, to) points [m]; x the reference positions."""
+    x = _points3(x)
+    if not len(crack_masks):
+        return []
+    grown = crack_masks[-1] & ~crack_masks[0]
+    if not grown.any():
+        return []
+    tracks = []
+    if len(cracks):
+        for number, (start, end) in enumerate(cracks):
+            start, end = _points3(np.atleast_2d(start))[0], _points3(np.atleast_2d(end))[0]
+            # the notch's tip is the end nearer to the new damage
+            near = lambda p: float(np.min(np.linalg.norm(x[grown] - p, axis=1)))  # noqa: E731
+            if near(start) < near(end):
+                start, end = end, start
+            direction = _unit(end - start)
+            normal = _xy_normal(direction)
+            label = f"crack {number + 1} " if len(cracks) > 1 else ""
+            tracks += [Track(f"{label}above the notch line", end, direction, normal),
+                       Track(f"{label}below the notch line", end, direction, -normal)]
+    else:
+        first = next(i for i, crack in enumerate(crack_masks) if (crack & ~crack_masks[0]).any())
+        origin = x[crack_masks[first] & ~crack_masks[0]].mean(axis=0)
+        final = x[grown]
+        if len(final) > 1:
+            _, _, vt = np.linalg.svd(final - final.mean(axis=0), full_matrices=False)
+            direction = vt[0]
+        else:
+            direction = np.array([1.0, 0.0, 0.0])
+        # a readable sign: the largest component positive
+        direction = _unit(direction * np.sign(direction[np.argmax(np.abs(direction))]))
+        axis = "xyz"[int(np.argmax(np.abs(direction)))]
+        tracks += [Track(f"+{axis} end", origin, direction, rests_at_origin=False),
+                   Track(f"−{axis} end", origin, -direction, rests_at_origin=False)]
+
+    def moved(track):
+        tips = tip_positions(x, crack_masks, track)
+        found = np.all(np.isfinite(tips), axis=1)
+        return bool(np.any(np.linalg.norm(tips[found] - track.origin, axis=1) > 0.0))
+
+    return [t for t in tracks if moved(t)]

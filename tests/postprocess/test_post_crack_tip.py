@@ -1,0 +1,230 @@
+"""The crack-tip tracker (postprocess/crack_tip.py) on synthetic damage fields whose tip path and
+speed are known, crack_path.png checked as the other report figures are, crack_tips.csv's numbers,
+and `python -m postprocess` drawing them only when a crack grew; validation/branching.py uses the
+same tracker (no second copy)."""
+import csv
+import json
+
+import numpy as np
+import pytest
+from matplotlib import pyplot as plt
+
+import synthetic_output as synth
+from postprocess import cli, crack_plot, crack_tip
+from postprocess.casefile import CaseSettings
+from test_post_report_figures import check_readable
+
+DX = 1.0e-3                 # m
+FRAME = 2.0e-6              # s between frames
+SPEED = 500.0               # m/s: the tip advances one node spacing per frame
+NX, NY = 41, 21             # nodes along x and y
+NOTCH_Y = 10.5 * DX         # the notch line lies between node rows 10 and 11
+NOTCH_TIP = 10 * DX         # the notch runs from x = 0 to here
+START = 3                   # frames with the notch only; then the tip runs
+
+
+def grid():
+    x, y = np.meshgrid(DX * np.arange(NX), DX * np.arange(NY), indexing="xy")
+    return np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+
+
+def known_tip_x(k):
+    """x of the last crack node in frame k: the notch tip's column until START, then one column per frame."""
+    return NOTCH_TIP + DX * max(0, k - START)
+
+
+def notch_damage(points, frames=12):
+    """Damage 0.5 on the two node rows beside the notch line up to known_tip_x(k); a few decoys: a
+    node ahead of the tip with damage 0.25 (below DAMAGED) and an undamaged lattice elsewhere."""
+    x, y = points[:, 0], points[:, 1]
+    beside = np.isclose(y, 10 * DX) | np.isclose(y, 11 * DX)
+    fields = []
+    for k in range(frames):
+        damage = np.where(beside & (x <= known_tip_x(k) + 1e-12), 0.5, 0.0)
+        damage[np.isclose(x, known_tip_x(k) + 3 * DX) & np.isclose(y, 11 * DX)] = 0.25
+        fields.append(damage)
+    return np.arange(frames) * FRAME, fields
+
+
+def test_tracker_follows_a_known_tip_from_a_notch():
+    points = grid()
+    times, fields = notch_damage(points)
+    masks = [d > crack_tip.DAMAGED for d in fields]
+    tracks = crack_tip.plan_tracks(points, masks, [([0.0, NOTCH_Y, 0.0], [NOTCH_TIP, NOTCH_Y, 0.0])])
+    assert [t.name for t in tracks] == ["above the notch line", "below the notch line"]
+    assert np.allclose(tracks[0].origin, [NOTCH_TIP, NOTCH_Y, 0.0]) and np.allclose(tracks[0].direction, [1, 0, 0])
+    above = crack_tip.tip_positions(points, masks, tracks[0])
+    below = crack_tip.tip_positions(points, masks, tracks[1])
+    for k in range(len(times)):
+        if k <= START:   # nothing beyond the notch tip yet: the tip stays at the notch tip
+            assert np.allclose(above[k], tracks[0].origin)
+        else:
+            assert np.allclose(above[k], [known_tip_x(k), 11 * DX, 0.0])
+            assert np.allclose(below[k], [known_tip_x(k), 10 * DX, 0.0])
+    mid, speed = crack_tip.tip_speeds(times, below)
+    assert np.allclose(mid, times[1:-1])           # two-frame windows centred on the frames
+    running = mid > (START + 1) * FRAME             # both window ends past the notch tip
+    assert np.allclose(speed[running], SPEED, rtol=1e-12)
+    assert np.allclose(speed[mid < START * FRAME], 0.0)
+
+
+def test_tracker_without_a_notch_follows_both_ends_at_their_speeds():
+    """A crack that starts at the centre and runs up at 500 m/s and down at 250 m/s (a tip that
+    moves every other frame): two tracks, +y and −y, from the centre, at those mean speeds."""
+    points = grid()
+    x, y = points[:, 0], points[:, 1]
+    column = np.isclose(x, 20 * DX)
+    frames = 9
+    fields = []
+    for k in range(frames):
+        up, down = 10 + k, 10 - k // 2
+        fields.append(np.where(column & (y >= down * DX - 1e-12) & (y <= up * DX + 1e-12) & (k >= 1), 0.6, 0.0))
+    times = np.arange(frames) * FRAME
+    masks = [d > crack_tip.DAMAGED for d in fields]
+    tracks = crack_tip.plan_tracks(points, masks)
+    assert [t.name for t in tracks] == ["+y end", "−y end"]
+    assert np.allclose(tracks[0].origin, [20 * DX, 10.5 * DX, 0.0])  # the centroid of the first damaged nodes
+    up = crack_tip.tip_positions(points, masks, tracks[0])
+    down = crack_tip.tip_positions(points, masks, tracks[1])
+    assert np.isnan(up[0]).all() and np.isnan(down[0]).all()   # no tip before the crack appears
+    assert np.allclose(up[1:, 1], DX * (10 + np.arange(1, frames)))
+    assert np.allclose(down[2:, 1], DX * (10 - np.arange(2, frames) // 2))
+    _, speed_up = crack_tip.tip_speeds(times[1:], up[1:])
+    _, speed_down = crack_tip.tip_speeds(times[2:], down[2:])
+    assert np.allclose(speed_up, SPEED) and np.allclose(speed_down, SPEED / 2)
+
+
+def test_no_tracks_when_nothing_grew_beyond_the_notch():
+    points = grid()
+    times, fields = notch_damage(points)
+    masks = [fields[0] > crack_tip.DAMAGED] * 5
+    assert crack_tip.plan_tracks(points, masks, [([0.0, NOTCH_Y], [NOTCH_TIP, NOTCH_Y])]) == []
+    assert crack_tip.plan_tracks(points, [np.zeros(len(points), bool)] * 3) == []
+
+
+def test_validation_branching_uses_the_shared_tracker():
+    """validation/branching.py on a stand-in run: the speed the known field has, and no copy of the
+    tracker of its own."""
+    from validation import branching
+    import inspect
+    points = grid()
+    times, fields = notch_damage(points)
+
+    class Frame:
+        def __init__(self, damage):
+            self.damage = damage
+
+    class FakeRun:
+        case = {"cracks": [{"from": [0.0, NOTCH_Y, 0.0], "to": [NOTCH_TIP, NOTCH_Y, 0.0]}]}
+        x = points
+        series = list(zip(times, fields))
+
+        def __init__(self):
+            self.times = times
+
+        def frame(self, i):
+            return Frame(fields[i])
+
+    mid, speed = branching.tip_speeds(FakeRun())
+    assert np.allclose(speed[mid > (START + 1) * FRAME], SPEED)
+    assert branching.DAMAGED is crack_tip.DAMAGED
+    assert "argmax" not in inspect.getsource(branching.tip_history)
+
+
+def fracture_case():
+    return CaseSettings(name="branching", dimension=2, title="Crack branching in soda-lime glass (validation.md C7)",
+                        cracks=[([0.0, NOTCH_Y, 0.0], [NOTCH_TIP, NOTCH_Y, 0.0])])
+
+
+def test_crack_path_figure_is_readable_and_draws_the_known_speed(monkeypatch, tmp_path):
+    kept = {}
+
+    def spy(fig, path):
+        fig.canvas.draw()
+        kept["fig"] = fig
+
+    monkeypatch.setattr(crack_plot, "save_figure", spy)
+    points = grid()
+    times, fields = notch_damage(points)
+    masks = [d > crack_tip.DAMAGED for d in fields]
+    case = fracture_case()
+    tracks = crack_tip.plan_tracks(points, masks, case.cracks)
+    said = crack_plot.plot_crack_path(times, points, masks, tracks, case, str(tmp_path / "crack_path.png"))
+    fig = kept["fig"]
+    try:
+        check_readable(fig)
+        ax_path, ax_speed = fig.axes
+        assert ax_path.get_xlabel() == "x [mm]" and ax_speed.get_xlabel() == "time t [µs]"
+        assert ax_path.get_title() == "branching: crack path"
+        # the speed curves, in µs: 500 m/s once the window is past the notch tip
+        for line in ax_speed.get_lines():
+            t_us, v = line.get_xydata().T
+            assert np.allclose(v[t_us > (START + 1) * FRAME * 1e6], SPEED)
+        # the path: the last tip in mm
+        path_lines = [line for line in ax_path.get_lines() if line.get_label().startswith("tip")]
+        assert len(path_lines) == 2
+        assert np.allclose(path_lines[0].get_xydata()[-1], [known_tip_x(len(times) - 1) * 1e3, 11.0])
+        # the peak: the first step off the notch tip, which lies between two node rows
+        peak = np.hypot(2 * DX, 0.5 * DX) / (2 * FRAME)
+        assert f"peak speed {peak:.4g} m/s at {(START + 1) * FRAME * 1e6:.4g} µs" in said
+    finally:
+        plt.close(fig)
+
+
+def write_fracture_run(out, *, grow=True):
+    """A run in out/ with the notch_damage frames (or the notch only), a breakable block, the notch."""
+    out.mkdir(parents=True)
+    (out / "frames").mkdir()
+    points = grid()
+    times, fields = notch_damage(points)
+    entries = []
+    for k, (t, damage) in enumerate(zip(times, fields if grow else [fields[0]] * len(fields))):
+        name = f"frames/frame_{k:06d}.vtu"
+        synth.write_vtu(out / name, points, {"displacement": np.zeros((len(points), 3)), "damage": damage},
+                        {"TIME": float(t), "step": np.int64(k)}, np.zeros((0, 2), np.int64))
+        entries.append((float(t), name))
+    synth.write_pvd(out / "frames.pvd", entries)
+    synth.write_history(out / "history.csv", synth.history_values(rows=len(times), end=float(times[-1])))
+    case = {"format_version": 1, "case": "notched", "dimension": 2, "grid_spacing": DX,
+            "blocks": [{"id": 1, "name": "plate", "model": "pmb", "fracture_energy": 3.0}],
+            "cracks": [{"from": [0.0, NOTCH_Y, 0.0], "to": [NOTCH_TIP, NOTCH_Y, 0.0]}],
+            "figures": {"times": None, "displacement_component": 0}, "output": {"gmsh": "none"}}
+    (out / "case.json").write_text(json.dumps(case))
+    return times
+
+
+def test_postprocess_writes_crack_path_and_tip_speeds(tmp_path):
+    out = tmp_path / "notched"
+    times = write_fracture_run(out)
+    written = cli.run(str(out), log=lambda *_: None)
+    assert str(out / "figures" / "crack_path.png") in written
+    synth.png_size(out / "figures" / "crack_path.png")
+    with open(out / "crack_tips.csv", newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    assert list(rows[0]) == list(crack_plot.CSV_COLUMNS)
+    below = [r for r in rows if r["tip"] == "below the notch line"]
+    assert len(below) == len(times)
+    assert below[0]["speed"] == "" and below[-1]["speed"] == ""
+    for k, row in enumerate(below):
+        assert float(row["x"]) == pytest.approx(known_tip_x(k))
+        assert float(row["y"]) == pytest.approx(10 * DX if k > START else NOTCH_Y)   # the notch tip until it runs
+        assert float(row["extension"]) == pytest.approx(np.hypot(known_tip_x(k) - NOTCH_TIP, 0.5 * DX)
+                                                        if k > START else 0.0)
+        if START + 1 < k < len(times) - 1:
+            assert float(row["speed"]) == pytest.approx(SPEED, rel=1e-6)
+
+
+def test_postprocess_draws_no_crack_path_when_no_crack_grew(tmp_path, capsys):
+    out = tmp_path / "notched"
+    write_fracture_run(out, grow=False)
+    (out / "figures").mkdir()
+    (out / "figures" / "crack_path.png").write_bytes(b"stale")   # from an earlier run
+    cli.run(str(out), log=lambda *_: None)
+    assert not (out / "figures" / "crack_path.png").exists() and not (out / "crack_tips.csv").exists()
+    assert "crack_path.png: none, no crack grew" in capsys.readouterr().err
+
+
+def test_no_crack_outputs_for_an_unbreakable_run(run2d, capsys):
+    cli.run(str(run2d.out), log=lambda *_: None)
+    assert not (run2d.out / "figures" / "crack_path.png").exists() and not (run2d.out / "crack_tips.csv").exists()
+    assert "crack_path" not in capsys.readouterr().err
