@@ -4,7 +4,10 @@ frames.pvd and history.csv (but for its wall_time column) of the serial run.
 A coarse, short copy of cases/plate_with_hole (1234 nodes, pulled faster so that it cracks within
 300 steps) goes through mesh and preprocess as the Makefile calls them; pdsolve runs without mpirun,
 then under `mpiexec --oversubscribe -np R` for R = 1, 2, 3 with one thread per rank and for R = 2
-with two. What is not decomposed yet is refused on several ranks before any output.
+with two. The same holds for the plate with body forces and indenters (a disk pressing its top
+edge, a plane pushing its left grip; their reactions in history.csv are sums over the nodes inside)
+for the plate of LPS, the state-based law, and for the adaptive integrator. What is not decomposed yet is refused on several
+ranks before any output.
 """
 import json
 import os
@@ -107,6 +110,69 @@ def test_frames_and_history_equal_the_serial_run_byte_for_byte(runs, name):
     assert sorted(os.listdir(run)) == sorted(os.listdir(serial))
 
 
+def with_loads(case):
+    """Body forces (the whole plate in y, constant; the left grip in x, ramped) and two indenters: a disk
+    pressing the top edge (y = 0.049 m) and a plane pushing the left edge (x = 0.001 m), both inside from t = 0."""
+    case["boundary_conditions"] += [
+        {"set": "plate", "kind": "body_force", "component": 1, "times": [0.0], "values": [-4.0e7]},
+        {"set": "left", "kind": "body_force", "component": 0, "times": [0.0, 3.0e-4], "values": [0.0, 2.0e8]},
+    ]
+    case["indenters"] = [
+        {"name": "punch", "shape": "cylinder", "radius": 5.0e-3, "centre": [0.05, 0.0538, 0.0],
+         "velocity": [0.0, -5.0, 0.0], "axis": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, 0.0], "stiffness": 1.0e14},
+        {"name": "wall", "shape": "plane", "radius": 0.0, "centre": [0.0013, 0.0, 0.0],
+         "velocity": [1.0, 0.0, 0.0], "axis": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0], "stiffness": 1.0e14},
+    ]
+
+
+def as_lps(case):
+    """The plate of the linear peridynamic solid (two sweeps: the ghosts' P between them)."""
+    for block in case["blocks"]:
+        block["model"] = "lps"
+        block["poisson_ratio"] = 0.3
+
+
+def adaptive(case):
+    """The adaptive integrator (thesis §2.2), its default dt_max from the exact limit of the whole plate."""
+    case["time"]["integrator"] = "adaptive"
+
+
+@pytest.fixture(scope="module", params=["loads", "lps", "adaptive"])
+def variant_runs(request, prepared):
+    change = {"loads": with_loads, "lps": as_lps, "adaptive": adaptive}[request.param]
+    folders = {}
+    for name, ranks, threads in (("serial", None, 1), ("np2", 2, 1), ("np3", 3, 1), ("np2t2", 2, 2)):
+        folder = copy_case(prepared, f"{request.param}_{name}", change)
+        result = solve(folder, ranks, threads)
+        assert result.returncode == 0, f"{request.param} {name}: {result.stdout}\n{result.stderr}"
+        folders[name] = folder
+    return request.param, folders
+
+
+def test_loads_lps_and_adaptive_equal_the_serial_run_byte_for_byte(variant_runs):
+    kind, runs = variant_runs
+    serial = runs["serial"]
+    history = history_without_wall_time(serial)
+    header = history[0].split(",")
+    last = history[-1].split(",")
+    if kind == "loads":
+        # The punch pressed and the wall pushed: their reactions are in the history, non-zero.
+        assert "indenter_punch_fy" in header and "indenter_wall_fx" in header
+        assert float(last[header.index("indenter_punch_fy")]) > 0.0
+        assert float(last[header.index("indenter_wall_fx")]) < 0.0
+        assert float(last[header.index("contact_energy")]) > 0.0
+    else:
+        assert int(last[header.index("broken_bonds")]) > 100  # the plate cracked
+    frames = sorted(os.listdir(serial / "frames"))
+    for name in ("np2", "np3", "np2t2"):
+        run = runs[name]
+        assert history_without_wall_time(run) == history, f"{kind} {name}"
+        assert (run / "frames.pvd").read_bytes() == (serial / "frames.pvd").read_bytes()
+        assert sorted(os.listdir(run / "frames")) == frames
+        for frame in frames:
+            assert (run / "frames" / frame).read_bytes() == (serial / "frames" / frame).read_bytes(), (kind, name, frame)
+
+
 def test_run_log_says_how_the_run_was_decomposed(runs):
     assert "decomposed" not in (runs["np1"] / "run.log").read_text()  # one rank: the serial path
     for name, ranks in (("np2", 2), ("np3", 3)):
@@ -138,4 +204,17 @@ def test_lammps_s_alpha_rule_is_refused_on_several_ranks(prepared):
     assert result.returncode != 0
     assert ("blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end) is not "
             "decomposed over MPI ranks yet") in result.stderr, result.stderr
+    assert not (folder / "history.csv").exists() and not (folder / "frames").exists()
+
+
+@pytest.mark.parametrize("key, change", [
+    ("contact", lambda case: case["contact"].update(self_contact=True)),
+    ("time.integrator: quasi_static", lambda case: case["time"].update(integrator="quasi_static")),
+])
+def test_contact_and_the_implicit_integrators_stay_refused(prepared, key, change):
+    folder = copy_case(prepared, "refused_" + key.split(":")[0].replace(".", "_") + str(len(key)), change)
+    result = solve(folder, 2)
+    assert result.returncode != 0
+    assert f"{key} is not decomposed over MPI ranks yet" in result.stderr, result.stderr
+    assert "verlet and adaptive integrators with pmb and lps bonds" in result.stderr  # what is decomposed
     assert not (folder / "history.csv").exists() and not (folder / "frames").exists()

@@ -3,6 +3,7 @@
 #include "core/model.hpp"
 #include "core/state.hpp"
 #include "forces/force_term.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
@@ -11,8 +12,12 @@ class BodyForceTerm {
   explicit BodyForceTerm(const Model& model) : model_(model) {}
   // f += b(t) on every node of every body-force condition. Accumulates; never clears f.
   void AddMult(double t, Vec3Array& f) const;
-  // Σ_i V_i b_i(t)·v_i [W]
+  // Σ_i V_i b_i(t)·v_i [W], summed condition by condition, each over its nodes in node order.
   double power(double t, const Vec3Array& v) const;
+  // The same on a decomposed run (the model a rank's piece, whose conditions hold its owned nodes):
+  // one ordered sum per condition, each continuing the last (parallel/decomposed.hpp), so the
+  // serial loop's additions in its order: the same bits on every rank. Collective.
+  double power(double t, const Vec3Array& v, const Decomposed& d) const;
 
  private:
   const Model& model_;

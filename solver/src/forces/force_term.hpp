@@ -9,13 +9,19 @@
 #include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/state.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
 class ForceTerm {
  public:
   virtual ~ForceTerm() = default;
-  // s.f += the term's force density at (s.u, t); adds its potential energy to s.contact_energy (contact pairs) or s.indenter_energy (indenters)
+  // A decomposed run (issue 15): the term's model is this rank's piece, and whatever it reports as
+  // a sum over nodes (its power, the indenters' force on the body, its energy) must be the serial
+  // sum's bits on every rank: the term reduces it through `d` (parallel/decomposed.hpp). Null: serial.
+  void set_decomposed(const Decomposed* d) { decomposed_ = d; }
+  // s.f += the term's force density at (s.u, t); adds its potential energy to s.contact_energy (contact pairs)
+  // or s.indenter_energy (indenters)
   // and sets what it reports (the indenters' forces on the body). Accumulates; never clears.
   virtual void add_force(State& s, double t) const = 0;
   // p += the power the term puts into the body at (s.u, s.v, t) [W] (0 for a conservative term
@@ -37,6 +43,9 @@ class ForceTerm {
   }
   // Lines of the work plan (run.log) for this term.
   virtual std::vector<std::string> work_plan() const = 0;
+
+ protected:
+  const Decomposed* decomposed_ = nullptr;
 };
 
 // One registered term: how to build it for a scene (null when the scene does not need it) and

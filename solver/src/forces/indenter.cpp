@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <memory>
 
+#include "parallel/local_model.hpp"
+
 namespace pd {
 
 namespace {
@@ -59,8 +61,11 @@ std::array<double, 3> indenter_position(const IndenterSettings& ind, double t) {
   return {ind.centre[0] + ind.velocity[0] * t, ind.centre[1] + ind.velocity[1] * t, ind.centre[2] + ind.velocity[2] * t};
 }
 
-IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array& u, double omega2_exact) {
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
+IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array& u, double omega2_exact,
+                                      const Decomposed* dec) {
+  // A ghost's row is empty (its Σ would be wrong): a decomposed run looks at its owned nodes only.
+  const std::vector<std::int32_t>* owned = dec ? &dec->piece().owned_local : nullptr;
+  const auto n = static_cast<std::int64_t>(owned ? owned->size() : m.nodes.size());
   std::vector<IndenterShape> shapes;
   std::vector<std::array<double, 3>> centres;
   for (const IndenterSettings& ind : m.indenters) {
@@ -105,7 +110,7 @@ IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array&
   for (std::int64_t c = 0; c < chunks; ++c) {
     NodeBound& best = tightest[static_cast<std::size_t>(c)];
     for (std::int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
-      const NodeBound b = node_bound(static_cast<std::size_t>(i));
+      const NodeBound b = node_bound(owned ? static_cast<std::size_t>((*owned)[static_cast<std::size_t>(i)]) : static_cast<std::size_t>(i));
       if (b.gershgorin < best.gershgorin) best = b;
       diagonal[static_cast<std::size_t>(c)] = std::max(diagonal[static_cast<std::size_t>(c)], b.diagonal);
     }
@@ -115,6 +120,21 @@ IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array&
   for (std::size_t c = 0; c < tightest.size(); ++c) {
     if (tightest[c].gershgorin < best.gershgorin) best = tightest[c];
     max_diagonal = std::max(max_diagonal, diagonal[c]);
+  }
+  if (dec) {
+    // The serial choice over the whole body: the least bound, at the lowest global node among
+    // equals (min is exact in any order); the winner's depth and indenter, the others' +∞.
+    if (best.node >= 0) best.node = dec->piece().global[static_cast<std::size_t>(best.node)];
+    const double least = dec->minimum(best.gershgorin);
+    const bool mine = best.node >= 0 && best.gershgorin == least;
+    const double node = dec->minimum(mine ? static_cast<double>(best.node) : HUGE_VAL);
+    max_diagonal = -dec->minimum(-max_diagonal);
+    if (!std::isfinite(node)) return IndenterStepLimit{};
+    const bool winner = mine && static_cast<double>(best.node) == node;
+    best.gershgorin = least;
+    best.node = static_cast<std::int64_t>(node);
+    best.depth = dec->minimum(winner ? best.depth : HUGE_VAL);
+    best.indenter = static_cast<std::size_t>(dec->minimum(winner ? static_cast<double>(best.indenter) : HUGE_VAL));
   }
   IndenterStepLimit out;
   if (best.node < 0) return out;  // no node inside any indenter
@@ -177,6 +197,59 @@ double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
     }
   }
   return energy;
+}
+
+double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
+                              std::vector<std::array<double, 3>>& force_on_body, const Decomposed& dec) const {
+  const Model& m = model_;
+  const LocalPiece& piece = dec.piece();
+  const std::vector<std::int32_t>& owned = piece.owned_local;
+  const std::vector<std::int32_t>& global = piece.global;
+  const auto K = m.indenters.size();
+  // Rank 0 holds the whole body's chunk sums, as the serial AddMult: chunk b = global nodes
+  // [b·kChunk, (b+1)·kChunk), each summed in node order from 0, the chunks added in chunk order.
+  const std::int64_t chunks = (piece.global_nodes + kChunk - 1) / kChunk;
+  std::vector<double> totals(3 * K + 1, 0.0);  // force_on_body, then the energy
+  for (std::size_t k = 0; k < K; ++k) {
+    const IndenterSettings& ind = m.indenters[k];
+    const IndenterShape shape = indenter_shape_registry().get(ind.shape);
+    const std::array<double, 3> c = indenter_position(ind, t);
+    std::vector<std::int32_t> inside;  // global numbers of the owned nodes inside, ascending
+    std::vector<double> terms;         // their V·K h² n and V·K h³/3
+    for (std::int32_t l32 : owned) {
+      const auto q = static_cast<std::size_t>(l32);
+      const double y[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
+      double dir[3];
+      const double h = shape(ind, c.data(), y, dir);
+      if (!(h > 0.0)) continue;
+      const double magnitude = ind.stiffness * h * h;
+      const double vol = m.nodes.volume[q];
+      inside.push_back(global[q]);
+      for (std::size_t d = 0; d < 3; ++d) {
+        f[d][q] += magnitude * dir[d];
+        terms.push_back(vol * magnitude * dir[d]);
+      }
+      terms.push_back(vol * ind.stiffness * h * h * h / 3.0);
+    }
+    std::vector<std::int32_t> nodes;
+    std::vector<double> values;
+    dec.gather_entries(inside, terms, 4, nodes, values);
+    if (dec.rank() != 0) continue;
+    std::vector<double> sums(static_cast<std::size_t>(chunks) * 4, 0.0);
+    for (std::size_t e = 0; e < nodes.size(); ++e) {
+      double* s = &sums[static_cast<std::size_t>(nodes[e] / kChunk) * 4];
+      for (std::size_t r = 0; r < 4; ++r) s[r] += values[4 * e + r];
+    }
+    for (std::int64_t b = 0; b < chunks; ++b) {
+      for (std::size_t d = 0; d < 3; ++d) totals[3 * k + d] += sums[static_cast<std::size_t>(b) * 4 + d];
+      totals[3 * K] += sums[static_cast<std::size_t>(b) * 4 + 3];
+    }
+  }
+  dec.broadcast(totals);
+  force_on_body.assign(K, {0.0, 0.0, 0.0});
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t d = 0; d < 3; ++d) force_on_body[k][d] = totals[3 * k + d];
+  return totals[3 * K];
 }
 
 }  // namespace pd
@@ -244,7 +317,8 @@ class IndenterTerm : public ForceTerm {
  public:
   explicit IndenterTerm(const Model& model) : model_(model) {}
   void add_force(State& s, double t) const override {
-    s.indenter_energy += IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force);
+    s.indenter_energy += decomposed_ ? IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force, *decomposed_)
+                                     : IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force);
   }
   // A moving indenter works on the body at the rate (force on the body)·(indenter velocity): the
   // contact potential depends on y − c(t), so d(KE + potential)/dt = F·ċ.

@@ -13,6 +13,7 @@
 #include "core/model.hpp"
 #include "core/registry.hpp"
 #include "forces/force_term.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
@@ -41,7 +42,11 @@ struct IndenterStepLimit {
   double depth = 0.0;        // its depth h [m]
 };
 // omega2_exact: ω_max² of the body without indenters [1/s²], or 0 if not computed (then (a) only).
-IndenterStepLimit indenter_step_limit(const Model& model, double t, const Vec3Array& u, double omega2_exact = 0.0);
+// On a decomposed run (d not null; model and u a rank's piece): over the owned nodes, reduced over
+// the ranks to the serial result (the least dt, the lowest global node number among equals, which
+// `node` then is). Collective.
+IndenterStepLimit indenter_step_limit(const Model& model, double t, const Vec3Array& u, double omega2_exact = 0.0,
+                                      const Decomposed* d = nullptr);
 
 // How deep indenter `ind` may push any node while step dt keeps satisfying (a) or (b): the larger of
 // min_i (2ρ_i/dt² − Σ_i)/K and (4/dt² − ω_max²)·min_i ρ_i/(2K), ≥ 0. A lower bound of the depth
@@ -56,6 +61,12 @@ class IndenterForce {
   // chunks of nodes so that it does not depend on the thread count. Returns the potential
   // Σ_k Σ_i V_i·K h_i³/3 [J] (−d/dh of it is the force).
   double AddMult(double t, const Vec3Array& u, Vec3Array& f, std::vector<std::array<double, 3>>& force_on_body) const;
+  // The same on a decomposed run (issue 15; the model a rank's piece): f of the owned nodes, and
+  // force_on_body and the potential of the whole body, the serial sums' bits on every rank — the
+  // owned nodes inside an indenter send their terms to rank 0 (Decomposed::gather_entries), which
+  // sums them in the serial chunks of global node numbers and broadcasts. Collective.
+  double AddMult(double t, const Vec3Array& u, Vec3Array& f, std::vector<std::array<double, 3>>& force_on_body,
+                 const Decomposed& d) const;
   // y += ∂f/∂u·x at (u, t): the stiffness of the push, 2K·h along n, and for a curved surface the
   // turn of n with the node, K h²/r across it.
   void AddJacobianProduct(double t, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const;

@@ -10,6 +10,7 @@
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
+#include "parallel/node_sum.hpp"
 #include "integrators/messages.hpp"
 
 namespace pd {
@@ -132,11 +133,11 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
         correction_[static_cast<std::size_t>(i)] = std::sqrt(dc);
         motion_[static_cast<std::size_t>(i)] = std::sqrt(dm);
       }
-      double c = 0.0, m = 0.0;
-      for (std::int64_t i = 0; i < n; ++i) {
-        c += correction_[static_cast<std::size_t>(i)];
-        m += motion_[static_cast<std::size_t>(i)];
-      }
+      // Two sums in node order (each independent of the other), through the one reduction over
+      // nodes: on a decomposed run the serial sums' bits on every rank (ghosts left out), so every
+      // rank accepts or rejects alike.
+      const double c = sum_over_nodes(op_.decomposed(), correction_.size(), [&](std::size_t i) { return correction_[i]; });
+      const double m = sum_over_nodes(op_.decomposed(), motion_.size(), [&](std::size_t i) { return motion_[i]; });
       if (!std::isfinite(c) || !std::isfinite(m)) {
         phi_k = 0.01;
         diverged = true;

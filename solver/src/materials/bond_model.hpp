@@ -28,6 +28,8 @@
 
 namespace pd {
 
+class Decomposed;  // parallel/decomposed.hpp
+
 struct Model;
 
 // A number a model reads from its block in case.json (blocks[k].<name>), checked by the reader.
@@ -111,6 +113,22 @@ class BondModel {
   virtual bool jacobian_diagonal_blocks(const Model&, const Vec3Array&, std::vector<double>&, bool = false) const {
     return false;
   }
+
+  // A decomposed run (issue 15, parallel/local_model): the law for a rank's piece `local`, whose
+  // node l is node global[l] of the model this law was built for. By default built again from the
+  // registry on the piece; a law with per-node constants that need a whole row (LPS's m_i) copies
+  // them from this one instead, ghosts included, so they are the serial run's bits. `registry_make`
+  // is the registry's factory of this law.
+  virtual std::shared_ptr<const BondModel> for_piece(
+      const Model& local, const std::vector<std::int32_t>& global,
+      std::shared_ptr<const BondModel> (*registry_make)(const Model&)) const {
+    (void)global;
+    return registry_make(local);
+  }
+  // A decomposed run: a law whose force sweep reads per-node values of the bond's far end that only
+  // the end's own row gives (LPS's P_j) fills its ghosts' copies through `d` between its sweeps.
+  // Called once by the operator; the default law needs nothing.
+  virtual void set_decomposed(const Decomposed* d) const { (void)d; }
 };
 
 // What the registry holds per model: its parameters (the reader checks them and --describe prints

@@ -25,6 +25,12 @@ ForceOperator::ForceOperator(Model& model) : model_(model) {
   for (const auto& item : by_power) power_terms_.push_back(item.second);
 }
 
+void ForceOperator::set_decomposed(const Decomposed* d) {
+  decomposed_ = d;
+  model_.bond_model->set_decomposed(d);
+  for (const auto& term : terms_) term->set_decomposed(d);
+}
+
 void ForceOperator::evaluate(State& s, double t) const {
   if (decomposed_) decomposed_->update_ghosts(s.u);
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
@@ -282,11 +288,10 @@ double ForceOperator::external_power(const State& s, double t) const {
 // The serial loops of external_power and damping_power, one ordered sum per loop, each continuing
 // the last (parallel/decomposed.hpp): the same additions in the same order, so the same bits.
 double ForceOperator::decomposed_external_power(const State& s, double t) const {
-  // The force terms' powers are their own loops (forces/): none is decomposed yet, and the run
-  // refuses a decomposed scene that has one (check_decomposable).
-  if (!power_terms_.empty())
-    throw Error("external_power: a force term's power (body force, contact, indenters) is not decomposed yet");
+  // The force terms' powers first, in power order, each reduced by the term itself (it knows the
+  // decomposition: ForceTerm::set_decomposed), then the supports' loops.
   double p = 0.0;
+  for (const ForceTerm* term : power_terms_) term->add_power(s, t, p);
   std::vector<double> term(s.size());
   for (const auto& bc : model_.conditions.prescribed) {
     const auto c = static_cast<std::size_t>(bc.component);

@@ -34,7 +34,7 @@ class ForceOperator {
   // A decomposed run (issue 15): the model is this rank's piece (parallel/local_model), and before
   // each sweep the ghosts' displacements come from their owners; energies and break reports are
   // reduced over the ranks in an order that does not depend on them. Null (the default): serial.
-  void set_decomposed(const Decomposed* d) { decomposed_ = d; }
+  void set_decomposed(const Decomposed* d);
   const Decomposed* decomposed() const { return decomposed_; }
 
   // s.f = force density at (s.u, t) (cleared, then the bonds and every active term add into it);

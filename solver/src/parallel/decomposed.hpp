@@ -21,6 +21,8 @@ class Decomposed {
   // Sets the ghost entries of a local per-node array (e.g. the displacement) to their owners'
   // values: exact copies, so a row sums the same bits as on one rank.
   virtual void update_ghosts(Vec3Array& a) const = 0;
+  // The same for a scalar per node (LPS's P_i between its two sweeps).
+  virtual void update_ghosts(std::vector<double>& a) const = 0;
   // start + Σ over owned local nodes of per_node[l], added one by one in global node order (the
   // serial sum's order), the same on every rank: bitwise the serial result for any rank count.
   // Entries of ghosts are ignored. start lets a serial sum that runs through several loops (over
@@ -43,6 +45,14 @@ class Decomposed {
   Vec3Array gather(const Vec3Array& a) const {
     return {gather(a[0]), gather(a[1]), gather(a[2])};
   }
+  // Entries of owned nodes from every rank — entry e is node global_node[e] with the `width` values
+  // values[width·e …] — merged on rank 0 in ascending global node order (empty elsewhere): for a sum
+  // over a few nodes (those inside an indenter) that rank 0 then takes in the serial loop's order.
+  // A node is given by its owner only, so it appears once. Collective.
+  virtual void gather_entries(const std::vector<std::int32_t>& global_node, const std::vector<double>& values,
+                              int width, std::vector<std::int32_t>& all_nodes, std::vector<double>& all_values) const = 0;
+  // values = rank 0's values on every rank (the same size everywhere). Collective.
+  virtual void broadcast(std::vector<double>& values) const = 0;
   // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
   // frames' damage reads). Collective.
   virtual void gather_broken(const BondList& local, BondList& global) const = 0;

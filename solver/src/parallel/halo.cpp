@@ -60,6 +60,24 @@ HaloExchange::HaloExchange(MPI_Comm comm, const LocalPiece& piece, const std::ve
   requests_.resize(send_rank_.size() + recv_rank_.size());
 }
 
+void HaloExchange::exchange(std::vector<double>& a) const {
+  constexpr int kTag = 16;  // not the displacements' tag, though one exchange runs at a time anyway
+  std::size_t q = 0;
+  for (std::size_t m = 0; m < recv_rank_.size(); ++m) {
+    const std::int64_t begin = recv_start_[m], count = recv_start_[m + 1] - begin;
+    MPI_Irecv(recv_buffer_.data() + begin, static_cast<int>(count), MPI_DOUBLE, recv_rank_[m], kTag, comm_,
+              &requests_[q++]);
+  }
+  for (std::size_t k = 0; k < send_node_.size(); ++k) send_buffer_[k] = a[static_cast<std::size_t>(send_node_[k])];
+  for (std::size_t m = 0; m < send_rank_.size(); ++m) {
+    const std::int64_t begin = send_start_[m], count = send_start_[m + 1] - begin;
+    MPI_Isend(send_buffer_.data() + begin, static_cast<int>(count), MPI_DOUBLE, send_rank_[m], kTag, comm_,
+              &requests_[q++]);
+  }
+  MPI_Waitall(static_cast<int>(q), requests_.data(), MPI_STATUSES_IGNORE);
+  for (std::size_t k = 0; k < recv_node_.size(); ++k) a[static_cast<std::size_t>(recv_node_[k])] = recv_buffer_[k];
+}
+
 void HaloExchange::exchange(Vec3Array& a) const {
   constexpr int kTag = 15;  // issue 15; one exchange at a time, so one tag suffices
   const double start = MPI_Wtime();

@@ -21,6 +21,8 @@ class HaloExchange {
 
   // a's ghost entries = their owners' entries (3 doubles per ghost). Collective over comm.
   void exchange(Vec3Array& a) const;
+  // a's ghost entries = their owners' entries, for a scalar per node (1 double per ghost). Collective.
+  void exchange(std::vector<double>& a) const;
 
   // Per exchange, from this rank: messages sent and bytes sent (of payload).
   std::int64_t messages_sent() const { return static_cast<std::int64_t>(send_rank_.size()); }

@@ -94,9 +94,9 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
     if (g.conditions.fixed[static_cast<std::size_t>(d)].size() == n)
       m.conditions.fixed[static_cast<std::size_t>(d)] = pick(g.conditions.fixed[static_cast<std::size_t>(d)], p.global);
 
-  // The law again from the registry on the local model: a model that precomputes per-node
-  // quantities (materials/bond_model.hpp MaterialDefinition::make) computes them for these nodes.
-  m.bond_model = material_registry().get(g.bond_model->name()).make(m);
+  // The law for the piece (materials/bond_model.hpp for_piece): by default built again from the
+  // registry on the local model; a law whose per-node constants need whole rows copies them.
+  m.bond_model = g.bond_model->for_piece(m, p.global, material_registry().get(g.bond_model->name()).make);
   return p;
 }
 

@@ -30,6 +30,7 @@ class MpiDecomposed : public Decomposed {
   const HaloExchange& halo() const { return *halo_; }
 
   void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
+  void update_ghosts(std::vector<double>& a) const override { halo_->exchange(a); }
   double ordered_sum(const std::vector<double>& per_node, double start = 0.0) const override {
     return sum_->sum(per_node, start);
   }
@@ -38,6 +39,9 @@ class MpiDecomposed : public Decomposed {
 
   using Decomposed::gather;
   std::vector<double> gather(const std::vector<double>& per_node) const override { return sum_->gather(per_node); }
+  void gather_entries(const std::vector<std::int32_t>& global_node, const std::vector<double>& values, int width,
+                      std::vector<std::int32_t>& all_nodes, std::vector<double>& all_values) const override;
+  void broadcast(std::vector<double>& values) const override;
   void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
   std::string broadcast(const std::string& bytes_on_rank_0) const override;
   Traffic traffic() const override;

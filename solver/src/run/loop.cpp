@@ -227,7 +227,9 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       break;
     }
     if (indenter_depth.watching()) {
-      const IndenterStepLimit limit = indenter_step_limit(model, loop.t, state.u, p.omega2_exact);
+      const IndenterStepLimit limit =
+          dec ? indenter_step_limit(dec->piece().model, loop.t, state.u, p.omega2_exact, dec)
+              : indenter_step_limit(model, loop.t, state.u, p.omega2_exact);
       if (const auto warning = indenter_depth.check(
               limit, loop.step, loop.t, loop.dt_taken, [&] { return model.indenters[limit.indenter].name; },
               [&] { return node_text(model, limit.node); }))

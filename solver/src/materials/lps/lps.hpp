@@ -94,6 +94,13 @@ class LpsModel : public BondModel {
   // ∂f_i/∂u_i per node (lps_tangent.cpp): the bond terms and the dilatation's, derived there.
   bool jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, std::vector<double>& blocks,
                                 bool definite = false) const override;
+  // A decomposed run (issue 15): the piece's law takes m_i, κ, α, a, b of every local node, ghosts
+  // too, from this whole-model law (a ghost's row is empty on the piece, so its m could not be
+  // summed there), and between the sweeps fills the ghosts' P_j from their owners (one scalar per
+  // ghost: the force sweep's t_ij + t_ji needs P of both ends).
+  std::shared_ptr<const BondModel> for_piece(const Model& local, const std::vector<std::int32_t>& global,
+                                             std::shared_ptr<const BondModel> (*registry_make)(const Model&)) const override;
+  void set_decomposed(const Decomposed* d) const override { decomposed_ = d; }
 
   // The dilatation θ_i at u over the intact bonds (for tests and output).
   std::vector<double> dilatation(const Model& model, const Vec3Array& u) const;
@@ -108,6 +115,8 @@ class LpsModel : public BondModel {
   std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
   std::vector<double> a_;      // α_i / m_i
   std::vector<double> b_;      // d κ_i / m_i
+  // Set once by the operator of a decomposed run (set_decomposed), before any sweep; null: serial.
+  mutable const Decomposed* decomposed_ = nullptr;
 
   friend struct LpsKernel;
 };

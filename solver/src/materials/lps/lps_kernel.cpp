@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "materials/lps/lps_kernel.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
@@ -243,6 +244,7 @@ void LpsModel::add_force(const Model& model, const Vec3Array& u, Vec3Array& f, d
   const LpsKernel k(*this, model, u);
   std::vector<double> theta, p;
   dilatation_sweep(k, nullptr, theta, p);
+  if (decomposed_) decomposed_->update_ghosts(p);  // P_j of the ghosts, for t_ij + t_ji
   force_sweep(k, theta, p, f, w);
 }
 
@@ -253,6 +255,9 @@ BreakReport LpsModel::break_bonds_and_add_force(Model& model, const Vec3Array& u
   const Breaking br = breaking_of(model, want_energy ? lost.data() : nullptr);
   BreakReport r;
   r.broken = dilatation_sweep(k, model.material.can_break() ? &br : nullptr, theta, p);
+  // P_j of the ghosts, after their owners broke their rows: both ends of a crossing bond broke it
+  // in this sweep (the same stretch from exact copies of u), so P_j is the serial one.
+  if (decomposed_) decomposed_->update_ghosts(p);
   force_sweep(k, theta, p, f, w);
   if (lost_per_node && want_energy) {  // the caller sums the shares (materials/bond_model.hpp)
     std::copy(lost.begin(), lost.end(), lost_per_node);

@@ -49,6 +49,23 @@ LpsModel::LpsModel(const Model& model) {
   }
 }
 
+std::shared_ptr<const BondModel> LpsModel::for_piece(const Model&, const std::vector<std::int32_t>& global,
+                                                     std::shared_ptr<const BondModel> (*)(const Model&)) const {
+  auto local = std::make_shared<LpsModel>(*this);
+  const auto pick = [&](const std::vector<double>& a) {
+    std::vector<double> out(global.size());
+    for (std::size_t l = 0; l < global.size(); ++l) out[l] = a[static_cast<std::size_t>(global[l])];
+    return out;
+  };
+  local->m_ = pick(m_);
+  local->kappa_ = pick(kappa_);
+  local->alpha_ = pick(alpha_);
+  local->a_ = pick(a_);
+  local->b_ = pick(b_);
+  local->decomposed_ = nullptr;
+  return local;
+}
+
 std::vector<double> LpsModel::damage(const Model& m) const { return bond_damage(m); }  // as PMB's
 
 // Eq. 2.5's term for bond i→j, V_j ν C_ij, with a C_ij whose bond-based (PMB) stiffness dominates the
