@@ -163,7 +163,8 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
                                        " × the energy given";
   // The balance's constant: the energy at step 0, or E + D + B − W of the state a restart read back.
   energies.at(loop.step);
-  balance.start(energies.kinetic + energies.strain + state.contact_energy, state.damping_work, loop.broken_energy,
+  balance.start(energies.kinetic + energies.strain + state.contact_energy + state.indenter_energy, state.damping_work,
+                loop.broken_energy,
                 state.external_work);
 
   if (!s.restarting) timed([&] { frame(0.0); });

@@ -41,7 +41,7 @@ class BlowUpWatch {
 };
 
 // The energy balance of an explicit run: E(t) + D(t) + B(t) = E(0) + W(t), with E the kinetic,
-// strain and contact energy, D the damping work, B the energy of the bonds broken so far and W the
+// strain, contact and indenter energy, D the damping work, B the energy of the bonds broken so far and W the
 // external work (reactions, body forces, indenters; thesis §2.3's energy check). Verlet keeps it to
 // a few per cent (the shipped cases and bench-accuracy's runs: E + D ≤ 1.05 × (E(0) + W)); a step
 // above the stability limit breaks it long before the ×1.5-a-step growth shows or a value overflows
