@@ -211,3 +211,24 @@ def geo_identifiers(geo_path: str) -> set[str]:
             text = stream.read().decode("utf-8")
         names.update(value for kind, value, _ in tokens(text, path) if kind == "ident")
     return names
+
+
+# A DefineConstant entry `NAME = {value, ... Name "Parameters/label [m]"}`: the label's unit says
+# what the parameter is. gmsh itself takes any number, so `a: -0.005` meshed the same hole as 0.005
+# and `lc: 0` made gmsh fall back to its default size (issue 17, item 10).
+DEFINE_CONSTANT_ENTRY = re.compile(r"\b([A-Za-z_][A-Za-z0-9_]*)\s*=\s*\{[^{}]*?\bName\s*\"([^\"]*)\"", re.S)
+
+
+def geo_lengths(geo_path: str) -> dict[str, str]:
+    """The parameters that the .geo (and the files it Includes) label as lengths, "[m]" in their
+    DefineConstant Name: name → the Name ("Parameters/mesh size [m]"). A length must be > 0."""
+    lengths: dict[str, str] = {}
+    for path in check_geo(geo_path):
+        if not path.endswith(".geo"):
+            continue
+        with open(path, "rb") as stream:
+            text = stream.read().decode("utf-8")
+        for name, label in DEFINE_CONSTANT_ENTRY.findall(text):
+            if "[m]" in label:
+                lengths[name] = label
+    return lengths

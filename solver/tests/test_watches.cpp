@@ -51,12 +51,57 @@ TEST(BlowUpWatch, TheLikelyCauseBlamesTheStepOnlyForAnExplicitStepAboveTheLimit)
                              "a load that makes the state jump";
   EXPECT_EQ(pd::BlowUpWatch::likely_cause(2e-7, 1e-7, 5e-8, false),
             "dt = 2e-07 s is 2 × the exact stability limit 1e-07 s (eq. 2.5: 5e-08 s): " + within);
+  // An explicit step below the linear limit: the limit dropped (large deformation); contact
+  // stiffness is named only when the scene has contact (issue 17, item 12: the membrane, which has
+  // none, was told to look for contact stiffness).
   EXPECT_EQ(pd::BlowUpWatch::likely_cause(5e-8, 1e-7, 5e-8, true),
-            "dt = 5e-08 s is 0.5 × the exact stability limit 1e-07 s (eq. 2.5: 5e-08 s): " + within);
+            "dt = 5e-08 s is 0.5 × the exact stability limit 1e-07 s (eq. 2.5: 5e-08 s): the step is within the "
+            "linear limit, which large deformation lowers; use a smaller time.safety_factor (e.g. 0.8)");
+  EXPECT_EQ(pd::BlowUpWatch::likely_cause(5e-8, 1e-7, 5e-8, true, true),
+            "dt = 5e-08 s is 0.5 × the exact stability limit 1e-07 s (eq. 2.5: 5e-08 s): the step is within the "
+            "linear limit, which large deformation lowers and contact stiffness (contact.stiffness_factor) is not "
+            "part of; use a smaller time.safety_factor (e.g. 0.8) or a smaller contact.stiffness_factor");
   EXPECT_EQ(pd::BlowUpWatch::non_finite_message("node 1 at (0, 0, 0) m", 4, 1e-6, "node 2 at (1, 0, 0) m", "CAUSE"),
             "pdsolve: error: non-finite displacement or velocity at node 1 at (0, 0, 0) m after step 4 (t = 1e-06 s; the "
             "largest finite speed is at node 2 at (1, 0, 0) m); CAUSE; stopped without writing this state, the last "
             "frame written is the last valid one");
+}
+
+// E + D against E(0) + max(W, 0): ×10 stops, ×2 marks where the frames start to be dropped.
+TEST(EnergyBalanceWatch, StopsAboveTenTimesTheEnergyGivenAndRemembersWhereTwoTimesBegan) {
+  pd::EnergyBalanceWatch watch(true);
+  watch.start(1.0, 0.0, 0.0, 0.0);                  // 1 J at step 0
+  EXPECT_FALSE(watch.broken(1, 1.02, 0.0, 0.0));    // Verlet's few per cent
+  EXPECT_FALSE(watch.broken(2, 0.5, 0.6, 0.0));     // damping took 0.6 J: held 1.1 J
+  EXPECT_EQ(watch.suspect_from(), -1);
+  EXPECT_FALSE(watch.broken(3, 2.5, 0.0, 0.0));     // 2.5 × : suspect from step 3
+  EXPECT_EQ(watch.suspect_from(), 3);
+  EXPECT_FALSE(watch.broken(4, 1.5, 0.0, 0.0));     // back below 2 ×: not suspect any more
+  EXPECT_EQ(watch.suspect_from(), -1);
+  EXPECT_FALSE(watch.broken(5, 3.0, 0.0, 0.0));
+  EXPECT_FALSE(watch.broken(6, 10.0, 0.0, 0.0));    // 10 × exactly is not above
+  EXPECT_TRUE(watch.broken(7, 10.5, 0.0, 0.0));
+  EXPECT_EQ(watch.suspect_from(), 5);
+  EXPECT_EQ(watch.message(7, 2e-3, 10.5, 0.0, 0.0, "node 3 at (1, 2, 0) m", "CAUSE"),
+            "pdsolve: error: after step 7 (t = 0.002 s) the kinetic, strain and contact energy plus the damping work "
+            "are 10.5 J, 10.5 × the energy the run was given (1 J at the start + 0 J of external work; a sound run "
+            "stays near 1 ×, this one passed 2 × at step 5): the energy balance is broken and the run is unstable, "
+            "most likely starting at node 3 at (1, 2, 0) m (the largest speed); CAUSE; stopped without writing this state");
+}
+
+TEST(EnergyBalanceWatch, ExternalWorkAndBrokenBondsAreEnergyGivenAndAnImplicitRunIsNotWatched) {
+  pd::EnergyBalanceWatch watch(true);
+  watch.start(0.0, 0.0, 0.0, 0.0);                  // a body at rest, then pulled
+  EXPECT_FALSE(watch.broken(1, 5.0, 0.0, 0.0));     // nothing given yet: no comparison
+  EXPECT_FALSE(watch.broken(2, 9.0, 0.0, 1.0));     // 9 × the 1 J of work
+  EXPECT_TRUE(watch.broken(3, 11.0, 0.0, 1.0));
+  pd::EnergyBalanceWatch restarted(true);
+  restarted.start(3.0, 1.0, 2.0, 4.0);              // a restart: E(0) = E + D + B − W = 2 J
+  EXPECT_FALSE(restarted.broken(10, 50.0, 1.0, 4.0));  // 51 J ≤ 10 × (2 + 4) J
+  EXPECT_TRUE(restarted.broken(11, 60.0, 1.0, 4.0));
+  pd::EnergyBalanceWatch off(false);
+  off.start(1.0, 0.0, 0.0, 0.0);
+  EXPECT_FALSE(off.broken(1, 1e30, 0.0, 0.0));
 }
 
 TEST(IndenterDepthWatch, WarnsOnceWhenTheStepExceedsTheIndentersLimit) {

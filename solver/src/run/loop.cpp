@@ -59,6 +59,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   const std::filesystem::path checkpoint_file = checkpoint_path(p.c);
   Energies energies(*p.op, state);
   BlowUpWatch blow_up(loop.growth);
+  EnergyBalanceWatch balance(p.integrator->explicit_step());
   IndenterDepthWatch indenter_depth(p.indenter_watch);
   // Rank 0 only (the one with output): stderr's updating line on a terminal, else whole lines on
   // stderr; run.log's lines in both cases (run/progress.hpp).
@@ -139,7 +140,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,
   // item 12). They go, so the last frame kept is the last before the growth began at `first_step`.
-  const auto drop_frames_from = [&](std::int64_t first_step) {
+  const auto drop_frames_from = [&](std::int64_t first_step, const std::string& while_what) {
     double keep_until = -1.0;
     bool suspect = false;
     for (const auto& [step, t] : frames_here) {
@@ -149,12 +150,22 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     if (!out || !suspect || keep_until < 0.0) return;
     if (const int dropped = out->drop_frames_after(keep_until); dropped > 0)
       log.line("removed " + std::to_string(dropped) + " frame(s) written from step " + std::to_string(first_step) +
-               " on, while the energy grew ×" + format("%g", BlowUpWatch::kGrowthPerStep) +
-               " a step; the last frame kept, at t = " + format("%.6g", keep_until) + " s, is the last before the growth");
+               " on, " + while_what + "; the last frame kept, at t = " + format("%.6g", keep_until) + " s, is the last before the growth");
   };
+  // An explicit run is judged by the step it was given (dt, safety_factor), not by a step shortened
+  // to land on an output time.
   const auto likely_cause = [&](double h) {
-    return BlowUpWatch::likely_cause(h, p.exact_limit(), p.dt_stable, integrator.explicit_step());
+    const double step = integrator.explicit_step() && p.dt > 0.0 ? std::max(h, p.dt) : h;
+    return BlowUpWatch::likely_cause(step, p.exact_limit(), p.dt_stable, integrator.explicit_step(), model.contact.pairs);
   };
+  const std::string while_growing = "while the energy grew ×" + format("%g", BlowUpWatch::kGrowthPerStep) + " a step";
+  const std::string while_unbalanced = "while the energy held was more than " + format("%g", EnergyBalanceWatch::kSuspect) +
+                                       " × the energy given";
+  // The balance's constant: the energy at step 0, or E + D + B − W of the state a restart read back.
+  energies.at(loop.step);
+  balance.start(energies.kinetic + energies.strain + state.contact_energy + state.indenter_energy, state.damping_work,
+                loop.broken_energy,
+                state.external_work);
 
   if (!s.restarting) timed([&] { frame(0.0); });
   while (loop.step < p.max_steps && schedule.before_end(loop.t)) {
@@ -189,7 +200,8 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       if (out)
         log.error(BlowUpWatch::non_finite_message(node_text(model, bad), loop.step, loop.t,
                                                   node_text(model, fastest_node(*whole)), likely_cause(h)));
-      if (loop.growth.streak > 0) drop_frames_from(loop.step - loop.growth.streak);
+      if (balance.suspect_from() >= 0) drop_frames_from(balance.suspect_from(), while_unbalanced);
+      else if (loop.growth.streak > 0) drop_frames_from(loop.step - loop.growth.streak, while_growing);
       end.status = kRunFailed;
       end.state_valid = false;
       break;
@@ -200,7 +212,17 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       const State& st = output_state();
       if (out)
         log.error(blow_up.growth_message(energy, loop.step, loop.t, node_text(model, fastest_node(st)), likely_cause(h)));
-      drop_frames_from(loop.step - loop.growth.streak + 1);
+      drop_frames_from(loop.step - loop.growth.streak + 1, while_growing);
+      end.status = kRunFailed;
+      end.state_valid = false;
+      break;
+    }
+    if (balance.broken(loop.step, energy, state.damping_work, state.external_work)) {
+      const State& st = output_state();
+      if (out)
+        log.error(balance.message(loop.step, loop.t, energy, state.damping_work, state.external_work,
+                                  node_text(model, fastest_node(st)), likely_cause(h)));
+      drop_frames_from(balance.suspect_from() >= 0 ? balance.suspect_from() : loop.step, while_unbalanced);
       end.status = kRunFailed;
       end.state_valid = false;
       break;
