@@ -19,6 +19,7 @@
 #include "materials/lps/lps.hpp"
 #include "integrators/integrator.hpp"
 #include "one_thread.hpp"
+#include "static_tension.hpp"
 
 namespace {
 
@@ -437,75 +438,11 @@ TEST(Lps, StaticTensionGivesTheLatticesPoissonRatio) {
   const char* env = std::getenv("PD_LPS_INFLUENCE");  // the influence function (default one)
   const std::string w = env ? env : "one";
   const pd::Model m = pd::build_model(lps_case(3, "3d", {nu, w}), pdtest::cubic_lattice(nx, ny, nz, kDx, 3));
-  const std::size_t n = m.nodes.size();
-  std::vector<std::array<bool, 3>> fixed(n, {false, false, false});
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j) fixed[pdtest::node_index(0, j, k, nx, ny)][0] = true;
-  fixed[pdtest::node_index(0, ny / 2, nz / 2, nx, ny)][1] = fixed[pdtest::node_index(0, ny / 2, nz / 2, nx, ny)][2] = true;
-  fixed[pdtest::node_index(0, 0, nz / 2, nx, ny)][2] = true;  // no rotation about x
-  pd::Vec3Array b = pd::make_vec3(n);
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j) b[0][pdtest::node_index(nx - 1, j, k, nx, ny)] = sigma / kDx;
-  const pd::Vec3Array zero = pd::make_vec3(n);
-  const auto apply = [&](const pd::Vec3Array& x) {  // A x = −J(0) x on the free components
-    pd::Vec3Array y = jacobian_product(m, zero, x);
-    for (int d = 0; d < 3; ++d)
-      for (std::size_t i = 0; i < n; ++i) y[d][i] = fixed[i][d] ? 0.0 : -y[d][i];
-    return y;
-  };
-  const auto dot = [&](const pd::Vec3Array& p, const pd::Vec3Array& q) {
-    double s = 0.0;
-    for (int d = 0; d < 3; ++d)
-      for (std::size_t i = 0; i < n; ++i) s += p[d][i] * q[d][i];
-    return s;
-  };
-  pd::Vec3Array u = pd::make_vec3(n), r = b, p = b;
-  double rr = dot(r, r);
-  const double target = 1e-20 * rr;
-  int iterations = 0;
-  for (; iterations < 5000 && rr > target; ++iterations) {
-    const pd::Vec3Array ap = apply(p);
-    const double alpha = rr / dot(p, ap);
-    for (int d = 0; d < 3; ++d)
-      for (std::size_t i = 0; i < n; ++i) {
-        u[d][i] += alpha * p[d][i];
-        r[d][i] -= alpha * ap[d][i];
-      }
-    const double next = dot(r, r);
-    for (int d = 0; d < 3; ++d)
-      for (std::size_t i = 0; i < n; ++i) p[d][i] = r[d][i] + next / rr * p[d][i];
-    rr = next;
-  }
-  ASSERT_LE(rr, target) << iterations << " iterations";
-  // Least squares: u_x = c0 + ε_xx x + c2 y + c3 z, u_y = c0 + c1 x + ε_yy y + c3 z over the interior.
-  double sums[2][4][5] = {};  // normal equations per fitted component
-  for (int k = 6; k <= 8; ++k)
-    for (int j = 6; j <= 8; ++j)
-      for (int i = nx / 3; i < 2 * nx / 3; ++i) {
-        const std::size_t q = pdtest::node_index(i, j, k, nx, ny);
-        const double row[4] = {1.0, m.nodes.x[0][q], m.nodes.x[1][q], m.nodes.x[2][q]};
-        for (int c = 0; c < 2; ++c)
-          for (int a = 0; a < 4; ++a) {
-            for (int e = 0; e < 4; ++e) sums[c][a][e] += row[a] * row[e];
-            sums[c][a][4] += row[a] * u[static_cast<std::size_t>(c)][q];
-          }
-      }
-  double coef[2][4];
-  for (int c = 0; c < 2; ++c) {  // Gauss–Jordan on the 4×4 normal equations
-    double (&s)[4][5] = sums[c];
-    for (int a = 0; a < 4; ++a) {
-      for (int e = a + 1; e < 4; ++e) {
-        const double f = s[e][a] / s[a][a];
-        for (int g = a; g < 5; ++g) s[e][g] -= f * s[a][g];
-      }
-    }
-    for (int a = 3; a >= 0; --a) {
-      double v = s[a][4];
-      for (int g = a + 1; g < 4; ++g) v -= s[a][g] * coef[c][g];
-      coef[c][a] = v / s[a][a];
-    }
-  }
-  const double exx = coef[0][1], eyy = coef[1][2];
+  // The fit's interior: y and z indices 6..8, i.e. 2δ from the lateral faces (static_tension.hpp).
+  const pdtest::Tension tension = pdtest::static_tension(m, nx, ny, nz, kDx, sigma, 6);
+  ASSERT_TRUE(tension.converged) << tension.iterations << " iterations";
+  const int iterations = tension.iterations;
+  const double exx = tension.interior_xx, eyy = tension.interior_yy;
   // The cubic lattice's prediction: K exact (the dilatation is, on the discrete family), the axis
   // shear modulus μ·r_A: S11 = 1/(9K) + 1/(3μ r_A), S12 = 1/(9K) − 1/(6μ r_A).
   const pd::LpsModuli k = pd::lps_moduli(kE, nu, "3d");
