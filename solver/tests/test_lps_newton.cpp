@@ -15,6 +15,7 @@
 #include "integrators/mixed.hpp"
 #include "integrators/quasi_static.hpp"
 #include "integrators/verlet.hpp"
+#include "force_norm.hpp"
 #include "lattice.hpp"
 
 namespace {
@@ -45,13 +46,7 @@ pd::Case quasi_static_case(const std::string& solver) {
   return c;
 }
 
-double force_norm(const pd::Model& m, const pd::State& s, bool free) {
-  double sum = 0.0;
-  for (std::size_t d = 0; d < 3; ++d)
-    for (std::size_t i = 0; i < s.size(); ++i)
-      if (static_cast<bool>(m.conditions.fixed[d][i]) != free) sum += std::pow(m.nodes.volume[i] * s.f[d][i], 2);
-  return std::sqrt(sum);
-}
+using pdtest::force_norm;
 
 bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
   for (std::size_t d = 0; d < 3; ++d)

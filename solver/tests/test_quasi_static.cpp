@@ -10,6 +10,7 @@
 
 #include "integrators/quasi_static.hpp"
 #include "jacobian_check.hpp"
+#include "force_norm.hpp"
 #include "lattice.hpp"
 #include "one_thread.hpp"
 #include "linalg/cholesky.hpp"
@@ -38,13 +39,7 @@ pd::Case bar_case() {
   return c;
 }
 
-double force_norm(const pd::Model& m, const pd::State& s, bool free) {
-  double sum = 0.0;
-  for (std::size_t d = 0; d < 3; ++d)
-    for (std::size_t i = 0; i < s.size(); ++i)
-      if (static_cast<bool>(m.conditions.fixed[d][i]) != free) sum += std::pow(m.nodes.volume[i] * s.f[d][i], 2);
-  return std::sqrt(sum);
-}
+using pdtest::force_norm;
 
 }  // namespace
 

@@ -29,6 +29,12 @@ from test_mpi_ranks import (MPI_ENV, MPIEXEC, copy_case, history_without_wall_ti
 DEATH_NOTICED_WITHIN_S = 30
 
 
+# The interrupted runs: 10 ms (about 9 200 steps), a checkpoint every 0.1 ms. Long enough that a
+# signal sent after the first checkpoint finds the run still going on a quiet machine too: at 2 ms
+# the whole 2-rank run took 0.41 s and ended before mpirun had passed SIGTERM on.
+LONG_END, LONG_EVERY = 1.0e-2, 1.0e-4
+
+
 def with_checkpoints(end, every):
     def change(case):
         case["time"]["end"] = end
@@ -115,15 +121,15 @@ def test_a_checkpoint_written_on_2_ranks_continues_on_3_and_on_1_bitwise(prepare
 
 @pytest.fixture(scope="module")
 def long_reference(prepared):
-    """A run long enough to be interrupted (2 ms, about 1800 steps), serial and uninterrupted."""
-    reference = copy_case(prepared, "long_reference", with_checkpoints(2.0e-3, 1.0e-4))
+    """A run long enough to be interrupted (LONG_END), serial and uninterrupted."""
+    reference = copy_case(prepared, "long_reference", with_checkpoints(LONG_END, LONG_EVERY))
     result = solve(reference, None)
     assert result.returncode == 0, result.stderr
     return reference
 
 
 def test_sigterm_to_mpirun_writes_a_checkpoint_that_continues_bitwise(prepared, long_reference):
-    folder = copy_case(prepared, "sigterm", with_checkpoints(2.0e-3, 1.0e-4))
+    folder = copy_case(prepared, "sigterm", with_checkpoints(LONG_END, LONG_EVERY))
     process = start_two_ranks(folder)
     wait_for_checkpoint(folder, process)
     process.send_signal(signal.SIGTERM)  # mpirun passes it on to every rank
@@ -139,7 +145,7 @@ def test_sigterm_to_mpirun_writes_a_checkpoint_that_continues_bitwise(prepared, 
 
 
 def test_a_killed_rank_ends_the_run_within_seconds_and_the_last_checkpoint_continues_it(prepared, long_reference):
-    folder = copy_case(prepared, "killed", with_checkpoints(2.0e-3, 1.0e-4))
+    folder = copy_case(prepared, "killed", with_checkpoints(LONG_END, LONG_EVERY))
     process = start_two_ranks(folder)
     wait_for_checkpoint(folder, process)
     os.kill(rank_pid(process.pid, 1), signal.SIGKILL)

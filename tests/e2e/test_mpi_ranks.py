@@ -160,7 +160,8 @@ def test_loads_lps_and_adaptive_equal_the_serial_run_byte_for_byte(variant_runs)
         assert "indenter_punch_fy" in header and "indenter_wall_fx" in header
         assert float(last[header.index("indenter_punch_fy")]) > 0.0
         assert float(last[header.index("indenter_wall_fx")]) < 0.0
-        assert float(last[header.index("contact_energy")]) > 0.0
+        assert float(last[header.index("indenter_energy")]) > 0.0  # its own column since issue 16
+        assert float(last[header.index("contact_energy")]) == 0.0   # no contact pairs in this scene
     else:
         assert int(last[header.index("broken_bonds")]) > 100  # the plate cracked
     frames = sorted(os.listdir(serial / "frames"))
