@@ -21,8 +21,8 @@ import pytest
 
 from e2e_support import SOLVER  # noqa: E402
 # prepared: the coarse plate, meshed and preprocessed once per module; pytestmark: skip without MPI.
-from test_mpi_ranks import (MPI_ENV, MPIEXEC, copy_case, history_without_wall_time,  # noqa: F401, F811
-                            prepared, pytestmark, solve)
+from test_mpi_ranks import (MPI_ENV, MPIEXEC, adaptive, as_lps, copy_case,  # noqa: F401, F811
+                            history_without_wall_time, prepared, pytestmark, solve, with_loads)
 
 # Within this many seconds of a rank's death mpirun must have ended the others (measured: 2.1 s
 # with the machine's load average at 21 on 2 cores).
@@ -193,3 +193,26 @@ def test_a_restart_rank_0_refuses_is_refused_by_every_rank_at_once(prepared):
     assert result.stderr.count("frame_000001.vtu: missing, but the checkpoint counts") == 1  # said once, by rank 0
     assert "to start the run over instead, delete" in result.stderr
     assert (folder / "history.csv").read_bytes() == history  # refused before any file changed
+
+
+@pytest.mark.parametrize("kind, change", [("loads", with_loads), ("lps", as_lps), ("adaptive", adaptive)])
+def test_checkpoints_of_the_other_decomposed_terms_continue_bitwise(prepared, kind, change):
+    """Body forces and indenters (their work and the indenters' forces are whole-body totals that
+    a restart hands to every rank's piece), LPS (the ghosts' P) and the adaptive integrator (its
+    saved step proposal): written on 2 ranks, continued on 3, equal to the serial uninterrupted run."""
+    def with_both(case):
+        change(case)
+        with_checkpoints(3.0e-4, 1.2e-4)(case)
+    reference = copy_case(prepared, f"{kind}_ckpt_reference", with_both)
+    result = solve(reference, None)
+    assert result.returncode == 0, result.stderr
+    written = copy_case(prepared, f"{kind}_ckpt_np2", with_both)
+    result = solve(written, 2)
+    assert result.returncode == 0, result.stderr
+    assert_same_run(reference, written)
+    folder = prepared[0] / f"{kind}_ckpt_np2_to_np3"
+    shutil.copytree(written, folder)
+    result = restart(folder, 3)
+    assert result.returncode == 0, f"{kind}: {result.stderr}"
+    assert restarted_at_step(folder) > 0
+    assert_same_run(reference, folder)

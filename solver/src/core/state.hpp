@@ -24,6 +24,19 @@ struct State {
 
   explicit State(std::size_t n = 0) : u(make_vec3(n)), v(make_vec3(n)), f(make_vec3(n)), w(n, 0.0) {}
   std::size_t size() const { return u[0].size(); }
+
+  // Copies every whole-body value (the energies, the indenters' forces, the work ledger) of `from`,
+  // not the per-node fields: what a decomposed run's pieces and its gathered state share (run/).
+  // A new whole-body member belongs here, so that output and restarts under MPI carry it.
+  void copy_totals(const State& from) {
+    contact_energy = from.contact_energy;
+    indenter_energy = from.indenter_energy;
+    indenter_force = from.indenter_force;
+    external_power = from.external_power;
+    damping_power = from.damping_power;
+    external_work = from.external_work;
+    damping_work = from.damping_work;
+  }
 };
 
 }  // namespace pd

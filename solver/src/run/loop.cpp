@@ -80,13 +80,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     gathered.v = dec->gather(state.v);
     gathered.f = dec->gather(state.f);
     gathered.w = dec->gather(state.w);
-    gathered.contact_energy = state.contact_energy;
-    gathered.indenter_energy = state.indenter_energy;
-    gathered.indenter_force = state.indenter_force;
-    gathered.external_power = state.external_power;
-    gathered.damping_power = state.damping_power;
-    gathered.external_work = state.external_work;
-    gathered.damping_work = state.damping_work;
+    gathered.copy_totals(state);
     dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
     return gathered;
   };

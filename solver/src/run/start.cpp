@@ -46,12 +46,7 @@ void restore_piece(Prepared& p, State& whole, Start& s) {
   local.v = to_local(piece, whole.v);
   local.f = to_local(piece, whole.f);
   local.w = to_local(piece, whole.w);
-  local.contact_energy = whole.contact_energy;
-  local.indenter_force = whole.indenter_force;
-  local.external_power = whole.external_power;
-  local.damping_power = whole.damping_power;
-  local.external_work = whole.external_work;
-  local.damping_work = whole.damping_work;
+  local.copy_totals(whole);
   rows_to_local(piece, p.model.bonds, piece.model.bonds);
 }
 
