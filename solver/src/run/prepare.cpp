@@ -87,14 +87,14 @@ void check_decomposable(const Prepared& p) {
   else if (p.model.bonds.corrected())
     what = "discretization.surface_correction: " + c.surface_correction + " (a piece's bonds would need their factors)";
   // verlet and adaptive are decomposed (adaptive's norms of eq. 2.6 are ordered sums); quasi_static,
-  // implicit and mixed solve with a factorisation or Krylov sums that are not yet.
+  // implicit and mixed solve with a factorisation or Krylov sums that are not yet. dt: exact is
+  // decomposed too: choose_dt ran on the whole model on every rank, before the decomposition.
   else if (c.time.integrator != "verlet" && c.time.integrator != "adaptive")
     what = "time.integrator: " + c.time.integrator;
-  else if (c.time.dt_rule == "exact") what = "time.dt: exact";
   else if (p.model.contact.pairs) what = "contact";
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
-                "verlet and adaptive integrators with pmb and lps bonds, breaking, displacement and velocity conditions, body forces, indenters, "
+                "verlet and adaptive integrators with pmb and lps bonds, dt: stable, exact or fixed, breaking, displacement and velocity conditions, body forces, indenters, "
                 "damping, frames, history, checkpoints and restarts on any rank count): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
 }
 
