@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "bits.hpp"
 #include "core/model.hpp"
 #include "lattice.hpp"
 #include "materials/pmb/pmb.hpp"
@@ -49,7 +50,7 @@ void notch(pd::Model& m) {
     }
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using pdtest::same_bits;
 
 int rank_count() {
   int r = 1;

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "bits.hpp"
 #include "core/model.hpp"
 #include "forces/indenter.hpp"
 #include "integrators/adaptive.hpp"
@@ -27,14 +28,9 @@ namespace {
 
 constexpr double kDx = 1e-3;
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using pdtest::same_bits;
+using pdtest::differing;
 
-std::int64_t differing(const pd::Vec3Array& a, const pd::Vec3Array& b) {
-  std::int64_t bad = 0;
-  for (std::size_t d = 0; d < 3; ++d)
-    for (std::size_t i = 0; i < a[d].size(); ++i) bad += !same_bits(a[d][i], b[d][i]);
-  return bad;
-}
 
 pd::NodeSet set_where(const pd::Nodes& nodes, const std::string& name, const std::function<bool(std::size_t)>& in) {
   pd::NodeSet s{name, std::vector<std::uint8_t>(nodes.size(), 0)};

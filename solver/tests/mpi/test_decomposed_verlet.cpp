@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "bits.hpp"
 #include "core/model.hpp"
 #include "integrators/verlet.hpp"
 #include "lattice.hpp"
@@ -57,14 +58,9 @@ pd::Vec3Array opening(const pd::Model& m) {
   return v;
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using pdtest::same_bits;
+using pdtest::differing;
 
-std::int64_t differing(const pd::Vec3Array& a, const pd::Vec3Array& b) {
-  std::int64_t bad = 0;
-  for (std::size_t d = 0; d < 3; ++d)
-    for (std::size_t i = 0; i < a[d].size(); ++i) bad += !same_bits(a[d][i], b[d][i]);
-  return bad;
-}
 
 }  // namespace
 
