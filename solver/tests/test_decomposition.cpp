@@ -152,3 +152,37 @@ TEST(LocalPiece, OwnedRowsOfTheKernelOnAPieceAreTheSerialRowsBitwise) {
   }
   EXPECT_EQ(broken_sum, broken);  // each broken bond counted once, on the rank of its lower end
 }
+
+// What a bond's breaking and force read besides positions travels into the piece: the LAMMPS order,
+// the per-node s0 of the α rule (ghosts too: the halo refreshes them later) and the surface-
+// correction factors of the owned rows (issue 15; before, the pieces ran the thesis order and the
+// decomposed run refused the other two).
+TEST(LocalPiece, CarriesTheBreakingOrderThePerNodeCriticalStretchAndTheSurfaceFactors) {
+  pd::Model m = lattice_model(10, 9, 8, 0.5);
+  m.break_after_force = true;
+  m.node_critical_stretch.resize(m.nodes.size());
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) m.node_critical_stretch[i] = 1e-3 * (1.0 + 1e-3 * static_cast<double>(i));
+  m.bonds.surface_factor.resize(m.bonds.directed());
+  for (std::size_t k = 0; k < m.bonds.directed(); ++k) m.bonds.surface_factor[k] = 1.0 + 1e-5 * static_cast<double>(k);
+  const pd::Decomposition d = pd::decompose(m.nodes.x, m.bonds, 3, m.horizon);
+  for (int r = 0; r < 3; ++r) {
+    const pd::LocalPiece p = pd::make_local_piece(m, d.owner, r);
+    EXPECT_TRUE(p.model.break_after_force);
+    ASSERT_EQ(p.model.node_critical_stretch.size(), p.size());
+    ASSERT_EQ(p.model.bonds.surface_factor.size(), p.model.bonds.directed());
+    for (std::size_t l = 0; l < p.size(); ++l) {
+      const auto i = static_cast<std::size_t>(p.global[l]);
+      EXPECT_EQ(p.model.node_critical_stretch[l], m.node_critical_stretch[i]);
+      for (std::int64_t q = 0; q < p.model.bonds.offsets[l + 1] - p.model.bonds.offsets[l]; ++q)
+        EXPECT_EQ(p.model.bonds.surface_factor[static_cast<std::size_t>(p.model.bonds.offsets[l] + q)],
+                  m.bonds.surface_factor[static_cast<std::size_t>(m.bonds.offsets[i] + q)]);
+    }
+  }
+  m.break_after_force = false;
+  m.node_critical_stretch.clear();
+  m.bonds.surface_factor.clear();
+  const pd::LocalPiece plain = pd::make_local_piece(m, d.owner, 1);
+  EXPECT_FALSE(plain.model.break_after_force);
+  EXPECT_TRUE(plain.model.node_critical_stretch.empty());
+  EXPECT_FALSE(plain.model.bonds.corrected());
+}

@@ -201,20 +201,6 @@ def test_what_is_not_decomposed_is_refused_before_any_output(prepared):
     assert not (folder / "history.csv").exists() and not (folder / "frames").exists()
 
 
-def test_lammps_s_alpha_rule_is_refused_on_several_ranks(prepared):
-    """LAMMPS's per-node critical stretch (docs/lammps.md): a bond's threshold min(s0_i, s0_j) needs
-    the s0 of a ghost end, which no halo carries yet."""
-    def alpha(case):
-        for block in case["blocks"]:
-            block["critical_stretch_alpha"] = 0.25
-    folder = copy_case(prepared, "refused_alpha", alpha)
-    result = solve(folder, 2)
-    assert result.returncode != 0
-    assert ("blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end) is not "
-            "decomposed over MPI ranks yet") in result.stderr, result.stderr
-    assert not (folder / "history.csv").exists() and not (folder / "frames").exists()
-
-
 @pytest.mark.parametrize("key, change", [
     ("contact", lambda case: case["contact"].update(self_contact=True)),
     ("time.integrator: quasi_static", lambda case: case["time"].update(integrator="quasi_static")),

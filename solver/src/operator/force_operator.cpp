@@ -2,6 +2,7 @@
 #include "operator/force_operator.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "core/error.hpp"
@@ -50,6 +51,9 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
     // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
     // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
     decomposed_->update_ghosts(s.u);
+    // LAMMPS's α rule: a bond's threshold min(s0_i, s0_j) reads its ghost end's s0, which the
+    // previous pass updated on the owner only (a ghost's empty row leaves +inf).
+    if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
     std::vector<double> lost(s.size(), 0.0);
     report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost.data());
     report.broken = decomposed_->total(report.broken);
@@ -349,11 +353,17 @@ std::vector<std::string> ForceOperator::work_plan(const Case& c) const {
   lines.push_back("work: bond forces over " + std::to_string((decomposed_ ? decomposed_->total(directed) : directed) / 2) +
                   " bonds, partial volume " +
                   c.partial_volume + (c.dimension == 2 ? "; 2D (cell grids one bin thick)" : "; 3D"));
-  if (model_.bonds.corrected()) {  // only then: run.log of a case without it is unchanged
+  // Only with the correction: run.log of a case without it is unchanged. Decomposed, the range is
+  // over every rank's rows (min and max are exact in any order); a piece may hold no bond at all.
+  const bool corrected =
+      decomposed_ ? decomposed_->total(model_.bonds.corrected() ? 1 : 0) > 0 : model_.bonds.corrected();
+  if (corrected) {
     const auto& g = model_.bonds.surface_factor;
-    const auto [lo, hi] = std::minmax_element(g.begin(), g.end());
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (double gk : g) lo = std::min(lo, gk), hi = std::max(hi, gk);
+    if (decomposed_) lo = decomposed_->minimum(lo), hi = -decomposed_->minimum(-hi);
     char range[96];
-    std::snprintf(range, sizeof range, "factors g from %.4g to %.4g", *lo, *hi);
+    std::snprintf(range, sizeof range, "factors g from %.4g to %.4g", lo, hi);
     lines.push_back("work: surface correction " + c.surface_correction + " (Le & Bobaru 2018), bond " + range);
   }
   const auto& registry = force_term_registry();

@@ -58,6 +58,10 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   m.density = pick(g.density, p.global);
   m.block_index = pick(g.block_index, p.global);
   m.no_fail = pick(g.no_fail, p.global);
+  // The breaking rules (Model::break_after_force, LAMMPS's per-node s0): the ghosts' s0 are copies
+  // that the operator refreshes from their owners before each breaking pass.
+  m.break_after_force = g.break_after_force;
+  if (!g.node_critical_stretch.empty()) m.node_critical_stretch = pick(g.node_critical_stretch, p.global);
   m.nodes.dimension = g.nodes.dimension;
   m.nodes.grid_spacing = g.nodes.grid_spacing;
   for (int d = 0; d < 3; ++d) m.nodes.x[static_cast<std::size_t>(d)] = pick(g.nodes.x[static_cast<std::size_t>(d)], p.global);
@@ -75,6 +79,8 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
       for (std::int64_t k = g.bonds.offsets[i]; k < g.bonds.offsets[i + 1]; ++k) {
         m.bonds.neighbour.push_back(local_of[static_cast<std::size_t>(g.bonds.neighbour[static_cast<std::size_t>(k)])]);
         m.bonds.broken.push_back(g.bonds.broken[static_cast<std::size_t>(k)]);
+        // The surface-correction factors were computed on the whole model (core/model.cpp): the serial bits.
+        if (g.bonds.corrected()) m.bonds.surface_factor.push_back(g.bonds.surface_factor[static_cast<std::size_t>(k)]);
       }
     m.bonds.offsets[l + 1] = static_cast<std::int64_t>(m.bonds.neighbour.size());
   }

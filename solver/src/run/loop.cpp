@@ -125,6 +125,11 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   // a serial run: whole, of one step, and readable on any rank count. Collective.
   const auto write_restart = [&]() {
     const State& whole = output_state();
+    // LAMMPS's α rule: the owners' s0 in global node order, as the serial run holds them.
+    if (dec && !p.model.node_critical_stretch.empty()) {
+      std::vector<double> s0 = dec->gather(dec->piece().model.node_critical_stretch);
+      if (out) p.model.node_critical_stretch = std::move(s0);
+    }
     if (!out) return;
     out->flush_history();
     LoopState saved = loop;

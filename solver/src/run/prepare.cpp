@@ -82,11 +82,9 @@ void check_decomposable(const Prepared& p) {
   // pmb and lps are decomposed (lps fills its ghosts' P between its sweeps); a new law must say how.
   if (p.model.bond_model->name() != "pmb" && p.model.bond_model->name() != "lps")
     what = "blocks[].model: " + p.model.bond_model->name();
-  else if (!p.model.node_critical_stretch.empty())
-    what = "blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end)";
-  else if (p.model.bonds.corrected())
-    what = "discretization.surface_correction: " + c.surface_correction + " (a piece's bonds would need their factors)";
-  // verlet and adaptive are decomposed (adaptive's norms of eq. 2.6 are ordered sums); quasi_static,
+  // LAMMPS's α rule (the ghosts' s0 refreshed before each breaking pass), breaking_order: lammps and
+  // surface_correction (its factors computed on the whole model, copied into the pieces' rows) are
+  // decomposed; verlet and adaptive are decomposed (adaptive's norms of eq. 2.6 are ordered sums); quasi_static,
   // implicit and mixed solve with a factorisation or Krylov sums that are not yet. dt: exact is
   // decomposed too: choose_dt ran on the whole model on every rank, before the decomposition.
   else if (c.time.integrator != "verlet" && c.time.integrator != "adaptive")
@@ -94,7 +92,8 @@ void check_decomposable(const Prepared& p) {
   else if (p.model.contact.pairs) what = "contact";
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
-                "verlet and adaptive integrators with pmb and lps bonds, dt: stable, exact or fixed, breaking, displacement and velocity conditions, body forces, indenters, "
+                "verlet and adaptive integrators with pmb and lps bonds, dt: stable, exact or fixed, breaking (breaking_order "
+                "thesis or lammps, critical_stretch_alpha), surface_correction, displacement and velocity conditions, body forces, indenters, "
                 "damping, frames, history, checkpoints and restarts on any rank count): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
 }
 

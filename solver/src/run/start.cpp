@@ -84,6 +84,8 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   if (p.decomposed) restore_piece(p, checkpoint.state, s);
   else s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
   model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
+  if (p.decomposed && !model.node_critical_stretch.empty())  // the piece's owned nodes and ghosts, global order
+    p.decomposed->piece().model.node_critical_stretch = to_local(p.decomposed->piece(), model.node_critical_stretch);
   if (model.contact.pairs)
     model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
                                checkpoint.contact_seconds);
