@@ -6,7 +6,7 @@ On the coarse cracking plate of test_mpi_ranks.py (1234 nodes, 300 steps), each 
 - `critical_stretch_alpha: 0.25` with the LAMMPS order (s0_i = s00 − α·min_j s_ij: a bond's threshold
   min(s0_i, s0_j) reads the s0 of its ghost end, refreshed from its owner before each breaking pass),
 - `surface_correction: energy` (the factors computed on the whole model before the decomposition)
-writes on 1, 2 and 3 ranks (and 2 ranks × 2 threads for α) frames, frames.pvd and history.csv
+writes on 2 and 3 ranks (and on 1 for α) frames, frames.pvd and history.csv
 byte for byte as the serial run. A checkpoint of the α run holds the owners' s0 in global node
 order: written on 2 ranks it continues on 3 and on 1, written serially it continues on 2, each
 byte for byte as the uninterrupted serial run.
@@ -18,7 +18,7 @@ import pytest
 
 # prepared: the coarse plate, meshed and preprocessed once per module; pytestmark: skip without MPI.
 from test_mpi_checkpoint import assert_same_run, restart, restarted_at_step, with_checkpoints
-from test_mpi_ranks import copy_case, history_without_wall_time, prepared, pytestmark, solve  # noqa: F401
+from test_mpi_ranks import copy_case, history_without_wall_time, prepared, pytestmark, solve  # noqa: F401, F811
 
 
 def lammps_order(case):
@@ -35,7 +35,7 @@ def surface_corrected(case):
     case["surface_correction"] = "energy"
 
 
-VARIANTS = {"lammps": (lammps_order, (2, 3)), "alpha": (alpha_rule, (1, 2, 3, "2t2")),
+VARIANTS = {"lammps": (lammps_order, (2, 3)), "alpha": (alpha_rule, (1, 2, 3)),
             "surface": (surface_corrected, (2, 3))}
 
 
@@ -63,10 +63,8 @@ def test_decomposed_runs_equal_the_serial_run_byte_for_byte(prepared, thesis_ser
     assert history_without_wall_time(serial) != history_without_wall_time(thesis_serial)
     serial_log = (serial / "run.log").read_text()
     for ranks in rank_counts:
-        threads = 2 if ranks == "2t2" else 1
-        count = 2 if ranks == "2t2" else ranks
         folder = copy_case(prepared, f"{kind}_np{ranks}", change)
-        result = solve(folder, count, threads)
+        result = solve(folder, ranks)
         assert result.returncode == 0, f"{kind} np{ranks}: {result.stderr}"
         assert_same_run(serial, folder)
         if kind == "surface":  # run.log's factor range: over every rank's rows, as the serial run's
