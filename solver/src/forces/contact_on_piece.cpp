@@ -119,7 +119,6 @@ void ContactOnPiece::build(const Vec3Array& u, bool counted) {
   f_ = make_vec3(kept);
   energy_.assign(kept, 0.0);
   halo_ = d_.make_node_halo(global_, extra);
-  built_ = true;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   m.contact_list.record_build(list, u, seconds, counted);
 }
@@ -129,7 +128,10 @@ double ContactOnPiece::add_force(const Vec3Array& u, Vec3Array& f) {
   NeighbourList& list = m.contact_list;
   // NeighbourList::update's rule, decided by all ranks together: the serial verdict over all nodes
   // is the largest of the pieces' (a piece holds its owned nodes and copies of its bond ghosts).
-  if (!built_ && list.rebuilds() > 0) build(list.u_build(), false);  // a restart: the recorded list again
+  // A restart replaced the record (after the integrator's first evaluation had built a list at the
+  // start's state): search again at the recorded displacement, the list the serial restore finds.
+  // (restore_record leaves the pairs empty; a build leaves a row per node of the set.)
+  if (list.rebuilds() > 0 && list.pairs().offsets.empty()) build(list.u_build(), false);
   if (list.rebuilds() == 0) {
     build(u, true);
   } else {

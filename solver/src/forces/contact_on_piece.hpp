@@ -46,7 +46,6 @@ class ContactOnPiece {
 
   const Model& model_;
   const Decomposed& d_;
-  bool built_ = false;  // in this process (false after a restart until the first evaluation)
   // The contact set: owned nodes and kept contact ghosts, ascending global number.
   std::vector<std::int32_t> global_;
   std::vector<std::int32_t> piece_local_;  // its piece-local number, −1 for a ghost outside the piece
