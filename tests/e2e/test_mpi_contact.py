@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 from e2e_support import ROOT, new_case_folder, prepare_stages  # noqa: E402
+from test_impact import coarsen
 from test_mpi_checkpoint import assert_same_run, restart, restarted_at_step
 from test_mpi_ranks import copy_case, history_without_wall_time, pytestmark, solve  # noqa: F401
 
@@ -29,9 +30,7 @@ def prepared(tmp_path_factory):
     shutil.copy(os.path.join(ROOT, "cases", "impact", "impact.geo"), case_dir)
     with open(os.path.join(ROOT, "cases", "impact", "impact.yaml"), encoding="utf-8") as stream:
         case = yaml.safe_load(stream)
-    case["discretization"]["dx"] = 2.5e-4
-    case["geometry"]["parameters"].update({"gap": 1.0e-3, "lc": 0.002})
-    case["node_sets"] = {"left": {"layer": 8.0e-4}, "right": {"layer": 8.0e-4}}
+    coarsen(case)
     case["time"]["end"] = END
     case["output"] = {"every_time": 5.0e-6, "history_every": 5}
     yaml_path = case_dir / "impact.yaml"

@@ -108,8 +108,7 @@ std::vector<std::string> MpiDecomposed::contact_traffic_report(std::int64_t step
                                 static_cast<double>(t.box_bytes) * per, static_cast<double>(t.halo_exchanges) * per,
                                 static_cast<double>(t.halo_messages) * per, static_cast<double>(t.halo_bytes) * per,
                                 t.seconds * per};
-  std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(kColumns * ranks()) : 0);
-  MPI_Gather(row, kColumns, MPI_DOUBLE, all.data(), kColumns, MPI_DOUBLE, 0, comm_);
+  const std::vector<double> all = rows_on_rank_0(row, kColumns);
   std::vector<std::string> lines;
   for (int r = 0; r < ranks() && rank_ == 0; ++r) {
     const double* v = &all[static_cast<std::size_t>(kColumns * r)];

@@ -64,6 +64,8 @@ class MpiDecomposed : public Decomposed {
   const ContactTraffic& contact_traffic() const { return *contact_traffic_; }
 
  private:
+  // Every rank's `columns` values, rank after rank, on rank 0 (empty elsewhere): run.log's lines. Collective.
+  std::vector<double> rows_on_rank_0(const double* row, int columns) const;
   MPI_Comm comm_;
   int rank_ = 0;
   Decomposition decomposition_;
