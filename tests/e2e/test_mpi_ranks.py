@@ -202,10 +202,9 @@ def test_what_is_not_decomposed_is_refused_before_any_output(prepared):
 
 
 @pytest.mark.parametrize("key, change", [
-    ("contact", lambda case: case["contact"].update(self_contact=True)),
     ("time.integrator: quasi_static", lambda case: case["time"].update(integrator="quasi_static")),
 ])
-def test_contact_and_the_implicit_integrators_stay_refused(prepared, key, change):
+def test_the_implicit_integrators_stay_refused(prepared, key, change):
     folder = copy_case(prepared, "refused_" + key.split(":")[0].replace(".", "_") + str(len(key)), change)
     result = solve(folder, 2)
     assert result.returncode != 0

@@ -21,7 +21,7 @@ ContactPairs NeighbourList::search(const Vec3Array& x, const Vec3Array& u, const
 }
 
 void NeighbourList::search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
-                        const ContactParameters& p, ContactPairs& out, Scratch& scratch) {
+                        const ContactParameters& p, ContactPairs& out, Scratch& scratch, const std::uint8_t* rows) {
   const std::size_t n = x[0].size();
   out.offsets.assign(n + 1, 0);
   out.neighbour.clear();
@@ -71,7 +71,7 @@ void NeighbourList::search(const Vec3Array& x, const Vec3Array& u, const std::ve
       if (last < first) first = i;
       last = i;
       const std::size_t row_start = mine.size();
-      for_each(static_cast<std::size_t>(i), [&](std::int32_t j) { mine.push_back(j); });
+      if (!rows || rows[i]) for_each(static_cast<std::size_t>(i), [&](std::int32_t j) { mine.push_back(j); });
       std::sort(mine.begin() + static_cast<std::ptrdiff_t>(row_start), mine.end());
       out.offsets[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(mine.size() - row_start);
     }
@@ -97,18 +97,7 @@ bool NeighbourList::update(const Vec3Array& x, const Vec3Array& u, const std::ve
   const auto n = static_cast<std::int64_t>(x[0].size());
   bool stale = rebuilds_ == 0 || static_cast<std::int64_t>(u_build_[0].size()) != n;
   if (!stale) {
-    // The Verlet-skin criterion: rebuild once any node has moved more than skin/2 (max is exact,
-    // so the decision does not depend on the thread count).
-    const double limit2 = 0.25 * p.skin * p.skin;
-    int moved = 0;  // 1: moved too far; 2: non-finite
-#pragma omp parallel for schedule(static) reduction(max : moved)
-    for (std::int64_t i = 0; i < n; ++i) {
-      const auto s = static_cast<std::size_t>(i);
-      const double d0 = u[0][s] - u_build_[0][s], d1 = u[1][s] - u_build_[1][s], d2 = u[2][s] - u_build_[2][s];
-      const double r2 = d0 * d0 + d1 * d1 + d2 * d2;
-      if (!std::isfinite(r2)) moved = 2;
-      else if (r2 > limit2) moved = std::max(moved, 1);
-    }
+    const int moved = moved_since_build(u, p);
     // A non-finite state cannot be binned; the time loop stops on it after this step anyway.
     if (moved == 2) return false;
     stale = moved != 0;
@@ -120,6 +109,37 @@ bool NeighbourList::update(const Vec3Array& x, const Vec3Array& u, const std::ve
   ++rebuilds_;
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return true;
+}
+
+int NeighbourList::moved_since_build(const Vec3Array& u, const ContactParameters& p) const {
+  // The Verlet-skin criterion: rebuild once any node has moved more than skin/2 (max is exact,
+  // so the decision does not depend on the thread count, nor on the rank count: forces/contact_on_piece).
+  const auto n = static_cast<std::int64_t>(u[0].size());
+  const double limit2 = 0.25 * p.skin * p.skin;
+  int moved = 0;  // 1: moved too far; 2: non-finite
+#pragma omp parallel for schedule(static) reduction(max : moved)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    const double d0 = u[0][s] - u_build_[0][s], d1 = u[1][s] - u_build_[1][s], d2 = u[2][s] - u_build_[2][s];
+    const double r2 = d0 * d0 + d1 * d1 + d2 * d2;
+    if (!std::isfinite(r2)) moved = 2;
+    else if (r2 > limit2) moved = std::max(moved, 1);
+  }
+  return moved;
+}
+
+void NeighbourList::record_build(ContactPairs& pairs, const Vec3Array& u_build, double seconds, bool counted) {
+  std::swap(pairs_, pairs);
+  u_build_ = u_build;
+  rebuilds_ += counted ? 1 : 0;
+  seconds_ += seconds;
+}
+
+void NeighbourList::restore_record(const Vec3Array& u_build, std::int64_t rebuilds, double seconds) {
+  pairs_ = ContactPairs{};
+  u_build_ = u_build;
+  rebuilds_ = rebuilds;
+  seconds_ = seconds;
 }
 
 void NeighbourList::restore(const Vec3Array& x, const Vec3Array& u_build, const std::vector<std::int32_t>& block,

@@ -54,9 +54,24 @@ class NeighbourList {
     Vec3Array y;                                   // current positions x + u
     std::vector<std::vector<std::int32_t>> found;  // per thread: the j's of its rows, row after row
   };
-  // search() into `out`, reusing its storage and that of `scratch`.
+  // search() into `out`, reusing its storage and that of `scratch`. rows (null: every row): the
+  // rows to search, 1 a row and 0 an empty one (a decomposed run searches its owned rows only,
+  // forces/contact_on_piece); a searched row is the same in either case.
   static void search(const Vec3Array& x, const Vec3Array& u, const std::vector<std::int32_t>& block,
-                     const ContactParameters& p, ContactPairs& out, Scratch& scratch);
+                     const ContactParameters& p, ContactPairs& out, Scratch& scratch,
+                     const std::uint8_t* rows = nullptr);
+  // The skin rule on u: 0 no node moved more than skin/2 since the last build, 1 one did, 2 some
+  // displacement is not finite (the list cannot be binned; the time loop stops on it anyway).
+  int moved_since_build(const Vec3Array& u, const ContactParameters& p) const;
+
+  // A decomposed run keeps the list of its piece (forces/contact_on_piece) and records each build
+  // here: `pairs` (swapped in; the old list comes back for reuse), the piece's displacement at the
+  // build (the skin rule's and the checkpoint's u_build) and the time it took. counted: false for
+  // the build that brings a restored list back, which the checkpoint has counted already.
+  void record_build(ContactPairs& pairs, const Vec3Array& u_build, double seconds, bool counted);
+  // A restart of a decomposed run: the count, time and displacement of the last build, without the
+  // search (its owner searches on the ranks, in their next force evaluation).
+  void restore_record(const Vec3Array& u_build, std::int64_t rebuilds, double seconds);
 
   // The list as it was after `rebuilds` builds, the last at displacement u_build (a checkpoint,
   // io/checkpoint.hpp): search() at u_build gives bitwise the pairs that build found.

@@ -15,6 +15,15 @@ namespace pd {
 
 struct LocalPiece;
 
+// The ghosts' exchange over a set of nodes other than the piece's (the contact ghosts of
+// forces/contact_on_piece): made by Decomposed::make_node_halo, rebuilt with the set.
+class NodeHalo {
+ public:
+  virtual ~NodeHalo() = default;
+  // The ghost entries of a per-node array over the set = their owners' entries. Collective.
+  virtual void exchange(Vec3Array& a) const = 0;
+};
+
 class Decomposed {
  public:
   virtual ~Decomposed() = default;
@@ -59,6 +68,24 @@ class Decomposed {
   // Rank 0's bytes on every rank (MPI_Bcast): what rank 0 alone read (a checkpoint file, or the
   // error it met reading it) so that every rank decides alike. Collective.
   virtual std::string broadcast(const std::string& bytes_on_rank_0) const = 0;
+
+  // Contact between bodies and fragments on several ranks (forces/contact_on_piece). Each rank
+  // gives its box [lo, hi] and its candidate nodes (global numbers, ascending, with their positions
+  // and `width` values each); every rank's box goes to all (MPI_Allgather), and each candidate
+  // inside another rank's box goes to that rank with its values (MPI_Alltoallv). Out: the nodes
+  // received, ascending by global number (a node comes from its one owner, so once), with their
+  // values. Collective.
+  virtual void exchange_in_boxes(const double lo[3], const double hi[3], const std::vector<std::int32_t>& global_node,
+                                 const Vec3Array& position, const std::vector<double>& values, int width,
+                                 std::vector<std::int32_t>& received_node, std::vector<double>& received_values) const = 0;
+  // A halo over a set of nodes numbered locally in ascending global order (`global`): the entries
+  // `ghost_local` come from their owners; every rank's set holds its own owned nodes that others
+  // ask for. Collective.
+  virtual std::unique_ptr<NodeHalo> make_node_halo(const std::vector<std::int32_t>& global,
+                                                   const std::vector<std::int32_t>& ghost_local) const = 0;
+  // run.log's lines on the contact ghosts' traffic (box exchanges, their halo), per rank and per
+  // step of `steps`, like traffic_report. Collective; the lines on rank 0 (empty elsewhere).
+  virtual std::vector<std::string> contact_traffic_report(std::int64_t steps) const = 0;
 
   // What this rank's communication has cost so far (issue 15's per-step measures): halo exchanges
   // and ordered sums/gathers, with their wall time.

@@ -61,6 +61,12 @@ Decomposed::Traffic MpiDecomposed::traffic() const {
   return t;
 }
 
+std::vector<double> MpiDecomposed::rows_on_rank_0(const double* row, int columns) const {
+  std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(columns * ranks()) : 0);
+  MPI_Gather(row, columns, MPI_DOUBLE, all.data(), columns, MPI_DOUBLE, 0, comm_);
+  return all;
+}
+
 std::vector<std::string> MpiDecomposed::traffic_report(std::int64_t steps) const {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);  // ru_maxrss: this process's (this rank's) peak resident set, in KiB on Linux
@@ -72,8 +78,7 @@ std::vector<std::string> MpiDecomposed::traffic_report(std::int64_t steps) const
                                 static_cast<double>(t.halo_bytes) * per, static_cast<double>(t.reductions) * per,
                                 static_cast<double>(t.reduction_bytes) * per, t.halo_seconds * per, t.reduction_seconds * per,
                                 static_cast<double>(usage.ru_maxrss) / 1024.0};
-  std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(kColumns * ranks()) : 0);
-  MPI_Gather(row, kColumns, MPI_DOUBLE, all.data(), kColumns, MPI_DOUBLE, 0, comm_);
+  const std::vector<double> all = rows_on_rank_0(row, kColumns);
   std::vector<std::string> lines;
   for (int r = 0; r < ranks() && rank_ == 0; ++r) {
     const double* v = &all[static_cast<std::size_t>(kColumns * r)];

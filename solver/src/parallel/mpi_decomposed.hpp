@@ -47,13 +47,32 @@ class MpiDecomposed : public Decomposed {
   Traffic traffic() const override;
   std::vector<std::string> traffic_report(std::int64_t steps) const override;
 
+  // Contact ghosts (parallel/mpi_contact_exchange.cpp).
+  void exchange_in_boxes(const double lo[3], const double hi[3], const std::vector<std::int32_t>& global_node,
+                         const Vec3Array& position, const std::vector<double>& values, int width,
+                         std::vector<std::int32_t>& received_node, std::vector<double>& received_values) const override;
+  std::unique_ptr<NodeHalo> make_node_halo(const std::vector<std::int32_t>& global,
+                                           const std::vector<std::int32_t>& ghost_local) const override;
+  std::vector<std::string> contact_traffic_report(std::int64_t steps) const override;
+  // What the contact ghosts cost this rank so far: sent by this rank.
+  struct ContactTraffic {
+    std::int64_t box_exchanges = 0, box_bytes = 0;               // boxes (Allgather) and candidates (Alltoallv)
+    std::int64_t halo_exchanges = 0, halo_messages = 0, halo_bytes = 0;
+    std::int64_t ghosts = 0;                                     // in the last halo made
+    double seconds = 0.0;
+  };
+  const ContactTraffic& contact_traffic() const { return *contact_traffic_; }
+
  private:
+  // Every rank's `columns` values, rank after rank, on rank 0 (empty elsewhere): run.log's lines. Collective.
+  std::vector<double> rows_on_rank_0(const double* row, int columns) const;
   MPI_Comm comm_;
   int rank_ = 0;
   Decomposition decomposition_;
   LocalPiece piece_;
   std::unique_ptr<HaloExchange> halo_;
   std::unique_ptr<OrderedSum> sum_;
+  std::unique_ptr<ContactTraffic> contact_traffic_ = std::make_unique<ContactTraffic>();  // shared with the halos made
 };
 
 }  // namespace pd

@@ -23,7 +23,8 @@ const std::vector<std::string>& fixed_history_columns() {
   return names;
 }
 
-HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrator* integrator) {
+HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrator* integrator,
+                               const NeighbourList* contact_list) {
   const Model* m = &model;
   // A term the case does not have is 0: the operator zeroes both energies before its terms add to
   // them (operator/force_operator.cpp), and the broken-bond energy stays 0 when nothing can break.
@@ -32,8 +33,10 @@ HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrat
     out.push_back(in.state.indenter_energy);
     out.push_back(in.broken_energy);  // validation.md C4 with breaking
   });
-  add({"contact_rebuilds"}, [m](const HistoryInputs&, std::vector<double>& out) {
-    out.push_back(m->contact.pairs ? static_cast<double>(m->contact_list.rebuilds()) : 0.0);
+  // The operator's list (contact_list; on a decomposed run the piece's: every rank builds together).
+  const NeighbourList* list = contact_list ? contact_list : &model.contact_list;
+  add({"contact_rebuilds"}, [m, list](const HistoryInputs&, std::vector<double>& out) {
+    out.push_back(m->contact.pairs ? static_cast<double>(list->rebuilds()) : 0.0);
   });
   // 1 a quasi-static load step, 0 a dynamic one (explicit or implicit): integrators/integrator.hpp.
   add({"mode"}, [integrator](const HistoryInputs&, std::vector<double>& out) {

@@ -28,7 +28,10 @@ class HistoryColumns {
  public:
   // fixed_history_columns() for every case (a term the case lacks is 0), then each indenter's
   // reaction and each output.reactions set's (formats.md §4).
-  HistoryColumns(const Model& model, const Case& c, const Integrator* integrator = nullptr);
+  // contact_list: the Verlet list whose builds the contact_rebuilds column counts (the operator's;
+  // null: model's).
+  HistoryColumns(const Model& model, const Case& c, const Integrator* integrator = nullptr,
+                 const NeighbourList* contact_list = nullptr);
   HistoryColumns(const HistoryColumns&) = delete;
   HistoryColumns& operator=(const HistoryColumns&) = delete;
 

@@ -130,11 +130,15 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
       std::vector<double> s0 = dec->gather(dec->piece().model.node_critical_stretch);
       if (out) p.model.node_critical_stretch = std::move(s0);
     }
+    // The contact list's displacement at its last build, from the pieces (forces/contact_on_piece).
+    const NeighbourList& contact_list = p.op->model().contact_list;
+    const Vec3Array contact_u_build =
+        dec && model.contact.pairs && contact_list.rebuilds() > 0 ? dec->gather(contact_list.u_build()) : Vec3Array{};
     if (!out) return;
     out->flush_history();
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
-    write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out));
+    write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, contact_u_build));
   };
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,
@@ -262,6 +266,8 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   // What the ranks exchanged, per step of this run (issue 15's measures; bench/mpi_ranks.py reads them).
   if (dec)
     for (const std::string& text : dec->traffic_report(loop.step - first_step)) log.line(text);
+  if (dec && model.contact.pairs)
+    for (const std::string& text : dec->contact_traffic_report(loop.step - first_step)) log.line(text);
   return end;
 }
 

@@ -89,11 +89,11 @@ void check_decomposable(const Prepared& p) {
   // decomposed too: choose_dt ran on the whole model on every rank, before the decomposition.
   else if (c.time.integrator != "verlet" && c.time.integrator != "adaptive")
     what = "time.integrator: " + c.time.integrator;
-  else if (p.model.contact.pairs) what = "contact";
+  // contact is decomposed (forces/contact_on_piece) for these explicit integrators.
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
                 "verlet and adaptive integrators with pmb and lps bonds, dt: stable, exact or fixed, breaking (breaking_order "
-                "thesis or lammps, critical_stretch_alpha), surface_correction, displacement and velocity conditions, body forces, indenters, "
+                "thesis or lammps, critical_stretch_alpha), surface_correction, contact, displacement and velocity conditions, body forces, indenters, "
                 "damping, frames, history, checkpoints and restarts on any rank count): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
 }
 

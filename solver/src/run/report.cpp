@@ -20,10 +20,15 @@ int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, cons
            (p.integrator->linear_algebra_summary().empty() ? "" : ", " + p.integrator->linear_algebra_summary()));
   log.line("output: frames and history.csv took " + format("%.3f", end.output_seconds) + " s wall, " +
            format("%.1f", wall > 0 ? 100.0 * end.output_seconds / wall : 0.0) + " % of the time loop");
-  if (model.contact.pairs)
-    log.line("contact: " + std::to_string(model.contact_list.rebuilds()) + " Verlet-list builds in " +
-             std::to_string(loop.step) + " steps, " + format("%.3f", model.contact_list.seconds()) + " s searching, " +
-             std::to_string(model.contact_list.pairs().directed() / 2) + " pairs in the last list");
+  if (model.contact.pairs) {
+    // The operator's list: on a decomposed run the piece's, whose owned rows the ranks add up (collective).
+    const NeighbourList& list = p.op->model().contact_list;
+    auto directed = static_cast<std::int64_t>(list.pairs().directed());
+    if (p.decomposed) directed = p.decomposed->total(directed);
+    log.line("contact: " + std::to_string(list.rebuilds()) + " Verlet-list builds in " +
+             std::to_string(loop.step) + " steps, " + format("%.3f", list.seconds()) + " s searching" +
+             (p.decomposed ? " (on rank 0)" : "") + ", " + std::to_string(directed / 2) + " pairs in the last list");
+  }
   // A checkpoint of a decomposed run holds the whole model in node order: any rank count R continues it.
   if (end.interrupted) {
     const std::string checkpoint_file = checkpoint_path(p.c).string();

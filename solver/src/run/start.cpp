@@ -71,8 +71,6 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
                 std::to_string(checkpoint.directed_bonds / 2) + " bonds, integrator " + checkpoint.integrator + "; here " +
                 std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator.name() + ")");
   if (checkpoint.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
-  if (p.decomposed && model.contact.pairs)  // the Verlet list below is the whole model's, not the piece's
-    throw Error(where + "restarting a decomposed run with contact is not supported yet: restart it on one rank");
   // Checked before any rank takes its piece: every rank holds the same whole state and decides alike
   // (a serial run checks after restore, in start_or_restore).
   if (p.decomposed && first_non_finite(checkpoint.state) >= 0) throw Error(where + "the checkpoint's state is not finite");
@@ -86,7 +84,14 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
   if (p.decomposed && !model.node_critical_stretch.empty())  // the piece's owned nodes and ghosts, global order
     p.decomposed->piece().model.node_critical_stretch = to_local(p.decomposed->piece(), model.node_critical_stretch);
-  if (model.contact.pairs)
+  if (model.contact.pairs && p.decomposed) {
+    // The piece's record of the last build; its first force evaluation searches again at that
+    // displacement on every rank (forces/contact_on_piece), the list the serial restore finds.
+    const LocalPiece& piece = p.decomposed->piece();
+    piece.model.contact_list.restore_record(
+        checkpoint.contact_rebuilds > 0 ? to_local(piece, checkpoint.contact_u_build) : Vec3Array{},
+        checkpoint.contact_rebuilds, checkpoint.contact_seconds);
+  } else if (model.contact.pairs)
     model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
                                checkpoint.contact_seconds);
   try {
@@ -153,7 +158,7 @@ std::string restart_line(const RunOptions& opt, const Start& s) {
 }
 
 Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
-                         const OutputWriter& out) {
+                         const OutputWriter& out, const Vec3Array& contact_u_build) {
   const Model& model = p.model;
   Checkpoint k;
   k.case_hash = s.case_hash;
@@ -166,9 +171,12 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, 
   k.state = whole;
   k.broken_flags = model.bonds.broken;
   k.node_critical_stretch = model.node_critical_stretch;
-  k.contact_rebuilds = model.contact_list.rebuilds();
-  k.contact_seconds = model.contact_list.seconds();
-  k.contact_u_build = model.contact_list.u_build();
+  // The operator's list: the whole model's, or on a decomposed run the piece's record, whose
+  // displacement at the last build the caller gathered in global node order (contact_u_build).
+  const NeighbourList& list = p.op->model().contact_list;
+  k.contact_rebuilds = list.rebuilds();
+  k.contact_seconds = list.seconds();
+  k.contact_u_build = p.decomposed ? contact_u_build : list.u_build();
   k.frame_times = out.frame_times();
   k.history_bytes = out.history_bytes();
   return k;
