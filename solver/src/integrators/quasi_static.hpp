@@ -33,6 +33,7 @@
 #include "linalg/cholesky.hpp"
 #include "linalg/pcg.hpp"
 #include "linalg/sparse_matrix.hpp"
+#include "parallel/dof_sums.hpp"
 
 namespace pd {
 
@@ -92,6 +93,8 @@ class QuasiStatic : public Integrator {
   double end_ = 0.0, dt_min_ = 0.0, dt_max_ = 0.0;
   std::optional<double> dt_initial_;
   FreeDofs dofs_;
+  DofSums sums_;  // the norms and CG's dot products over dofs_ (every rank's on a decomposed run)
+  mutable std::vector<double> terms_, motion_terms_;  // per-dof terms of those sums
   SparseCholesky factor_;
   bool have_factor_ = false;
   int factorisations_ = 0;
