@@ -388,6 +388,13 @@ ImplicitSettings read_implicit(const Checker& ck, const json& j) {
   if (m.dt_min && m.dt_max && *m.dt_min > *m.dt_max) ck.fail("implicit.dt_min", "is larger than implicit.dt_max");
   if (m.dt_initial && m.dt_max && *m.dt_initial > *m.dt_max) ck.fail("implicit.dt_initial", "is larger than implicit.dt_max");
   if (m.dt_initial && m.dt_min && *m.dt_initial < *m.dt_min) ck.fail("implicit.dt_initial", "is smaller than implicit.dt_min");
+  if (const json* v = ck.optional(j, "linear_solver")) {
+    m.linear_solver = ck.string(*v, "implicit.linear_solver");
+    if (m.linear_solver != "auto" && m.linear_solver != "direct" && m.linear_solver != "cg")
+      ck.fail("implicit.linear_solver", "unknown value '" + m.linear_solver + "'; known: auto, direct, cg");
+  }
+  if (const json* v = ck.optional(j, "cg_max_iterations"))
+    m.cg_max_iterations = static_cast<int>(ck.integer(*v, "implicit.cg_max_iterations", 1, 100000000));
   return m;
 }
 
@@ -456,7 +463,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
-                    "dt_min", "dt_max"}},
+                    "dt_min", "dt_max", "linear_solver", "cg_max_iterations"}},
       {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
