@@ -86,17 +86,15 @@ void check_decomposable(const Prepared& p) {
     what = "blocks[].critical_stretch_alpha > 0 (a bond's threshold needs the s0 of its ghost end)";
   else if (p.model.bonds.corrected())
     what = "discretization.surface_correction: " + c.surface_correction + " (a piece's bonds would need their factors)";
-  // verlet and adaptive are decomposed (adaptive's norms of eq. 2.6 are ordered sums); quasi_static,
-  // implicit and mixed too, on their matrix-free path (their norms and CG's dot products summed in
-  // global dof order: parallel/dof_sums.hpp; linear_solver: direct is refused by the integrator).
-  // dt: exact is decomposed too: choose_dt ran on the whole model on every rank, before the
-  // decomposition.
-  else if (c.time.integrator == "implicit" || (c.time.integrator == "mixed" && c.mixed.start == "implicit"))
-    what = "time.integrator: " + c.time.integrator + (c.time.integrator == "mixed" ? " with mixed.start: implicit" : "");
+  // Every integrator is decomposed: verlet, adaptive (its norms of eq. 2.6 are ordered sums), and
+  // quasi_static, implicit and mixed on their matrix-free path (their norms and CG's dot products
+  // summed in global dof order: parallel/dof_sums.hpp; linear_solver: direct is refused by the
+  // integrator). dt: exact is decomposed too: choose_dt ran on the whole model on every rank,
+  // before the decomposition.
   else if (p.model.contact.pairs) what = "contact";
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
-                "verlet, adaptive, quasi_static and mixed integrators with pmb and lps bonds, dt: stable, exact or fixed, breaking, displacement and velocity conditions, body forces, indenters, "
+                "verlet, adaptive, quasi_static, implicit and mixed integrators with pmb and lps bonds, dt: stable, exact or fixed, breaking, displacement and velocity conditions, body forces, indenters, "
                 "damping, frames, history, checkpoints and restarts on any rank count): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
 }
 

@@ -43,8 +43,9 @@ std::string restart_line(const RunOptions& options, const Start& s);
 // Everything the loop carries from step to step, for checkpoint.bin. loop.wall_time: the time
 // loop's seconds up to now.
 // `whole`: the run's state in the whole model's numbering (on a decomposed run, gathered on rank 0;
-// the broken flags are then p.model's, gathered too).
+// the broken flags are then p.model's, gathered too). integrator_state: Integrator::save_state(),
+// which every rank of a decomposed run calls (it may gather).
 Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
-                         const OutputWriter& out);
+                         const OutputWriter& out, std::vector<char> integrator_state);
 
 }  // namespace pd
