@@ -117,36 +117,39 @@ def test_runs_on_several_ranks_equal_the_serial_run_byte_for_byte(prepared, seri
         assert "quasi-static → explicit" in log
 
 
-def test_a_checkpoint_written_on_2_ranks_continues_on_3_and_on_1_bitwise(prepared, serial_runs):
-    """The mixed run checkpoints every 0.3 ms: in the load steps and in the explicit phase."""
-    def change(case):
-        mixed(case)
-        case["output"]["restart_every_time"] = 3.0e-4
-    written = copy_case(prepared, "mixed_ckpt_np2", change)
+def written_with_checkpoints(prepared, name, change, every):
+    """A run on 2 ranks of `change` that writes a checkpoint every `every` seconds."""
+    def with_checkpoints(case):
+        change(case)
+        case["output"]["restart_every_time"] = every
+    written = copy_case(prepared, f"{name}_ckpt_np2", with_checkpoints)
     result = solve(written, 2)
     assert result.returncode == 0, result.stderr
+    return written
+
+
+def restarted(prepared, written, name, ranks):
+    folder = prepared[0] / name
+    shutil.copytree(written, folder)
+    result = restart(folder, ranks)
+    assert result.returncode == 0, f"{name}: {result.stderr}"
+    return folder
+
+
+def test_a_checkpoint_written_on_2_ranks_continues_on_3_and_on_1_bitwise(prepared, serial_runs):
+    """The mixed run checkpoints every 0.3 ms: in the load steps and in the explicit phase."""
+    written = written_with_checkpoints(prepared, "mixed", mixed, 3.0e-4)
     assert_same_run(serial_runs["mixed"], written)  # the checkpoints cost nothing in the results
     for name, ranks in (("mixed_ckpt_np3", 3), ("mixed_ckpt_serial", None)):
-        folder = prepared[0] / name
-        shutil.copytree(written, folder)
-        result = restart(folder, ranks)
-        assert result.returncode == 0, f"{name}: {result.stderr}"
+        folder = restarted(prepared, written, name, ranks)
         assert restarted_at_step(folder) > 4  # from the last checkpoint (t ≥ 0.9 ms: explicit steps)
         assert_same_run(serial_runs["mixed"], folder)
 
 
 def test_an_implicit_checkpoint_with_its_accelerations_continues_across_rank_counts(prepared, serial_runs):
     """implicit's checkpoint holds a_n per node: gathered in global order on 2 ranks, read on 3."""
-    def change(case):
-        implicit(case)
-        case["output"]["restart_every_time"] = 1.0e-5
-    written = copy_case(prepared, "implicit_ckpt_np2", change)
-    result = solve(written, 2)
-    assert result.returncode == 0, result.stderr
-    folder = prepared[0] / "implicit_ckpt_np3"
-    shutil.copytree(written, folder)
-    result = restart(folder, 3)
-    assert result.returncode == 0, result.stderr
+    written = written_with_checkpoints(prepared, "implicit", implicit, 1.0e-5)
+    folder = restarted(prepared, written, "implicit_ckpt_np3", 3)
     assert restarted_at_step(folder) > 0
     assert_same_run(serial_runs["implicit"], folder)
 

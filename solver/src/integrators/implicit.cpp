@@ -9,7 +9,7 @@
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
 #include "integrators/messages.hpp"
-#include "integrators/quasi_static.hpp"
+#include "integrators/newton_krylov.hpp"
 #include "parallel/local_model.hpp"
 
 namespace pd {
@@ -39,48 +39,14 @@ void Implicit::configure(const Case& c, double) {
                 message_number(dt_max_) + " s; lower implicit.dt_min or raise implicit.dt_max");
 }
 
-// direct or cg, and why (for describe()): quasi_static's rule (integrators/quasi_static.cpp), with
-// the dofs of this scheme (z too in 2D).
+// direct or cg, and why (for describe()): quasi_static's rule, over this scheme's dofs (z too in 2D).
 void Implicit::choose_linear_solver(const Case& c) {
-  const Decomposed* decomposed = op_.decomposed();
-  const int dimension = op_.model().nodes.dimension;
-  const auto local_free = static_cast<std::int64_t>(op_.free_dofs(3).size());
-  const auto free = static_cast<std::size_t>(decomposed ? decomposed->total(local_free) : local_free);
-  const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0);
-  const std::string& choice = settings_.linear_solver;
-  if (choice == "direct") {
-    // A factorisation is of the whole tangent on one process: refused before any work.
-    if (decomposed)
-      throw Error(c.file.string() + ": implicit.linear_solver: direct factorises the whole tangent on one process and is "
-                  "not decomposed over MPI ranks (here " + std::to_string(decomposed->ranks()) +
-                  "); use linear_solver: cg (or auto, which takes cg on several ranks), or run on one rank");
-    if (!missing.empty())
-      throw Error(c.file.string() + ": implicit.linear_solver: direct factorises the assembled tangent stiffness, which " +
-                  missing + " does not have; use linear_solver: cg (or auto)");
-    use_cg_ = false;
-    solver_reason_ = "as the case file asks";
-  } else if (choice == "cg") {
-    use_cg_ = true;
-    solver_reason_ = "as the case file asks";
-  } else if (decomposed) {
-    use_cg_ = true;
-    solver_reason_ = "auto: decomposed over " + std::to_string(decomposed->ranks()) +
-                     " MPI ranks (a factorisation stays on one process)";
-  } else if (!missing.empty()) {
-    use_cg_ = true;
-    solver_reason_ = "auto: " + missing + " has no assembled tangent";
-  } else if (dimension == 3 && free >= QuasiStatic::kCgFromDofs3d) {
-    use_cg_ = true;
-    solver_reason_ = "auto: " + std::to_string(free) + " free dofs in 3D, at least " + std::to_string(QuasiStatic::kCgFromDofs3d);
-  } else {
-    use_cg_ = false;
-    solver_reason_ = "auto: " + std::to_string(free) + " free dofs" +
-                     (dimension == 3 ? ", below " + std::to_string(QuasiStatic::kCgFromDofs3d) + " in 3D" : std::string(" in 2D"));
-  }
+  const LinearSolverChoice choice = pd::choose_linear_solver(op_, c, "implicit", settings_.linear_solver, 3);
+  use_cg_ = choice.use_cg;
+  solver_reason_ = choice.reason;
 }
 
 bool Implicit::solve_krylov(const State& s, double t1, double h, double floor) {
-  const auto& volume = op_.model().nodes.volume;
   const double c = mass_coefficient(h);
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
     // A law with neither form of diagonal block: the mass term alone preconditions.
@@ -93,31 +59,18 @@ bool Implicit::solve_krylov(const State& s, double t1, double h, double floor) {
     for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a)
       blocks_[9 * g + static_cast<std::size_t>(4 * a)] += c * mass_[static_cast<std::size_t>(block_first_[g] + a)];
   preconditioner_.build(block_first_, blocks_);
-  // K_eff x = −V ∂f/∂u·x + c m x over the free dofs (x zero at the prescribed components).
-  const LinearOperator K = [&](const std::vector<double>& x, std::vector<double>& y) {
-    dofs_.scatter(x, cg_x_);
-    op_.apply_jacobian(s, t1, cg_x_, cg_y_);
-    y.resize(x.size());
-    for (std::size_t q = 0; q < dofs_.size(); ++q) {
-      const auto i = static_cast<std::size_t>(dofs_.node[q]);
-      y[q] = -volume[i] * cg_y_[dofs_.component[q]][i] + c * mass_[q] * x[q];
-    }
-  };
   PcgSettings settings;
   settings.relative_tol = kCgTolerance;
   settings.absolute_tol = floor;
   settings.max_iterations = settings_.cg_max_iterations;
-  settings.dot = [this](const std::vector<double>& a, const std::vector<double>& b) { return sums_.dot(a, b); };
-  correction_.clear();  // CG from Δu = 0
-  const PcgResult result = preconditioned_cg(K, preconditioner_, r_, correction_, settings);
+  diagonal_.resize(dofs_.size());
+  for (std::size_t q = 0; q < dofs_.size(); ++q) diagonal_[q] = c * mass_[q];  // K_eff = K + c M
+  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, preconditioner_, r_, correction_,
+                                               settings, cg_x_, cg_y_);
   cg_iterations_ += result.iterations;
   ++cg_solves_;
   report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
-  if (result.status == PcgResult::kIndefinite && result.iterations == 0) {
-    preconditioner_.apply(r_, correction_);  // Steihaug's first step, scaled by the line search
-    return true;
-  }
-  return result.converged() || result.residual < result.initial_residual;
+  return result.converged() || result.status == PcgResult::kIndefinite || result.residual < result.initial_residual;
 }
 
 std::string Implicit::linear_algebra_summary() const {

@@ -163,7 +163,7 @@ class Implicit : public Integrator {
   bool solve_krylov(const State& s, double t1, double h, double floor);
   BlockJacobi preconditioner_;
   std::vector<std::int64_t> block_first_;
-  std::vector<double> blocks_;
+  std::vector<double> blocks_, diagonal_;
   Vec3Array cg_x_, cg_y_;
   std::int64_t cg_iterations_ = 0;
   int cg_solves_ = 0;

@@ -11,6 +11,7 @@
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
 #include "integrators/messages.hpp"
+#include "integrators/newton_krylov.hpp"
 
 namespace pd {
 
@@ -43,45 +44,10 @@ void QuasiStatic::configure(const Case& c, double) {
 // factorisation serves the elastic range): auto keeps direct whatever the size there, unless a term
 // has no assembled form.
 void QuasiStatic::choose_linear_solver(const Case& c) {
-  const int dimension = op_.model().nodes.dimension;
-  const Decomposed* decomposed = op_.decomposed();
-  const auto local_free = static_cast<std::int64_t>(op_.free_dofs(dimension).size());
-  const auto free = static_cast<std::size_t>(decomposed ? decomposed->total(local_free) : local_free);
-  const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0);
-  const bool assembled = missing.empty();
-  const bool law_assembled = assembled || missing == "contact";
-  const std::string& choice = settings_.linear_solver;
-  if (choice == "direct") {
-    // The factorisation is of the whole tangent on one process (no distributed one is built in):
-    // on several ranks the solves are matrix-free, their products force evaluations with ghosts.
-    if (decomposed)
-      throw Error(c.file.string() + ": quasi_static.linear_solver: direct factorises the whole tangent on one process and "
-                  "is not decomposed over MPI ranks (here " + std::to_string(decomposed->ranks()) +
-                  "); use linear_solver: cg (or auto, which takes cg on several ranks), or run on one rank");
-    if (!assembled)
-      throw Error(c.file.string() + ": quasi_static.linear_solver: direct needs an assembled tangent, which " + missing +
-                  " does not have; use linear_solver: cg (or auto)");
-    use_cg_ = false;
-    solver_reason_ = "as the case file asks";
-  } else if (choice == "cg") {
-    use_cg_ = true;
-    solver_reason_ = "as the case file asks";
-  } else if (decomposed) {
-    use_cg_ = true;
-    solver_reason_ = "auto: decomposed over " + std::to_string(decomposed->ranks()) +
-                     " MPI ranks (a factorisation stays on one process)";
-  } else if (!assembled) {
-    use_cg_ = true;
-    solver_reason_ = law_assembled ? "auto: a term (contact) has no assembled tangent"
-                                   : "auto: the material " + op_.model().bond_model->name() + " has no assembled tangent";
-  } else if (dimension == 3 && free >= kCgFromDofs3d) {
-    use_cg_ = true;
-    solver_reason_ = "auto: " + std::to_string(free) + " free dofs in 3D, at least " + std::to_string(kCgFromDofs3d);
-  } else {
-    use_cg_ = false;
-    solver_reason_ = "auto: " + std::to_string(free) + " free dofs" +
-                     (dimension == 3 ? ", below " + std::to_string(kCgFromDofs3d) + " in 3D" : std::string(" in 2D"));
-  }
+  const LinearSolverChoice choice = pd::choose_linear_solver(op_, c, "quasi_static", settings_.linear_solver,
+                                                             op_.model().nodes.dimension);
+  use_cg_ = choice.use_cg;
+  solver_reason_ = choice.reason;
 }
 
 void QuasiStatic::initialize(State& state, double t) {
@@ -108,7 +74,6 @@ void QuasiStatic::initialize(State& state, double t) {
 }
 
 bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
-  const auto& volume = op_.model().nodes.volume;
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
     // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG.
     block_first_.clear();
@@ -130,35 +95,16 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
       for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a) blocks_[9 * g + static_cast<std::size_t>(4 * a)] += shift;
   }
   preconditioner_.build(block_first_, blocks_);
-  // K x = −V ∂f/∂u·x over the free dofs (x zero at the prescribed components) + shift·x.
-  const LinearOperator K = [&](const std::vector<double>& x, std::vector<double>& y) {
-    dofs_.scatter(x, cg_x_);
-    op_.apply_jacobian(s, t1, cg_x_, cg_y_);
-    y.resize(x.size());
-    const auto n = static_cast<std::int64_t>(dofs_.size());
-#pragma omp parallel for schedule(static) if (n >= 32768)
-    for (std::int64_t k = 0; k < n; ++k) {
-      const auto q = static_cast<std::size_t>(k);
-      const auto i = static_cast<std::size_t>(dofs_.node[q]);
-      y[q] = -volume[i] * cg_y_[dofs_.component[q]][i] + shift * x[q];
-    }
-  };
   PcgSettings settings;
   settings.relative_tol = eta;
   settings.absolute_tol = floor;
   settings.max_iterations = settings_.cg_max_iterations;
-  settings.dot = [this](const std::vector<double>& a, const std::vector<double>& b) { return sums_.dot(a, b); };
-  correction_.clear();  // CG from Δu = 0
-  const PcgResult result = preconditioned_cg(K, preconditioner_, rhs_, correction_, settings);
+  diagonal_.assign(dofs_.size(), shift);  // K + shift·I
+  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, preconditioner_, rhs_, correction_,
+                                               settings, cg_x_, cg_y_);
   cg_iterations_ += result.iterations;
   ++cg_solves_;
   report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
-  if (result.status == PcgResult::kIndefinite && result.iterations == 0) {
-    // Negative curvature along the first direction: the preconditioned residual, a descent
-    // direction of the energy, scaled by the line search (Steihaug's first step).
-    preconditioner_.apply(rhs_, correction_);
-    return true;
-  }
   if (result.status == PcgResult::kNotConverged && !(result.residual < result.initial_residual)) {
     cg_failure_ = result.message();
     return false;

@@ -63,15 +63,19 @@ void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y) {
 
 }  // namespace
 
-double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& b) {
-  const auto n = static_cast<std::int64_t>(a.size());
+namespace {
+
+// Σ term(k) for k < n in the fixed order of pcg.hpp: each kChunk-long chunk summed serially, the
+// chunk sums added serially in chunk order.
+template <class Term>
+double chunked_sum(std::int64_t n, const Term& term) {
   const std::int64_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<double> partial(static_cast<std::size_t>(chunks), 0.0);
 #pragma omp parallel for schedule(static) if (n >= kParallelFrom)
   for (std::int64_t c = 0; c < chunks; ++c) {
     double sum = 0.0;
     const std::int64_t end = std::min(n, (c + 1) * kChunk);
-    for (std::int64_t k = c * kChunk; k < end; ++k) sum += a[static_cast<std::size_t>(k)] * b[static_cast<std::size_t>(k)];
+    for (std::int64_t k = c * kChunk; k < end; ++k) sum += term(static_cast<std::size_t>(k));
     partial[static_cast<std::size_t>(c)] = sum;
   }
   double sum = 0.0;
@@ -79,20 +83,14 @@ double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& 
   return sum;
 }
 
+}  // namespace
+
+double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& b) {
+  return chunked_sum(static_cast<std::int64_t>(a.size()), [&](std::size_t k) { return a[k] * b[k]; });
+}
+
 double fixed_order_sum(const std::vector<double>& terms) {
-  const auto n = static_cast<std::int64_t>(terms.size());
-  const std::int64_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<double> partial(static_cast<std::size_t>(chunks), 0.0);
-#pragma omp parallel for schedule(static) if (n >= kParallelFrom)
-  for (std::int64_t c = 0; c < chunks; ++c) {
-    double sum = 0.0;
-    const std::int64_t end = std::min(n, (c + 1) * kChunk);
-    for (std::int64_t k = c * kChunk; k < end; ++k) sum += terms[static_cast<std::size_t>(k)];
-    partial[static_cast<std::size_t>(c)] = sum;
-  }
-  double sum = 0.0;
-  for (double p : partial) sum += p;
-  return sum;
+  return chunked_sum(static_cast<std::int64_t>(terms.size()), [&](std::size_t k) { return terms[k]; });
 }
 
 void BlockJacobi::build(const std::vector<std::int64_t>& first, const std::vector<double>& blocks) {
