@@ -262,7 +262,8 @@ CASE = {
                           "gradients with a block-Jacobi preconditioner, solved only as far as "
                           "Newton needs: Eisenstat–Walker), or auto (cg when a term or the "
                           "material has no assembled tangent, i.e. contact or model lps, or the "
-                          "model is large: run.log says which and why); lps cannot use direct", default="auto", choices=("auto", "direct", "cg")),
+                          "model is large, or the run is on several MPI ranks: run.log says which and "
+                          "why); lps cannot use direct, nor a run on several MPI ranks", default="auto", choices=("auto", "direct", "cg")),
         cg_max_iterations=Key("integer", "CG iterations in one Newton iteration; then Newton goes "
                               "on with the iterate reached", default=5000, minimum=1,
                               maximum=100000000),
@@ -301,6 +302,16 @@ CASE = {
         dt_min=Key("number", "smallest step; a step not accepted there stops the run (default: 1e-6 × "
                    "eq. 2.5)", default=None, unit="s", above=0.0),
         dt_max=Key("number", "largest step (default: end/10)", default=None, unit="s", above=0.0),
+        linear_solver=Key("string", "the linear solve of each Newton iteration, on the tangent plus "
+                          "the mass term: direct (CHOLMOD factorisation of the assembled matrix), cg "
+                          "(matrix-free conjugate gradients with a block-Jacobi preconditioner), or "
+                          "auto (cg for the lps model, for contact, for 3D models with at least 20 000 "
+                          "free dofs and on several MPI ranks; direct otherwise: run.log says which and "
+                          "why); direct is refused for lps and contact and on several MPI ranks",
+                          default="auto", choices=("auto", "direct", "cg")),
+        cg_max_iterations=Key("integer", "CG iterations in one Newton iteration; then Newton goes "
+                              "on with the iterate reached", default=5000, minimum=1,
+                              maximum=100000000),
     ),
     "mixed": section(
         "the mixed scheme (time.integrator: mixed): quasi-static load steps (the quasi_static "

@@ -393,13 +393,12 @@ def _check_materials(case: dict, checker: _Checker):
     if "lps" in models:
         # A state-based law has no assembled tangent (solver/src/materials/bond_model.hpp
         # bond_tangent_row: its force on a node depends on the neighbours' neighbours). Its Newton
-        # solves run matrix-free: CG with the law's diagonal blocks (quasi_static, mixed); what
-        # factorises the tangent (implicit, linear_solver: direct) is refused, as the solver does.
+        # solves run matrix-free: CG with the law's diagonal blocks (quasi_static, implicit, mixed);
+        # linear_solver: direct, which factorises the tangent, is refused, as the solver does.
         starts_implicit = integrator == "mixed" and case["mixed"].get("start") == "implicit"
-        if integrator == "implicit" or starts_implicit:
-            where = ("mixed", "start") if starts_implicit else ("time", "integrator")
-            checker.error(where, "implicit factorises the assembled tangent stiffness, which the state-based model "
-                          "lps does not have; use time.integrator: verlet, quasi_static or mixed (mixed.start: quasi_static)")
+        if (integrator == "implicit" or starts_implicit) and case["implicit"].get("linear_solver") == "direct":
+            checker.error(("implicit", "linear_solver"), "direct factorises the assembled tangent stiffness, which "
+                          "the state-based model lps does not have; use linear_solver: cg (or auto)")
         elif integrator in ("quasi_static", "mixed") and case["quasi_static"].get("linear_solver") == "direct":
             checker.error(("quasi_static", "linear_solver"), "direct factorises the assembled tangent stiffness, which "
                           "the state-based model lps does not have; use linear_solver: cg (or auto)")

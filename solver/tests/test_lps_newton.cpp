@@ -162,14 +162,23 @@ TEST(LpsQuasiStatic, WhatFactorisesTheTangentIsRefusedWithTheReason) {
               std::string::npos)
         << e.what();
   }
-  pd::Implicit implicit(op);
+  // implicit: auto takes the matrix-free path for lps; direct is refused with what to do.
   pd::Case c = quasi_static_case("auto");
+  {
+    pd::Implicit implicit(op);
+    implicit.configure(c);
+    EXPECT_TRUE(implicit.uses_cg());
+    EXPECT_NE(implicit.describe(0.0)[1].find("(cg, auto: the material lps has no assembled tangent"), std::string::npos)
+        << implicit.describe(0.0)[1];
+  }
+  pd::Implicit implicit(op);
+  c.implicit.linear_solver = "direct";
   try {
     implicit.configure(c);
-    FAIL() << "implicit accepted";
+    FAIL() << "implicit with linear_solver: direct accepted";
   } catch (const pd::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("lps_bar.yaml: time.integrator: implicit factorises the assembled tangent "
-                                         "stiffness, which the state-based material lps"),
+    EXPECT_NE(std::string(e.what()).find("lps_bar.yaml: implicit.linear_solver: direct needs an assembled tangent, "
+                                         "which the state-based material lps"),
               std::string::npos)
         << e.what();
   }

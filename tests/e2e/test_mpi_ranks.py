@@ -6,7 +6,8 @@ A coarse, short copy of cases/plate_with_hole (1234 nodes, pulled faster so that
 then under `mpiexec --oversubscribe -np R` for R = 1, 2, 3 with one thread per rank and for R = 2
 with two. The same holds for the plate with body forces and indenters (a disk pressing its top
 edge, a plane pushing its left grip; their reactions in history.csv are sums over the nodes inside)
-for the plate of LPS, the state-based law, and for the adaptive integrator. What is not decomposed yet is refused on several
+for the plate of LPS, the state-based law, and for the adaptive integrator (the Newton integrators:
+test_mpi_implicit.py). What is not decomposed yet is refused on several
 ranks before any output.
 """
 import json
@@ -190,24 +191,16 @@ def test_run_log_says_how_the_run_was_decomposed(runs):
 
 
 def test_what_is_not_decomposed_is_refused_before_any_output(prepared):
-    def mixed(case):
-        case["time"]["integrator"] = "mixed"
-    folder = copy_case(prepared, "refused", mixed)
+    """Contact inside a Newton solve: the contact's linearised force is not decomposed."""
+    def contact_in_newton(case):
+        case["contact"].update(self_contact=True)
+        case["time"]["integrator"] = "quasi_static"
+    folder = copy_case(prepared, "refused", contact_in_newton)
     result = solve(folder, 2)
     assert result.returncode != 0
-    assert "time.integrator: mixed is not decomposed over MPI ranks yet" in result.stderr, result.stderr
+    assert ("contact with time.integrator: quasi_static (the contact's linearised force) is not decomposed "
+            "over MPI ranks yet") in result.stderr, result.stderr
+    assert "verlet, adaptive, quasi_static, implicit and mixed integrators with pmb and lps bonds" in result.stderr
     assert "run this case on one rank" in result.stderr
     assert result.stderr.count("pdsolve: error") == 1  # said once, by rank 0
-    assert not (folder / "history.csv").exists() and not (folder / "frames").exists()
-
-
-@pytest.mark.parametrize("key, change", [
-    ("time.integrator: quasi_static", lambda case: case["time"].update(integrator="quasi_static")),
-])
-def test_the_implicit_integrators_stay_refused(prepared, key, change):
-    folder = copy_case(prepared, "refused_" + key.split(":")[0].replace(".", "_") + str(len(key)), change)
-    result = solve(folder, 2)
-    assert result.returncode != 0
-    assert f"{key} is not decomposed over MPI ranks yet" in result.stderr, result.stderr
-    assert "verlet and adaptive integrators with pmb and lps bonds" in result.stderr  # what is decomposed
     assert not (folder / "history.csv").exists() and not (folder / "frames").exists()

@@ -72,6 +72,8 @@ struct ImplicitSettings {
   double p = 2.0;              // exponent of eq. 2.8
   int max_iterations = 20;     // Newton iterations before the step is cut
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: time.dt, 1e-6 × eq. 2.5, end/10
+  std::string linear_solver = "auto";  // auto | direct (CHOLMOD) | cg (matrix-free, block-Jacobi)
+  int cg_max_iterations = 5000;        // CG iterations per Newton iteration before it takes the iterate it has
 };
 
 // mixed: quasi-static load steps while the body is in equilibrium, Verlet while a crack runs

@@ -9,6 +9,8 @@
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
 #include "integrators/messages.hpp"
+#include "integrators/newton_krylov.hpp"
+#include "parallel/local_model.hpp"
 
 namespace pd {
 
@@ -31,14 +33,50 @@ void Implicit::configure(const Case& c, double) {
   const double scale = std::isfinite(dt_sa) && dt_sa > 0.0 ? dt_sa : c.time.end;
   dt_max_ = settings_.dt_max.value_or(c.time.end / 10.0);
   dt_min_ = settings_.dt_min.value_or(std::min(1e-6 * scale, dt_max_));
-  // The Newton solves factorise the assembled tangent (CHOLMOD), which a state-based law does not
-  // have: refused here, before any work, rather than at the first step.
-  if (const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0); !missing.empty())
-    throw Error(c.file.string() + ": time.integrator: implicit factorises the assembled tangent stiffness, which " +
-                missing + " does not have; use time.integrator: verlet, quasi_static or mixed (mixed.start: quasi_static)");
+  choose_linear_solver(c);
   if (dt_min_ > dt_max_)
     throw Error(c.file.string() + ": implicit.dt_min = " + message_number(dt_min_) + " s is above dt_max = " +
                 message_number(dt_max_) + " s; lower implicit.dt_min or raise implicit.dt_max");
+}
+
+// direct or cg, and why (for describe()): quasi_static's rule, over this scheme's dofs (z too in 2D).
+void Implicit::choose_linear_solver(const Case& c) {
+  const LinearSolverChoice choice = pd::choose_linear_solver(op_, c, "implicit", settings_.linear_solver, 3);
+  use_cg_ = choice.use_cg;
+  solver_reason_ = choice.reason;
+}
+
+bool Implicit::solve_krylov(const State& s, double t1, double h, double floor) {
+  const double c = mass_coefficient(h);
+  if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
+    // A law with neither form of diagonal block: the mass term alone preconditions.
+    block_first_.clear();
+    for (std::size_t k = 0; k <= dofs_.size(); ++k) block_first_.push_back(static_cast<std::int64_t>(k));
+    blocks_.assign(9 * dofs_.size(), 0.0);
+  }
+  // K_eff's blocks: + c m on the diagonal (a node's dofs share its mass).
+  for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
+    for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a)
+      blocks_[9 * g + static_cast<std::size_t>(4 * a)] += c * mass_[static_cast<std::size_t>(block_first_[g] + a)];
+  preconditioner_.build(block_first_, blocks_);
+  PcgSettings settings;
+  settings.relative_tol = kCgTolerance;
+  settings.absolute_tol = floor;
+  settings.max_iterations = settings_.cg_max_iterations;
+  diagonal_.resize(dofs_.size());
+  for (std::size_t q = 0; q < dofs_.size(); ++q) diagonal_[q] = c * mass_[q];  // K_eff = K + c M
+  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, preconditioner_, r_, correction_,
+                                               settings, cg_x_, cg_y_);
+  cg_iterations_ += result.iterations;
+  ++cg_solves_;
+  report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
+  return result.converged() || result.status == PcgResult::kIndefinite || result.residual < result.initial_residual;
+}
+
+std::string Implicit::linear_algebra_summary() const {
+  if (!use_cg_) return {};  // the direct path's done: line stays as it was
+  return std::to_string(cg_solves_) + " CG solves with " + std::to_string(cg_iterations_) +
+         " iterations (J·x products)";
 }
 
 void Implicit::resume(const State& state) {
@@ -57,7 +95,10 @@ void Implicit::initialize(State& state, double t) {
   // Every component that is not prescribed, z too in 2D: Verlet moves a 2D membrane out of plane
   // (cases/drum), and so must this scheme. K has no z stiffness in a flat unstressed sheet, but
   // K_eff has the mass; z stays exactly 0 where nothing moves it (a zero right-hand side).
-  dofs_ = FreeDofs::of(n, 3, op_.fixed());
+  dofs_ = op_.free_dofs(3);
+  sums_.setup(op_.decomposed(), dofs_);
+  for (auto& terms : terms_) terms.assign(dofs_.size(), 0.0);
+  if (use_cg_) cg_x_ = make_vec3(n), cg_y_ = make_vec3(n);
   const auto& volume = op_.model().nodes.volume;
   const auto& rho = op_.density();
   mass_.resize(dofs_.size());
@@ -108,7 +149,8 @@ bool Implicit::factorize_at(const State& s, double t1, double h, bool definite) 
 double Implicit::residual(const State& start, const State& s, double h, double& scale) {
   const auto& volume = op_.model().nodes.volume;
   const double alpha = op_.damping(), am = ga_.alpha_m, af = ga_.alpha_f, beta = ga_.beta, gamma = ga_.gamma;
-  double rr = 0.0, inertia2 = 0.0, force2 = 0.0;  // serial, dof order: the same for any thread count
+  // Σ r², Σ inertia², Σ force² one by one in dof order (over the ranks: parallel/dof_sums.hpp): the
+  // same for any thread and rank count.
   for (std::size_t q = 0; q < dofs_.size(); ++q) {
     const auto i = static_cast<std::size_t>(dofs_.node[q]);
     const std::size_t d = dofs_.component[q];
@@ -121,12 +163,13 @@ double Implicit::residual(const State& start, const State& s, double h, double& 
     a_new_[q] = a1;
     v_new_[q] = v1;
     r_[q] = inertia - force;
-    rr += r_[q] * r_[q];
-    inertia2 += inertia * inertia;
-    force2 += force * force;
+    terms_[0][q] = r_[q] * r_[q];
+    terms_[1][q] = inertia * inertia;
+    terms_[2][q] = force * force;
   }
-  scale = std::sqrt(inertia2) + std::sqrt(force2);
-  return std::sqrt(rr);
+  const std::vector<double> sums = sums_.sums({&terms_[0], &terms_[1], &terms_[2]});
+  scale = std::sqrt(sums[1]) + std::sqrt(sums[2]);
+  return std::sqrt(sums[0]);
 }
 
 bool Implicit::solve_step(const State& start, State& s, double t1, double h, int& iterations, double& omega) {
@@ -156,7 +199,9 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
     // fast; else assemble and factorise at the current iterate — once per step: a tangent made in
     // this step that no longer cuts the residual 4× is at the round-off floor, or the step is too
     // long for the nonlinearity (then the step is cut).
-    if (!have_factor_ || factor_h_ != h || (res > 0.25 * previous && !fresh)) {
+    if (use_cg_) {
+      fresh = true;  // every iterate's own tangent (full Newton)
+    } else if (!have_factor_ || factor_h_ != h || (res > 0.25 * previous && !fresh)) {
       fresh = true;
       // The definite variant (compressed bonds without their negative lateral stiffness) when the
       // full tangent plus the mass is not positive definite (large Δt under compression): modified
@@ -166,7 +211,11 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
     previous = res;
     const double to_dofs = -1.0 / (1.0 - ga_.alpha_f);  // K_eff Δu = −r/(1 − α_f)
     for (double& value : r_) value *= to_dofs;
-    factor_.solve(r_, correction_);
+    if (use_cg_) {
+      if (!solve_krylov(s, t1, h, -0.5 * to_dofs * settings_.residual_tol * scale)) return false;
+    } else {
+      factor_.solve(r_, correction_);
+    }
     // Backtracking: the full correction unless it raises the residual (then ½, ¼, … up to 1/32).
     // The trial's force evaluation is the next iteration's.
     double step = 1.0;
@@ -183,13 +232,14 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
       step *= 0.5;
     }
     std::swap(s, trial_);
-    double dc = 0.0, dm = 0.0;
     for (std::size_t q = 0; q < dofs_.size(); ++q) {
       const auto i = static_cast<std::size_t>(dofs_.node[q]);
       const double du = step * correction_[q], motion = s.u[dofs_.component[q]][i] - start.u[dofs_.component[q]][i];
-      dc += du * du;
-      dm += motion * motion;
+      terms_[0][q] = du * du;
+      terms_[1][q] = motion * motion;
     }
+    const std::vector<double> norms = sums_.sums({&terms_[0], &terms_[1]});
+    const double dc = norms[0], dm = norms[1];
     omega = dm > 0.0 ? std::sqrt(dc / dm) : 0.0;  // eq. 2.6 for Newton
     iterations = k;
     if (!std::isfinite(omega)) return false;
@@ -225,18 +275,21 @@ void Implicit::step(State& state, double& t, double& dt) {
     if (converged) {
       // The local error estimate (implicit.hpp), against the step's motion like eq. 2.6.
       const double c = ga_.error_coefficient() * h * h;
-      double e2 = 0.0, m2 = 0.0;
       for (std::size_t q = 0; q < dofs_.size(); ++q) {
         const auto i = static_cast<std::size_t>(dofs_.node[q]);
         const std::size_t d = dofs_.component[q];
         const double e = c * (a_new_[q] - a_[d][i]), motion = s.u[d][i] - state.u[d][i];
-        e2 += e * e;
-        m2 += motion * motion;
+        terms_[0][q] = e * e;
+        terms_[1][q] = motion * motion;
       }
+      const std::vector<double> norms = sums_.sums({&terms_[0], &terms_[1]});
+      const double e2 = norms[0], m2 = norms[1];
       // Motions below kMotionFloor × dx per dof are not measured against themselves: a body at rest
       // (round-off noise) or the first instants of a load that starts smoothly from zero (force ∝ t²:
       // the first step's relative error is O(1) at any Δt) would otherwise be cut down to dt_min.
-      const double floor = kMotionFloor * op_.model().nodes.grid_spacing * std::sqrt(static_cast<double>(dofs_.size()));
+      const auto dof_count = op_.decomposed() ? op_.decomposed()->total(static_cast<std::int64_t>(dofs_.size()))
+                                              : static_cast<std::int64_t>(dofs_.size());
+      const double floor = kMotionFloor * op_.model().nodes.grid_spacing * std::sqrt(static_cast<double>(dof_count));
       const double motion = std::max(std::sqrt(m2), floor);
       eta = motion > 0.0 ? std::sqrt(e2) / motion : 0.0;
       if (eta <= settings_.tol) {
@@ -248,7 +301,7 @@ void Implicit::step(State& state, double& t, double& dt) {
         }
         // Thesis order: accept, break, then the force with the bonds left (implicit.hpp).
         if (op_.can_break()) {
-          const BreakReport broke = op_.model().bond_model->break_bonds(op_.model(), s.u, true);
+          const BreakReport broke = op_.break_bonds(s);
           if (broke.broken > 0) {
             const Vec3Array f_old = s.f;
             op_.evaluate(s, t1);
@@ -313,14 +366,20 @@ std::vector<char> Implicit::save_state() const {
   };
   const std::uint8_t have = have_factor_ ? 1 : 0, definite = factor_definite_ ? 1 : 0;
   put(have), put(definite), put(factor_t_), put(factor_h_), put(proposal_), put(last_error_), put(factorisations_);
-  put_vec3(a_);
+  // A decomposed run saves the whole model's a_n in global node order (gathered on rank 0, the one
+  // that writes), as a serial run does: the checkpoint restarts on any rank count.
+  if (const Decomposed* d = op_.decomposed()) put_vec3(d->gather(a_));
+  else put_vec3(a_);
   if (have_factor_) put_vec3(factor_u_);
   return bytes;
 }
 
 void Implicit::load_state(const std::vector<char>& bytes) {
   constexpr std::size_t fixed_part = 2 + 4 * sizeof(double) + sizeof(int);
-  const std::size_t n = op_.size(), vec3 = 3 * n * sizeof(double);
+  const Decomposed* decomposed = op_.decomposed();
+  // The checkpoint's arrays are the whole model's (save_state); a decomposed run takes its piece.
+  const std::size_t n = decomposed ? static_cast<std::size_t>(decomposed->piece().global_nodes) : op_.size();
+  const std::size_t vec3 = 3 * n * sizeof(double);
   if (bytes.size() < kReportBytes + fixed_part) throw std::runtime_error("integrator state of the wrong size");
   const bool have = bytes[kReportBytes] != 0;
   if (bytes.size() != kReportBytes + fixed_part + vec3 + (have ? vec3 : 0))
@@ -337,6 +396,7 @@ void Implicit::load_state(const std::vector<char>& bytes) {
   };
   get(t), get(h), get(proposal_), get(last_error_), get(factorisations);
   get_vec3(a_);
+  if (decomposed) a_ = to_local(decomposed->piece(), a_);
   have_factor_ = false;
   if (have) {
     State s(n);
@@ -354,7 +414,10 @@ std::vector<std::string> Implicit::describe(double) const {
               message_number(settings_.tol) + " (Zienkiewicz & Xie)",
           "implicit: Newton to correction " + message_number(settings_.newton_tol) + " and residual " +
               message_number(settings_.residual_tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
-              message_number(settings_.p) + "; tangent + mass/(βΔt²) factorised by CHOLMOD; steps dt_initial " +
+              message_number(settings_.p) +
+              (use_cg_ ? "; linear solves of tangent + mass/(βΔt²) by matrix-free CG with block-Jacobi (cg, "
+                       : "; tangent + mass/(βΔt²) factorised by CHOLMOD (direct, ") +
+              solver_reason_ + "); steps dt_initial " +
               (settings_.dt_initial ? message_number(*settings_.dt_initial) + " s" : std::string("from time.dt")) +
               ", dt_min " + message_number(dt_min_) + " s, dt_max " + message_number(dt_max_) + " s"};
 }

@@ -56,12 +56,23 @@
 // with the bonds left and used from the next step on; the step is not re-solved. The algorithmic
 // acceleration takes the force's jump, a_{n+1} += (f_new − f_old)/ρ, so that at ρ∞ = 1 the balance
 // m a = V f − α m v still holds at the step end.
+//
+// implicit.linear_solver: cg solves K_eff Δu = −r/(1−α_f) matrix-free instead (linalg/pcg.hpp):
+// K_eff x = −V ∂f/∂u·x + c m x from ForceOperator::apply_jacobian, preconditioned by K_eff's 3×3
+// node blocks (the law's definite diagonal blocks plus c m), to kCgTolerance relative or half the
+// residual tolerance absolute; the tangent is then that of every iterate (full Newton). It needs no
+// assembled tangent, so auto takes it for lps and contact, for 3D models with at least
+// kCgFromDofs3d free dofs (quasi_static's measured threshold), and on several MPI ranks, where the
+// products are force evaluations with ghosts and every norm and dot product is summed in global
+// dof order (parallel/dof_sums.hpp): the same bits for any rank count.
 #pragma once
 #include <memory>
 
 #include "integrators/integrator.hpp"
 #include "linalg/cholesky.hpp"
+#include "linalg/pcg.hpp"
 #include "linalg/sparse_matrix.hpp"
+#include "parallel/dof_sums.hpp"
 
 namespace pd {
 
@@ -94,6 +105,9 @@ class Implicit : public Integrator {
   const ImplicitSettings& settings() const { return settings_; }
   const GeneralizedAlpha& parameters() const { return ga_; }
   int factorisations() const { return factorisations_; }
+  bool uses_cg() const { return use_cg_; }
+  std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
+  std::string linear_algebra_summary() const override;
   double dt_min() const { return dt_min_; }
   double dt_max() const { return dt_max_; }
   // The local error estimate η of the last accepted step (implicit.hpp).
@@ -136,6 +150,23 @@ class Implicit : public Integrator {
 
   State trial_;
   std::vector<double> r_, correction_, a_new_, v_new_;
+
+  // Sums over the dofs (every rank's on a decomposed run) and their per-dof terms.
+  DofSums sums_;
+  std::vector<double> terms_[3];
+  // The matrix-free path: the choice and why (configure), and K_eff Δu = rhs by PCG at (s, t1) into
+  // correction_; false when CG made no progress.
+  static constexpr double kCgTolerance = 1e-6;
+  bool use_cg_ = false;
+  std::string solver_reason_;
+  void choose_linear_solver(const Case& c);
+  bool solve_krylov(const State& s, double t1, double h, double floor);
+  BlockJacobi preconditioner_;
+  std::vector<std::int64_t> block_first_;
+  std::vector<double> blocks_, diagonal_;
+  Vec3Array cg_x_, cg_y_;
+  std::int64_t cg_iterations_ = 0;
+  int cg_solves_ = 0;
 };
 
 }  // namespace pd

@@ -11,6 +11,7 @@
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
 #include "integrators/messages.hpp"
+#include "integrators/newton_krylov.hpp"
 
 namespace pd {
 
@@ -43,44 +44,23 @@ void QuasiStatic::configure(const Case& c, double) {
 // factorisation serves the elastic range): auto keeps direct whatever the size there, unless a term
 // has no assembled form.
 void QuasiStatic::choose_linear_solver(const Case& c) {
-  const int dimension = op_.model().nodes.dimension;
-  const std::size_t free = FreeDofs::of(op_.size(), dimension, op_.fixed()).size();
-  const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0);
-  const bool assembled = missing.empty();
-  const bool law_assembled = assembled || missing == "contact";
-  const std::string& choice = settings_.linear_solver;
-  if (choice == "direct") {
-    if (!assembled)
-      throw Error(c.file.string() + ": quasi_static.linear_solver: direct needs an assembled tangent, which " + missing +
-                  " does not have; use linear_solver: cg (or auto)");
-    use_cg_ = false;
-    solver_reason_ = "as the case file asks";
-  } else if (choice == "cg") {
-    use_cg_ = true;
-    solver_reason_ = "as the case file asks";
-  } else if (!assembled) {
-    use_cg_ = true;
-    solver_reason_ = law_assembled ? "auto: a term (contact) has no assembled tangent"
-                                   : "auto: the material " + op_.model().bond_model->name() + " has no assembled tangent";
-  } else if (dimension == 3 && free >= kCgFromDofs3d) {
-    use_cg_ = true;
-    solver_reason_ = "auto: " + std::to_string(free) + " free dofs in 3D, at least " + std::to_string(kCgFromDofs3d);
-  } else {
-    use_cg_ = false;
-    solver_reason_ = "auto: " + std::to_string(free) + " free dofs" +
-                     (dimension == 3 ? ", below " + std::to_string(kCgFromDofs3d) + " in 3D" : std::string(" in 2D"));
-  }
+  const LinearSolverChoice choice = pd::choose_linear_solver(op_, c, "quasi_static", settings_.linear_solver,
+                                                             op_.model().nodes.dimension);
+  use_cg_ = choice.use_cg;
+  solver_reason_ = choice.reason;
 }
 
 void QuasiStatic::initialize(State& state, double t) {
   op_.start(state, t);
-  dofs_ = FreeDofs::of(state.size(), op_.model().nodes.dimension, op_.fixed());
+  dofs_ = op_.free_dofs(op_.model().nodes.dimension);
+  sums_.setup(op_.decomposed(), dofs_);
   // Equilibrium fixes u only up to the rigid motions nothing holds: a direction in which no node
   // is prescribed is one (rotations are caught by the factorisation, singular then).
   static const char* const axis[3] = {"x", "y", "z"};
   for (int d = 0; d < op_.model().nodes.dimension; ++d) {
     const auto& held = op_.fixed()[static_cast<std::size_t>(d)];
-    if (std::none_of(held.begin(), held.end(), [](std::uint8_t f) { return f != 0; }))
+    const bool here = std::any_of(held.begin(), held.end(), [](std::uint8_t f) { return f != 0; });
+    if (!(op_.decomposed() ? op_.decomposed()->total(here ? 1 : 0) > 0 : here))
       throw Error(std::string("time.integrator: quasi_static: the body can move freely in ") + axis[d] +
                   " (no node has a displacement or velocity condition in " + axis[d] +
                   "): quasi_static needs one, or use time.integrator: verlet");
@@ -94,7 +74,6 @@ void QuasiStatic::initialize(State& state, double t) {
 }
 
 bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
-  const auto& volume = op_.model().nodes.volume;
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
     // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG.
     block_first_.clear();
@@ -110,39 +89,22 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
     for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
       for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a)
         largest = std::max(largest, std::fabs(blocks_[9 * g + static_cast<std::size_t>(4 * a)]));
+    if (op_.decomposed()) largest = -op_.decomposed()->minimum(-largest);  // over every rank's blocks: exact
     shift = kDiagonalShift * largest;
     for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
       for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a) blocks_[9 * g + static_cast<std::size_t>(4 * a)] += shift;
   }
   preconditioner_.build(block_first_, blocks_);
-  // K x = −V ∂f/∂u·x over the free dofs (x zero at the prescribed components) + shift·x.
-  const LinearOperator K = [&](const std::vector<double>& x, std::vector<double>& y) {
-    dofs_.scatter(x, cg_x_);
-    op_.apply_jacobian(s, t1, cg_x_, cg_y_);
-    y.resize(x.size());
-    const auto n = static_cast<std::int64_t>(dofs_.size());
-#pragma omp parallel for schedule(static) if (n >= 32768)
-    for (std::int64_t k = 0; k < n; ++k) {
-      const auto q = static_cast<std::size_t>(k);
-      const auto i = static_cast<std::size_t>(dofs_.node[q]);
-      y[q] = -volume[i] * cg_y_[dofs_.component[q]][i] + shift * x[q];
-    }
-  };
   PcgSettings settings;
   settings.relative_tol = eta;
   settings.absolute_tol = floor;
   settings.max_iterations = settings_.cg_max_iterations;
-  correction_.clear();  // CG from Δu = 0
-  const PcgResult result = preconditioned_cg(K, preconditioner_, rhs_, correction_, settings);
+  diagonal_.assign(dofs_.size(), shift);  // K + shift·I
+  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, preconditioner_, rhs_, correction_,
+                                               settings, cg_x_, cg_y_);
   cg_iterations_ += result.iterations;
   ++cg_solves_;
   report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
-  if (result.status == PcgResult::kIndefinite && result.iterations == 0) {
-    // Negative curvature along the first direction: the preconditioned residual, a descent
-    // direction of the energy, scaled by the line search (Steihaug's first step).
-    preconditioner_.apply(rhs_, correction_);
-    return true;
-  }
   if (result.status == PcgResult::kNotConverged && !(result.residual < result.initial_residual)) {
     cg_failure_ = result.message();
     return false;
@@ -152,32 +114,46 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
 
 double QuasiStatic::residual_norm(const State& s) const {
   const auto& volume = op_.model().nodes.volume;
-  double sum = 0.0;  // serial, dof order: the same for any thread count
+  // Σ r_k² one by one in dof order (over the ranks: parallel/dof_sums.hpp): the same bits for any
+  // thread and rank count.
+  terms_.resize(dofs_.size());
   for (std::size_t k = 0; k < dofs_.size(); ++k) {
     const auto i = static_cast<std::size_t>(dofs_.node[k]);
     const double r = volume[i] * s.f[dofs_.component[k]][i];
-    sum += r * r;
+    terms_[k] = r * r;
   }
-  return std::sqrt(sum);
+  return std::sqrt(sums_.sum(terms_));
 }
 
 double QuasiStatic::load_scale(const State& s, double t) const {
   // The load the residual is measured against: the reactions at prescribed components plus the
   // body forces, as force vectors [N].
   const Model& m = op_.model();
+  const Decomposed* d = op_.decomposed();
   double sum = 0.0;
-  for (const auto& p : m.conditions.prescribed)
-    for (std::int32_t i32 : p.nodes) {
-      const auto i = static_cast<std::size_t>(i32);
-      const double r = m.nodes.volume[i] * s.f[static_cast<std::size_t>(p.component)][i];
-      sum += r * r;
+  // One condition's Σ r², continuing the sum: serially node by node in the condition's order, and
+  // decomposed as an ordered sum over the owned nodes (node order, as ForceOperator's powers).
+  std::vector<double> term(d ? s.size() : 0);
+  const auto add = [&](const std::vector<std::int32_t>& nodes, const auto& r_of) {
+    if (!d) {
+      for (std::int32_t i32 : nodes) {
+        const double r = r_of(static_cast<std::size_t>(i32));
+        sum += r * r;
+      }
+      return;
     }
+    std::fill(term.begin(), term.end(), 0.0);
+    for (std::int32_t i32 : nodes) {
+      const double r = r_of(static_cast<std::size_t>(i32));
+      term[static_cast<std::size_t>(i32)] = r * r;
+    }
+    sum = d->ordered_sum(term, sum);
+  };
+  for (const auto& p : m.conditions.prescribed)
+    add(p.nodes, [&](std::size_t i) { return m.nodes.volume[i] * s.f[static_cast<std::size_t>(p.component)][i]; });
   for (const auto& b : m.conditions.body_forces) {
     const double value = b.table.value(t);
-    for (std::int32_t i32 : b.nodes) {
-      const double r = m.nodes.volume[static_cast<std::size_t>(i32)] * value;
-      sum += r * r;
-    }
+    add(b.nodes, [&](std::size_t i) { return m.nodes.volume[i] * value; });
   }
   return std::sqrt(sum);
 }
@@ -338,12 +314,18 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       if (residual_norm(trial_) < residual) break;
       alpha *= 0.5;
     }
+    // Σ Δu² and Σ (u − u_n)² one by one in dof order (over the ranks: parallel/dof_sums.hpp).
+    terms_.resize(dofs_.size());
+    motion_terms_.resize(dofs_.size());
     for (std::size_t q = 0; q < dofs_.size(); ++q) {
       const auto i = static_cast<std::size_t>(dofs_.node[q]);
       const double du = alpha * correction_[q], from_start = trial_.u[dofs_.component[q]][i] - u_start[dofs_.component[q]][i];
-      step_norm += du * du;
-      motion += from_start * from_start;
+      terms_[q] = du * du;
+      motion_terms_[q] = from_start * from_start;
     }
+    const std::vector<double> norms = sums_.sums({&terms_, &motion_terms_});
+    step_norm = norms[0];
+    motion = norms[1];
     std::swap(s.u, trial_.u);
     omega = motion > 0.0 ? std::sqrt(step_norm / motion) : 0.0;  // eq. 2.6 for Newton
     iterations = k;
@@ -360,10 +342,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   report_.force_evaluations = 0;
   // From the bonds themselves, not a flag carried along: a restarted run (or a pre-cracked body)
   // shifts its tangent exactly as the uninterrupted run does.
-  if (!broken_since_start_) {
-    const auto& broken = op_.model().bonds.broken;
-    broken_since_start_ = std::any_of(broken.begin(), broken.end(), [](std::uint8_t b) { return b != 0; });
-  }
+  if (!broken_since_start_) broken_since_start_ = op_.any_broken();
   double h = std::min(dt, dt_max_);
   for (;;) {
     const double t1 = t + h;
@@ -377,7 +356,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       converged = solve_equilibrium(s, t1, state.u, iterations, omega);
       total += iterations;
       if (!converged) break;
-      const BreakReport broke = op_.model().bond_model->break_bonds(op_.model(), s.u, true);
+      const BreakReport broke = op_.break_bonds(s);
       if (broke.broken == 0) break;
       broke_total.broken += broke.broken;
       broke_total.energy += broke.energy;

@@ -32,7 +32,9 @@
 #include "integrators/integrator.hpp"
 #include "linalg/cholesky.hpp"
 #include "linalg/pcg.hpp"
+#include "integrators/newton_krylov.hpp"
 #include "linalg/sparse_matrix.hpp"
+#include "parallel/dof_sums.hpp"
 
 namespace pd {
 
@@ -64,7 +66,7 @@ class QuasiStatic : public Integrator {
   std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
   int cg_solves() const { return cg_solves_; }
   // Auto picks cg at or above this many free dofs in 3D (measured: see the .cpp).
-  static constexpr std::size_t kCgFromDofs3d = 20000;
+  static constexpr std::size_t kCgFromDofs3d = pd::kCgFromDofs3d;
   const QuasiStaticSettings& settings() const { return settings_; }
 
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
@@ -92,6 +94,8 @@ class QuasiStatic : public Integrator {
   double end_ = 0.0, dt_min_ = 0.0, dt_max_ = 0.0;
   std::optional<double> dt_initial_;
   FreeDofs dofs_;
+  DofSums sums_;  // the norms and CG's dot products over dofs_ (every rank's on a decomposed run)
+  mutable std::vector<double> terms_, motion_terms_;  // per-dof terms of those sums
   SparseCholesky factor_;
   bool have_factor_ = false;
   int factorisations_ = 0;
@@ -114,7 +118,7 @@ class QuasiStatic : public Integrator {
   std::string cg_failure_;
   BlockJacobi preconditioner_;
   std::vector<std::int64_t> block_first_;
-  std::vector<double> blocks_, cg_rhs_;
+  std::vector<double> blocks_, cg_rhs_, diagonal_;
   Vec3Array cg_x_, cg_y_;
   std::int64_t cg_iterations_ = 0;
   int cg_solves_ = 0;

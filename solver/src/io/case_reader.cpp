@@ -331,6 +331,19 @@ IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) 
   return ind;
 }
 
+// <section>.linear_solver (auto | direct | cg) and <section>.cg_max_iterations of quasi_static and
+// implicit (integrators/newton_krylov.hpp).
+void read_linear_solver(const Checker& ck, const json& j, const std::string& section, std::string& choice,
+                        int& cg_max_iterations) {
+  if (const json* v = ck.optional(j, "linear_solver")) {
+    choice = ck.string(*v, section + ".linear_solver");
+    if (choice != "auto" && choice != "direct" && choice != "cg")
+      ck.fail(section + ".linear_solver", "unknown value '" + choice + "'; known: auto, direct, cg");
+  }
+  if (const json* v = ck.optional(j, "cg_max_iterations"))
+    cg_max_iterations = static_cast<int>(ck.integer(*v, section + ".cg_max_iterations", 1, 100000000));
+}
+
 // The quasi_static section (integrators/quasi_static.hpp).
 QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
   ck.object(j, "quasi_static");
@@ -351,13 +364,7 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
                             {"dt_min", &q.dt_min}, {"dt_max", &q.dt_max}})
     if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("quasi_static.") + name);
   if (q.dt_min && q.dt_max && *q.dt_min > *q.dt_max) ck.fail("quasi_static.dt_min", "is larger than quasi_static.dt_max");
-  if (const json* v = ck.optional(j, "linear_solver")) {
-    q.linear_solver = ck.string(*v, "quasi_static.linear_solver");
-    if (q.linear_solver != "auto" && q.linear_solver != "direct" && q.linear_solver != "cg")
-      ck.fail("quasi_static.linear_solver", "unknown value '" + q.linear_solver + "'; known: auto, direct, cg");
-  }
-  if (const json* v = ck.optional(j, "cg_max_iterations"))
-    q.cg_max_iterations = static_cast<int>(ck.integer(*v, "quasi_static.cg_max_iterations", 1, 100000000));
+  read_linear_solver(ck, j, "quasi_static", q.linear_solver, q.cg_max_iterations);
   return q;
 }
 
@@ -388,6 +395,7 @@ ImplicitSettings read_implicit(const Checker& ck, const json& j) {
   if (m.dt_min && m.dt_max && *m.dt_min > *m.dt_max) ck.fail("implicit.dt_min", "is larger than implicit.dt_max");
   if (m.dt_initial && m.dt_max && *m.dt_initial > *m.dt_max) ck.fail("implicit.dt_initial", "is larger than implicit.dt_max");
   if (m.dt_initial && m.dt_min && *m.dt_initial < *m.dt_min) ck.fail("implicit.dt_initial", "is smaller than implicit.dt_min");
+  read_linear_solver(ck, j, "implicit", m.linear_solver, m.cg_max_iterations);
   return m;
 }
 
@@ -456,7 +464,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
-                    "dt_min", "dt_max"}},
+                    "dt_min", "dt_max", "linear_solver", "cg_max_iterations"}},
       {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",

@@ -154,6 +154,9 @@ json describe_case() {
   keys["implicit.dt_initial"] = defaulted("number", value_or_null(im.dt_initial), {{"above", 0.0}, {"unit", "s"}});
   keys["implicit.dt_min"] = defaulted("number", value_or_null(im.dt_min), {{"above", 0.0}, {"unit", "s"}});
   keys["implicit.dt_max"] = defaulted("number", value_or_null(im.dt_max), {{"above", 0.0}, {"unit", "s"}});
+  keys["implicit.linear_solver"] = defaulted("string", im.linear_solver, {{"choices", {"auto", "direct", "cg"}}});
+  keys["implicit.cg_max_iterations"] =
+      defaulted("integer", im.cg_max_iterations, {{"minimum", 1}, {"maximum", 100000000}});
   const MixedSettings mx{};
   keys["mixed"] = defaulted("object", json::object());
   keys["mixed.start"] = defaulted("string", mx.start, {{"choices", {"quasi_static", "implicit"}}});

@@ -63,20 +63,34 @@ void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y) {
 
 }  // namespace
 
-double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& b) {
-  const auto n = static_cast<std::int64_t>(a.size());
+namespace {
+
+// Σ term(k) for k < n in the fixed order of pcg.hpp: each kChunk-long chunk summed serially, the
+// chunk sums added serially in chunk order.
+template <class Term>
+double chunked_sum(std::int64_t n, const Term& term) {
   const std::int64_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<double> partial(static_cast<std::size_t>(chunks), 0.0);
 #pragma omp parallel for schedule(static) if (n >= kParallelFrom)
   for (std::int64_t c = 0; c < chunks; ++c) {
     double sum = 0.0;
     const std::int64_t end = std::min(n, (c + 1) * kChunk);
-    for (std::int64_t k = c * kChunk; k < end; ++k) sum += a[static_cast<std::size_t>(k)] * b[static_cast<std::size_t>(k)];
+    for (std::int64_t k = c * kChunk; k < end; ++k) sum += term(static_cast<std::size_t>(k));
     partial[static_cast<std::size_t>(c)] = sum;
   }
   double sum = 0.0;
   for (double p : partial) sum += p;
   return sum;
+}
+
+}  // namespace
+
+double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& b) {
+  return chunked_sum(static_cast<std::int64_t>(a.size()), [&](std::size_t k) { return a[k] * b[k]; });
+}
+
+double fixed_order_sum(const std::vector<double>& terms) {
+  return chunked_sum(static_cast<std::int64_t>(terms.size()), [&](std::size_t k) { return terms[k]; });
 }
 
 void BlockJacobi::build(const std::vector<std::int64_t>& first, const std::vector<double>& blocks) {
@@ -139,6 +153,7 @@ std::string PcgResult::message() const {
 PcgResult preconditioned_cg(const LinearOperator& A, const BlockJacobi& M, const std::vector<double>& b,
                             std::vector<double>& x, const PcgSettings& settings) {
   PcgResult result;
+  const DotProduct dot = settings.dot ? settings.dot : DotProduct(fixed_order_dot);
   const std::size_t n = b.size();
   std::vector<double> r(n), z, p, q(n);
   if (x.size() != n) {
@@ -148,16 +163,16 @@ PcgResult preconditioned_cg(const LinearOperator& A, const BlockJacobi& M, const
     A(x, q);
     for (std::size_t k = 0; k < n; ++k) r[k] = b[k] - q[k];
   }
-  double rr = fixed_order_dot(r, r);
+  double rr = dot(r, r);
   result.initial_residual = result.residual = std::sqrt(rr);
-  const double target = std::max(settings.relative_tol * std::sqrt(fixed_order_dot(b, b)), settings.absolute_tol);
+  const double target = std::max(settings.relative_tol * std::sqrt(dot(b, b)), settings.absolute_tol);
   if (result.residual <= target) return result.status = PcgResult::kConverged, result;
   M.apply(r, z);
   p = z;
-  double rz = fixed_order_dot(r, z);
+  double rz = dot(r, z);
   for (int it = 1; it <= settings.max_iterations; ++it) {
     A(p, q);
-    const double curvature = fixed_order_dot(p, q);
+    const double curvature = dot(p, q);
     if (!(curvature > 0.0)) {  // A is not positive definite along p (or a NaN came in)
       result.status = PcgResult::kIndefinite;
       result.curvature = curvature;
@@ -167,11 +182,11 @@ PcgResult preconditioned_cg(const LinearOperator& A, const BlockJacobi& M, const
     axpy(alpha, p, x);
     axpy(-alpha, q, r);
     result.iterations = it;
-    rr = fixed_order_dot(r, r);
+    rr = dot(r, r);
     result.residual = std::sqrt(rr);
     if (result.residual <= target) return result.status = PcgResult::kConverged, result;
     M.apply(r, z);
-    const double rz_next = fixed_order_dot(r, z);
+    const double rz_next = dot(r, z);
     const double beta = rz_next / rz;
     rz = rz_next;
     xpby(z, beta, p);  // p = z + β p

@@ -19,6 +19,10 @@ using LinearOperator = std::function<void(const std::vector<double>& x, std::vec
 
 // Σ a_k b_k in the fixed order above (OpenMP over the chunks).
 double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& b);
+// Σ t_k in the same order: fixed_order_dot(a, b) == fixed_order_sum(a ⊙ b) bit for bit (the products
+// are rounded alike: no FMA contraction in the baseline x86-64 build). A decomposed run sums its
+// gathered products with it (parallel/dof_sums.hpp).
+double fixed_order_sum(const std::vector<double>& terms);
 
 // M⁻¹ for M = blockdiag(M_1, …, M_n): block g covers the unknowns first[g] … first[g+1]−1 (1 to 3 of
 // them: a node's free components, numbered together by FreeDofs). Each block is inverted once, by
@@ -41,10 +45,17 @@ class BlockJacobi {
   std::int64_t fallbacks_ = 0;
 };
 
+// Σ a_k b_k over all the unknowns of the system (a decomposed run's: every rank's, parallel/dof_sums.hpp).
+using DotProduct = std::function<double(const std::vector<double>& a, const std::vector<double>& b)>;
+
 struct PcgSettings {
   double relative_tol = 1e-8;  // stop when ‖r‖ ≤ max(relative_tol × ‖b‖, absolute_tol)
   double absolute_tol = 0.0;
   int max_iterations = 1000;
+  // Every dot product and norm of the iteration; empty: fixed_order_dot. A decomposed run passes
+  // one summed in global dof order over the ranks, so every rank takes the same α and β as a
+  // serial solve would, bit for bit (the vector updates are element by element).
+  DotProduct dot;
 };
 
 struct PcgResult {

@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/stability.hpp"
 #include "forces/damping.hpp"
+#include "parallel/local_model.hpp"
 #include "parallel/node_sum.hpp"
 
 namespace pd {
@@ -66,10 +67,46 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
   return report;
 }
 
+BreakReport ForceOperator::break_bonds(State& s) {
+  if (!decomposed_) return model_.bond_model->break_bonds(model_, s.u, true);
+  // The breaking of break_bonds_and_evaluate into scratch force arrays: the same flags as the law's
+  // break_bonds (bond_model.hpp), with each node's share of the lost energy kept for the ordered sum.
+  decomposed_->update_ghosts(s.u);
+  Vec3Array f = make_vec3(s.size());
+  std::vector<double> w(s.size(), 0.0), lost(s.size(), 0.0);
+  BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, f, w.data(), true, lost.data());
+  report.broken = decomposed_->total(report.broken);
+  report.energy = report.broken > 0 ? decomposed_->ordered_sum(lost) : 0.0;
+  return report;
+}
+
+bool ForceOperator::any_broken() const {
+  const auto& broken = model_.bonds.broken;
+  const bool here = std::any_of(broken.begin(), broken.end(), [](std::uint8_t b) { return b != 0; });
+  return decomposed_ ? decomposed_->total(here ? 1 : 0) > 0 : here;
+}
+
+FreeDofs ForceOperator::free_dofs(int dimension) const {
+  if (!decomposed_) return FreeDofs::of(size(), dimension, fixed());
+  // A ghost is treated as prescribed: its row, and so its unknowns, belong to its owner.
+  auto held = fixed();
+  const auto& owned = decomposed_->piece().owned;
+  for (auto& component : held)
+    for (std::size_t i = 0; i < component.size(); ++i)
+      if (!owned[i]) component[i] = 1;
+  return FreeDofs::of(size(), dimension, held);
+}
+
 void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x, Vec3Array& y) const {
+  const Vec3Array* in = &x;
+  if (decomposed_) {
+    ghosted_x_ = x;
+    decomposed_->update_ghosts(ghosted_x_);
+    in = &ghosted_x_;
+  }
   for (auto& yc : y) std::fill(yc.begin(), yc.end(), 0.0);
-  model_.bond_model->add_jacobian_product(model_, s.u, x, y);
-  for (const auto& term : terms_) term->add_jacobian_product(s, t, x, y);
+  model_.bond_model->add_jacobian_product(model_, s.u, *in, y);
+  for (const auto& term : terms_) term->add_jacobian_product(s, t, *in, y);
 }
 
 bool ForceOperator::has_assembled_stiffness(const State& s, double t) const {

@@ -43,9 +43,22 @@ class ForceOperator {
   // Bonds over their critical stretch at s.u break (thesis §2.2: after the state update, before the
   // force there), then evaluate(s, t) in the same sweep over the bonds. Returns what broke now.
   BreakReport break_bonds_and_evaluate(State& s, double t);
+  // Only the breaking: bonds over their critical stretch at s.u break (the implicit integrators
+  // break after a converged solve, then solve again). Serial: the law's break_bonds, as before.
+  // Decomposed: the ghosts' u first, the count summed over the ranks and the energy in node order
+  // (as break_bonds_and_evaluate). Collective on a decomposed run.
+  BreakReport break_bonds(State& s);
+  // Whether any bond of the whole model is broken (collective on a decomposed run).
+  bool any_broken() const;
+  // The free dofs of the implicit solves (linalg/sparse_matrix.hpp FreeDofs) over the nodes this
+  // operator owns: all nodes serially; on a decomposed run the owned ones only (a ghost's row is
+  // its owner's), in local order, which is ascending global order.
+  FreeDofs free_dofs(int dimension) const;
 
   // y = ∂f/∂u·x at (s.u, t): the linearised force density (matrix-free). Prescribed components are
-  // not treated specially: a solver constrains them itself.
+  // not treated specially: a solver constrains them itself. Decomposed: x's ghost entries are taken
+  // from their owners first (a halo exchange of a copy; s.u's ghosts must be current, as after
+  // evaluate(s, t)), so an owned row is the serial row bit for bit. Collective then.
   void apply_jacobian(const State& s, double t, const Vec3Array& x, Vec3Array& y) const;
 
   // K = −V_i ∂f_i/∂u_j over the free dofs at (s.u, t): the assembled tangent stiffness (symmetric;
@@ -108,6 +121,7 @@ class ForceOperator {
   std::vector<const ForceTerm*> power_terms_;            // the same, in power order
   std::vector<const ForceTerm*> built_;                  // per registry entry: its term, or null
   const Decomposed* decomposed_ = nullptr;
+  mutable Vec3Array ghosted_x_;  // apply_jacobian's x with its ghosts filled (decomposed only)
   double decomposed_external_power(const State& s, double t) const;
   double decomposed_damping_power(const State& s) const;
 };

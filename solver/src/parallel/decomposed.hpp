@@ -54,6 +54,9 @@ class Decomposed {
   Vec3Array gather(const Vec3Array& a) const {
     return {gather(a[0]), gather(a[1]), gather(a[2])};
   }
+  // The same for `width` values per node (local node l's at width·l …), in one message per rank:
+  // on rank 0 width × (global nodes) values, node g's at width·g … (empty elsewhere). Collective.
+  virtual std::vector<double> gather(const std::vector<double>& per_node, int width) const = 0;
   // Entries of owned nodes from every rank — entry e is node global_node[e] with the `width` values
   // values[width·e …] — merged on rank 0 in ascending global node order (empty elsewhere): for a sum
   // over a few nodes (those inside an indenter) that rank 0 then takes in the serial loop's order.

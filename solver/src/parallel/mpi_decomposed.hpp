@@ -39,6 +39,9 @@ class MpiDecomposed : public Decomposed {
 
   using Decomposed::gather;
   std::vector<double> gather(const std::vector<double>& per_node) const override { return sum_->gather(per_node); }
+  std::vector<double> gather(const std::vector<double>& per_node, int width) const override {
+    return sum_->gather(per_node, width);
+  }
   void gather_entries(const std::vector<std::int32_t>& global_node, const std::vector<double>& values, int width,
                       std::vector<std::int32_t>& all_nodes, std::vector<double>& all_values) const override;
   void broadcast(std::vector<double>& values) const override;

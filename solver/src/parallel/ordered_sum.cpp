@@ -39,6 +39,33 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) cons
   return out;
 }
 
+std::vector<double> OrderedSum::gather(const std::vector<double>& per_node, int width) const {
+  const double start = MPI_Wtime();
+  const auto w = static_cast<std::size_t>(width);
+  std::vector<double> send(w * owned_local_.size());
+  for (std::size_t k = 0; k < owned_local_.size(); ++k)
+    for (std::size_t c = 0; c < w; ++c) send[w * k + c] = per_node[w * static_cast<std::size_t>(owned_local_[k]) + c];
+  std::vector<int> counts, starts;
+  std::vector<double> received;
+  if (rank_ == 0) {
+    for (int count : counts_) counts.push_back(width * count);
+    for (int at : starts_) starts.push_back(width * at);
+    received.resize(w * static_cast<std::size_t>(global_nodes_));
+  }
+  MPI_Gatherv(send.data(), static_cast<int>(send.size()), MPI_DOUBLE, received.data(), counts.data(), starts.data(),
+              MPI_DOUBLE, 0, comm_);
+  std::vector<double> out;
+  if (rank_ == 0) {
+    out.resize(received.size());
+    for (std::size_t k = 0; k < gathered_node_.size(); ++k)
+      for (std::size_t c = 0; c < w; ++c) out[w * static_cast<std::size_t>(gathered_node_[k]) + c] = received[w * k + c];
+  }
+  ++calls_;
+  bytes_ += static_cast<std::int64_t>(8 * send.size());
+  seconds_ += MPI_Wtime() - start;
+  return out;
+}
+
 void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
   const double start = MPI_Wtime();
   std::vector<std::uint8_t> flags;

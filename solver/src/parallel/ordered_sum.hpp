@@ -24,6 +24,9 @@ class OrderedSum {
   double sum(const std::vector<double>& per_node, double start = 0.0) const;
   // The owned entries of every rank, in global node order, on rank 0 (empty elsewhere). Collective.
   std::vector<double> gather(const std::vector<double>& per_node) const;
+  // The same for `width` values per node (local node l's at width·l …): on rank 0, node g's at
+  // width·g …. One MPI_Gatherv. Collective.
+  std::vector<double> gather(const std::vector<double>& per_node, int width) const;
   // The broken flags of the owned rows of `local` (the piece's bond list) into the same rows of
   // `global` (the whole model's), on rank 0. Collective.
   void gather_rows(const BondList& local, BondList& global) const;

@@ -134,11 +134,13 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     const NeighbourList& contact_list = p.op->model().contact_list;
     const Vec3Array contact_u_build =
         dec && model.contact.pairs && contact_list.rebuilds() > 0 ? dec->gather(contact_list.u_build()) : Vec3Array{};
+    // Collective too: an integrator's per-node state is gathered on rank 0 (integrators/implicit.cpp).
+    std::vector<char> integrator_state = p.integrator->save_state();
     if (!out) return;
     out->flush_history();
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
-    write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, contact_u_build));
+    write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, std::move(integrator_state), contact_u_build));
   };
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,

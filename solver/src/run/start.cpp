@@ -158,7 +158,7 @@ std::string restart_line(const RunOptions& opt, const Start& s) {
 }
 
 Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
-                         const OutputWriter& out, const Vec3Array& contact_u_build) {
+                         const OutputWriter& out, std::vector<char> integrator_state, const Vec3Array& contact_u_build) {
   const Model& model = p.model;
   Checkpoint k;
   k.case_hash = s.case_hash;
@@ -167,7 +167,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, 
   k.directed_bonds = model.bonds.directed();
   k.integrator = p.integrator->name();
   k.loop = loop;
-  k.integrator_state = p.integrator->save_state();
+  k.integrator_state = std::move(integrator_state);
   k.state = whole;
   k.broken_flags = model.bonds.broken;
   k.node_critical_stretch = model.node_critical_stretch;

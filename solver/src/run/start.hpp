@@ -43,9 +43,10 @@ std::string restart_line(const RunOptions& options, const Start& s);
 // Everything the loop carries from step to step, for checkpoint.bin. loop.wall_time: the time
 // loop's seconds up to now.
 // `whole`: the run's state in the whole model's numbering (on a decomposed run, gathered on rank 0;
-// the broken flags are then p.model's, gathered too). contact_u_build: on a decomposed run with
-// contact, the displacement at the last Verlet-list build gathered the same way (empty otherwise).
+// the broken flags are then p.model's, gathered too). integrator_state: Integrator::save_state(),
+// which every rank of a decomposed run calls (it may gather). contact_u_build: on a decomposed run
+// with contact, the displacement at the last Verlet-list build gathered the same way (empty otherwise).
 Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
-                         const OutputWriter& out, const Vec3Array& contact_u_build = {});
+                         const OutputWriter& out, std::vector<char> integrator_state, const Vec3Array& contact_u_build = {});
 
 }  // namespace pd

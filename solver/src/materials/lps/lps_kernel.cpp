@@ -328,6 +328,8 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
     p[static_cast<std::size_t>(i)] = k.p_of(i, theta, sm);
     dp[static_cast<std::size_t>(i)] = k.p_of(i, k.theta_of(i, sd), sm);  // P is linear in θ at fixed m'
   }
+  // A decomposed run (issue 15): the ghosts' P and δP from their owners, for the second sweep.
+  if (decomposed_) decomposed_->update_ghosts(p), decomposed_->update_ghosts(dp);
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < k.nodes; ++i) {
     const auto iu = static_cast<std::size_t>(i);

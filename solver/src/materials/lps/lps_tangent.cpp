@@ -28,6 +28,8 @@
 
 #include "materials/lps/lps_kernel.hpp"
 
+#include "parallel/decomposed.hpp"
+
 namespace pd {
 
 bool LpsModel::jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, std::vector<double>& blocks,
@@ -53,6 +55,8 @@ bool LpsModel::jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, 
     gamma[iu] = k.p_of(i, 1.0, sm);
     b[3 * iu] = b0, b[3 * iu + 1] = b1, b[3 * iu + 2] = b2;
   }
+  // A decomposed run (issue 15): the far ends' P and γ of the ghosts from their owners.
+  if (decomposed_) decomposed_->update_ghosts(p), decomposed_->update_ghosts(gamma);
   // Sweep 2: the block of each node, from its own bonds and the γ, m, a, P of their far ends.
   blocks.assign(9 * n, 0.0);
 #pragma omp parallel for schedule(static)
