@@ -17,7 +17,8 @@ from preprocess.node_file import read_node_file
 from conftest import ROOT
 
 LPS = "    model: lps\n    poisson_ratio: 0.3\n"
-# (case, the text to change, its replacement): the 3D plate at 2 dx (40 × 20 × 3 nodes) to stay quick.
+# (case, the text to change, its replacement): the 3D plate at 2 dx (40 × 20 × 3 nodes) and the
+# branching plate (its pre-crack) at 2 dx and 2 δ (150 × 60) to stay quick.
 VARIANTS = {
     "membrane-pmb": ("membrane", "", ""),
     "membrane-lps": ("membrane", "    youngs_modulus: 3.0e9", LPS + "    youngs_modulus: 3.0e9"),
@@ -32,8 +33,12 @@ def steps(name, tmp_path, pdsolve, correction):
     case_dir = os.path.join(ROOT, "cases", case)
     with open(os.path.join(case_dir, case + ".yaml"), encoding="utf-8") as stream:
         text = stream.read()
-    if name.startswith("plate_3d"):
-        text = text.replace("  dx: 5.0e-4 ", "  dx: 1.0e-3 ")
+    coarse = {"plate_3d": [("  dx: 5.0e-4 ", "  dx: 1.0e-3 ")],
+              "branching": [("  dx: 3.3333333333333335e-4 ", "  dx: 6.666666666666667e-4 "),
+                            ("  horizon: 1.0e-3 ", "  horizon: 2.0e-3 ")]}
+    for a, b in coarse.get(case, []):
+        assert text.count(a) == 1
+        text = text.replace(a, b)
     assert (not old or text.count(old) >= 1) and text.count("\ndiscretization:\n") == 1
     text = text.replace(old, new, 1) if old else text
     text = text.replace("\ndiscretization:\n", f"\ndiscretization:\n  surface_correction: {correction}\n")
