@@ -75,6 +75,8 @@ std::shared_ptr<const BondModel> LpsModel::for_piece(const Model&, const std::ve
   local->alpha_ = pick(alpha_);
   local->a_ = pick(a_);
   local->b_ = pick(b_);
+  local->kappa0_ = pick(kappa0_);
+  local->mu0_ = pick(mu0_);
   local->decomposed_ = nullptr;
   return local;
 }
