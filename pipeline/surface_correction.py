@@ -38,7 +38,8 @@ def probe_strain(law: dict, block: int, d: int, dims: int, horizon: float, thick
     axial[d] = 1.0
     lateral = np.zeros(3)
     lateral[[e for e in range(dims) if e != d]] = 1.0
-    w = lambda s: continuum_energy(law, block, s, dims, horizon, thickness)  # noqa: E731
+    def w(strain):
+        return continuum_energy(law, block, strain, dims, horizon, thickness)
     ratio = (w(axial + lateral) - w(axial) - w(lateral)) / (2.0 * w(lateral))
     return axial - ratio * lateral
 
@@ -58,7 +59,7 @@ def direction_factors(law: dict, n: int, dims: int, horizon: float, thickness: f
     per block, "influence": ω per bond}."""
     blocks = int(block.max()) + 1 if n else 0
     probes = [[probe_strain(law, b, d, dims, horizon, thickness) for d in range(dims)] for b in range(blocks)]
-    continuum = np.array([[continuum_energy(law, b, probes[b][d] * 1.0, dims, horizon, thickness)
+    continuum = np.array([[continuum_energy(law, b, probes[b][d], dims, horizon, thickness)
                            for d in range(dims)] for b in range(blocks)])
     live = weight * intact
     factors = np.ones((n, 3))
