@@ -155,9 +155,9 @@ CASE = {
                            "hhb (family |ξ| − dx/2 ≤ δ, ν = (δ − |ξ| + dx/2)/dx on the outer shell)",
                            default="none", choices=("none", "lammps", "hhb")),
         surface_correction=Key("choice", "surface correction (Le & Bobaru 2018): none, or energy (per-bond "
-                               "factors from each node's strain energy under a uniform extension along each "
+                               "factors from each node's strain energy under a uniaxial stress along each "
                                "axis against the continuum's, combined over the two ends and the bond's "
-                               "direction; any node cloud)",
+                               "direction, refined in 3 passes with the factors applied; any node cloud)",
                                default="none", choices=("none", "energy")),
     ),
     "materials": Key("named", "one entry per block, named after a gmsh physical group of the "

@@ -14,6 +14,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
+from . import surface_correction
 from .yaml_lines import CaseError
 
 # A run needing more steps than this is a unit mistake, not a plan: at 10⁸ node-steps per second
@@ -94,7 +95,8 @@ def contact_stiffness_factor(resolved: dict, block: np.ndarray) -> float | None:
 def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, density: np.ndarray,
                      c_pair: np.ndarray, horizon: float, tree: cKDTree | None = None, *,
                      dx: float | None = None, partial_volume: str = "none", contact: float | None = None,
-                     sample: int | None = SAMPLE, lps: tuple | None = None) -> tuple[float, int]:
+                     sample: int | None = SAMPLE, lps: tuple | None = None,
+                     surface: np.ndarray | None = None) -> tuple[float, int]:
     """min over nodes of √(2ρ_i / Σ_j V_j ν_ij c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the
     node where it is reached, as solver/src/core/model.cpp stable_time_step computes it: ν of the
     `partial_volume` rule (needs the grid spacing dx unless "none"), and with contact (c_s/c given
@@ -102,7 +104,11 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
     |ξ| ≤ 1.35·dx. Over an evenly spread subset of `sample` nodes for larger clouds (None: all).
     block is 1-based; density[b-1] and c_pair[a-1, b-1] (the solver's arithmetic mean of the two
     blocks' c). (inf, -1) when no sampled node has a bond. lps = (q, kind): an LPS case, whose bond
-    term is V_j ν ω(|ξ|)(q_i + q_j) with q = (d²κ + α)/m per node (LpsModel::bond_stiffness). tests/pipeline/test_stability_solver.py
+    term is V_j ν ω(|ξ|)(q_i + q_j) with q = (d²κ + α)/m per node (LpsModel::bond_stiffness).
+    surface: the per-node direction factors of the energy surface correction (n × 3,
+    surface_correction.direction_factors): each bond's term times its g (core/model.cpp
+    node_stiffness; LPS's q is unchanged by the correction: its κ, α and m all scale by ḡ_i).
+    tests/pipeline/test_stability_solver.py
     holds it equal to `pdsolve --stable-dt` on every shipped case."""
     n = len(points)
     tree = tree if tree is not None else cKDTree(points)
@@ -122,6 +128,8 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
     else:
         q, kind = lps
         stiffness = volume[cols] * nu * influence(kind, dist, horizon) * (q[i] + q[cols])
+    if surface is not None:
+        stiffness = stiffness * surface_correction.bond_factors(surface, i, cols, (points[cols] - points[i]) / dist[:, None])
     if contact is not None:
         stiffness = stiffness + np.where(dist <= CONTACT_DISTANCE * dx, volume[cols] * contact * c / horizon, 0.0)
     total = np.bincount(rows, weights=stiffness, minlength=len(sample))
@@ -152,10 +160,39 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
         c = np.array([block_micromodulus(case, m, horizon) for m in materials])
     c_pair = 0.5 * (c[:, None] + c[None, :])
     density = np.array([m["density"] for m in materials], dtype=np.float64)
+    surface = None
+    if resolved.get("surface_correction", "none") == "energy":
+        law = {"model": "pmb", "c": c, "c_pair": c_pair} if lps is None else \
+            {"model": "lps", "moduli": moduli, "kind": lps[1]}
+        surface = surface_factors(case, resolved, cloud, block, law, tree)
     return stable_time_step(np.asarray(cloud.points), np.asarray(cloud.volume), block, density, c_pair,
                             horizon, tree, dx=float(resolved["grid_spacing"]),
                             partial_volume=resolved["partial_volume"],
-                            contact=contact_stiffness_factor(resolved, block), sample=sample, lps=lps)
+                            contact=contact_stiffness_factor(resolved, block), sample=sample, lps=lps,
+                            surface=surface)
+
+
+def surface_factors(case: dict, resolved: dict, cloud, block: np.ndarray, law: dict,
+                    tree: cKDTree | None = None) -> np.ndarray:
+    """The direction factors of `surface_correction: energy` (n × 3) on the whole cloud, over the
+    bonds the solver makes (the partial-volume rule's cutoff and ν; bonds across a pre-crack count
+    for g but hold no energy). Holds every bond in memory: a correction asked for on a large cloud
+    costs here what it costs the solver's set-up."""
+    points, volume = np.asarray(cloud.points, dtype=np.float64), np.asarray(cloud.volume)
+    tree = tree if tree is not None else cKDTree(points)
+    horizon, dx = float(resolved["horizon"]), float(resolved["grid_spacing"])
+    extension, shell = PARTIAL_VOLUME[resolved["partial_volume"]]
+    cutoff = horizon + extension * dx if extension else horizon
+    pairs = tree.sparse_distance_matrix(tree, cutoff * BOND_SLACK, output_type="coo_matrix")
+    keep = pairs.data > 0
+    i, j, dist = pairs.row[keep].astype(np.int64), pairs.col[keep].astype(np.int64), pairs.data[keep]
+    nu = np.clip((horizon + 0.5 * dx - dist) * (1.0 / dx), 0.0, 1.0) if shell else 1.0
+    intact = ~crosses_cracks(points, i, j, resolved.get("cracks") or [])
+    if law["model"] == "lps":
+        law = dict(law, influence=influence(law["kind"], dist, horizon))
+    dims = 3 if case["analysis"] == "3d" else 2
+    return surface_correction.direction_factors(law, len(points), dims, horizon, case["thickness"], block - 1, i, j,
+                                                dist, (points[j] - points[i]) / dist[:, None], volume[j] * nu, intact)
 
 
 def _orientation(o, a, b):

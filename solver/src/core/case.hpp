@@ -141,7 +141,7 @@ struct Case {
   double horizon = 0.0;
   std::string partial_volume = "none";  // validation.md F3: none | lammps | hhb
   // none | energy (Le & Bobaru 2018, core/surface_correction): per-bond factors from the energy of
-  // a uniform extension on each node's family against the continuum's.
+  // a uniaxial stress along each axis on each node's family against the continuum's.
   std::string surface_correction = "none";
   std::vector<BlockMaterial> blocks;
   // thesis: a bond over its critical stretch breaks before the force at the new state (§2.2);

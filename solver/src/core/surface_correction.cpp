@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/model.hpp"
+#include "materials/bond_model.hpp"
 
 namespace pd {
 
@@ -26,21 +27,97 @@ constexpr double kProbeStrain = 1e-5;
 
 }  // namespace
 
-std::vector<double> surface_direction_factors(const Model& m) {
+StrainTensor surface_probe_strain(const Model& m, std::size_t i, int d) {
+  const int dims = m.nodes.dimension == 2 ? 2 : 3;
+  StrainTensor axial{}, lateral{}, both{};
+  axial[static_cast<std::size_t>(4 * d)] = 1.0;
+  for (int e = 0; e < dims; ++e)
+    if (e != d) lateral[static_cast<std::size_t>(4 * e)] = 1.0;
+  for (std::size_t q = 0; q < 9; ++q) both[q] = axial[q] + lateral[q];
+  const BondModel& law = *m.bond_model;
+  const double w_axial = law.continuum_energy_density(m, i, axial), w_lateral = law.continuum_energy_density(m, i, lateral);
+  // B = W(1,1) − W(1,0) − W(0,1), C = 2 W(0,1): the lateral stress B a + C b vanishes at b = −(B/C) a.
+  const double ratio = (law.continuum_energy_density(m, i, both) - w_axial - w_lateral) / (2.0 * w_lateral);
+  StrainTensor probe = axial;
+  for (std::size_t q = 0; q < 9; ++q) probe[q] -= ratio * lateral[q];
+  return probe;
+}
+
+namespace {
+
+// g of every directed bond from the per-node direction factors f (bond_surface_factor); each row
+// writes only its own bonds.
+std::vector<double> bond_factors(const Model& m, const std::vector<double>& f) {
+  const auto& x = m.nodes.x;
+  std::vector<double> g(m.bonds.directed(), 1.0);
+  const auto n = static_cast<std::int64_t>(m.nodes.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i64 = 0; i64 < n; ++i64) {
+    const auto i = static_cast<std::size_t>(i64);
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
+      const double len = bond_length(x, i, j);
+      g[ku] = bond_surface_factor(&f[3 * i], &f[3 * j], (x[0][j] - x[0][i]) / len, (x[1][j] - x[1][i]) / len,
+                                  (x[2][j] - x[2][i]) / len);
+    }
+  }
+  return g;
+}
+
+// The law again with the bonds' current factors (LPS precomputes m_i and its moduli from them).
+void remake_law(Model& m) { m.bond_model = material_registry().get(m.bond_model->name()).make(m); }
+
+}  // namespace
+
+std::vector<double> surface_direction_factors(Model& m, int passes) {
   const std::size_t n = m.nodes.size();
   const int dims = m.nodes.dimension == 2 ? 2 : 3;
   std::vector<double> factors(3 * n, 1.0);
-  for (int d = 0; d < dims; ++d) {
-    std::vector<double> w(n, 0.0);
-    for (const double eps : {kProbeStrain, -kProbeStrain}) {
-      Vec3Array u = make_vec3(n);
-      for (std::size_t i = 0; i < n; ++i) u[static_cast<std::size_t>(d)][i] = eps * m.nodes.x[static_cast<std::size_t>(d)][i];
-      const std::vector<double> wi = m.bond_model->strain_energy_density(m, u);
-      for (std::size_t i = 0; i < n; ++i) w[i] += 0.5 * wi[i];
+  std::vector<double> saved = std::move(m.bonds.surface_factor);
+  const std::shared_ptr<const BondModel> saved_law = m.bond_model;
+  m.bonds.surface_factor.clear();
+  if (!saved.empty()) remake_law(m);
+  // Each node's probe (its block's lateral ratio), and the continuum energy of it; a cloud has few
+  // distinct probes (one per material), each one affine field over all nodes.
+  std::vector<StrainTensor> probe(3 * n);
+  std::vector<double> continuum(3 * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < dims; ++d) {
+      const std::size_t q = 3 * i + static_cast<std::size_t>(d);
+      probe[q] = surface_probe_strain(m, i, d);
+      StrainTensor scaled = probe[q];
+      for (double& v : scaled) v *= kProbeStrain;
+      continuum[q] = m.bond_model->continuum_energy_density(m, i, scaled);
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (w[i] > 0.0) factors[3 * i + static_cast<std::size_t>(d)] = m.bond_model->uniaxial_energy_density(m, i, kProbeStrain) / w[i];
+  for (int pass = 0; pass <= passes; ++pass) {
+    if (pass > 0) {
+      m.bonds.surface_factor = bond_factors(m, factors);
+      remake_law(m);
+    }
+    for (int d = 0; d < dims; ++d) {
+      std::vector<double> w(n, 0.0);
+      std::vector<char> done(n, 0);
+      for (std::size_t first = 0; first < n; ++first) {
+        if (done[first]) continue;
+        const StrainTensor& strain = probe[3 * first + static_cast<std::size_t>(d)];
+        for (const double eps : {kProbeStrain, -kProbeStrain}) {
+          Vec3Array u = make_vec3(n);
+          for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t a = 0; a < 3; ++a) u[a][i] = eps * strain[4 * a] * m.nodes.x[a][i];  // diagonal
+          const std::vector<double> wi = m.bond_model->strain_energy_density(m, u);
+          for (std::size_t i = first; i < n; ++i)
+            if (probe[3 * i + static_cast<std::size_t>(d)] == strain) w[i] += 0.5 * wi[i];
+        }
+        for (std::size_t i = first; i < n; ++i)
+          if (probe[3 * i + static_cast<std::size_t>(d)] == strain) done[i] = 1;
+      }
+      for (std::size_t i = 0; i < n; ++i)
+        if (w[i] > 0.0) factors[3 * i + static_cast<std::size_t>(d)] *= continuum[3 * i + static_cast<std::size_t>(d)] / w[i];
+    }
   }
+  m.bonds.surface_factor = std::move(saved);
+  m.bond_model = saved_law;
   return factors;
 }
 
@@ -52,22 +129,7 @@ double bond_surface_factor(const double* a, const double* b, double n0, double n
 void apply_surface_correction(const std::string& method, Model& m) {
   m.bonds.surface_factor.clear();
   if (!surface_correction_registry().get(method)) return;
-  const std::vector<double> f = surface_direction_factors(m);
-  const auto& x = m.nodes.x;
-  std::vector<double> g(m.bonds.directed(), 1.0);
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i64 = 0; i64 < n; ++i64) {  // each row writes only its own bonds
-    const auto i = static_cast<std::size_t>(i64);
-    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
-      const double len = bond_length(x, i, j);
-      g[ku] = bond_surface_factor(&f[3 * i], &f[3 * j], (x[0][j] - x[0][i]) / len, (x[1][j] - x[1][i]) / len,
-                                  (x[2][j] - x[2][i]) / len);
-    }
-  }
-  m.bonds.surface_factor = std::move(g);
+  m.bonds.surface_factor = bond_factors(m, surface_direction_factors(m, kSurfacePasses));
 }
 
 }  // namespace pd

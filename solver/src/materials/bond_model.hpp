@@ -32,6 +32,22 @@ class Decomposed;  // parallel/decomposed.hpp
 
 struct Model;
 
+// A small strain tensor, symmetric, row-major 3×3 (ε_xx, ε_xy, ε_xz, ε_yx, …).
+using StrainTensor = std::array<double, 9>;
+
+// tr ε and ε:ε of `strain` over the first `dims` axes (3, or 2 for the in-plane part).
+inline double strain_trace(const StrainTensor& strain, int dims) {
+  double t = 0.0;
+  for (int a = 0; a < dims; ++a) t += strain[static_cast<std::size_t>(4 * a)];
+  return t;
+}
+inline double strain_contraction(const StrainTensor& strain, int dims) {
+  double s = 0.0;
+  for (int a = 0; a < dims; ++a)
+    for (int b = 0; b < dims; ++b) s += strain[static_cast<std::size_t>(3 * a + b)] * strain[static_cast<std::size_t>(3 * a + b)];
+  return s;
+}
+
 // A number a model reads from its block in case.json (blocks[k].<name>), checked by the reader.
 struct MaterialParameter {
   std::string name;
@@ -88,10 +104,12 @@ class BondModel {
   // reference configuration (c/|ξ| for PMB): node i's stable step is √(2ρ_i / Σ_j (this + other
   // terms)), core/model.hpp node_stiffness.
   virtual double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const = 0;
-  // The continuum strain-energy density [J/m³] of node i's material under the uniform extension
-  // u = ε x_d e_d along a coordinate axis (a uniaxial strain): ½ C11 ε², C11 = λ + 2μ of the
-  // analysis. The reference of the energy surface correction (core/surface_correction).
-  virtual double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const = 0;
+  // The continuum strain-energy density [J/m³] of node i's material (its block's, without surface
+  // factors) under the uniform small strain `strain` (symmetric, row-major 3×3; in 2D only the
+  // in-plane components are read): the bulk value W(ε) the law tends to for a whole family. The
+  // reference of the energy surface correction (core/surface_correction), which probes each node
+  // with a uniaxial stress built from it.
+  virtual double continuum_energy_density(const Model& model, std::size_t i, const StrainTensor& strain) const = 0;
   // y = M^{-1/2} K M^{-1/2} x with K the stiffness linearised about the reference configuration
   // and M the lumped masses ρ_i V_i (core/stability: its largest eigenvalue is ω_max²). period[d] > 0
   // makes axis d periodic for the bond direction (the tests' infinite lattice).

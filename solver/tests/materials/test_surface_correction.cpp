@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -106,9 +107,10 @@ TEST(SurfaceCorrection, MeasureStaticTension) {
 
 namespace {
 
-// The energy of a uniform extension ε along x on a bulk node of the cubic (3D) or square (2D)
-// lattice, from the stencil (independent of the solver's bond list): PMB Σ ¼ c (ε n_x²)² |ξ| V_j.
-double pmb_bulk_energy(const pd::Model& m, double eps) {
+// The energy of the probe along x (uniaxial stress: ε along x, −νε laterally) on a bulk node of the
+// cubic (3D) or square (2D) lattice, from the stencil (independent of the solver's bond list and
+// of its probe): PMB Σ ¼ c (n·ε·n)² |ξ| V_j with the linearised stretch n·ε·n.
+double pmb_bulk_energy(const pd::Model& m, double eps, double nu) {
   const double c = m.material.micromodulus_pair[0];
   const int r = 4, dim = m.nodes.dimension;
   double w = 0.0;
@@ -117,45 +119,115 @@ double pmb_bulk_energy(const pd::Model& m, double eps) {
       for (int s = (dim == 3 ? -r : 0); s <= (dim == 3 ? r : 0); ++s) {
         const double l = std::sqrt(double(p * p + q * q + s * s)) * kDx;
         if (l == 0.0 || l > m.horizon * (1 + 1e-12)) continue;
-        const double nx2 = (p * kDx) * (p * kDx) / (l * l);
-        w += 0.25 * c * (eps * nx2) * (eps * nx2) * l * m.nodes.volume[0];
+        const double stretch = eps * (double(p * p) - nu * double(q * q + s * s)) * kDx * kDx / (l * l);
+        w += 0.25 * c * stretch * stretch * l * m.nodes.volume[0];
       }
   return w;
 }
 
 }  // namespace
 
-TEST(SurfaceCorrection, BulkFactorIsTheContinuumOverTheLatticeEnergyAndSurfaceFactorsDiffer) {
-  // Le & Bobaru's factor compares with the continuum, so on a bulk node it is W_cont/W_lattice: the
-  // C1 factor of validation.md (m = 3, full volumes), not 1 — the correction takes out the bulk's
-  // quadrature error as well as the surface's. Every bulk node has the same factors, and so each
-  // bond between two bulk nodes has g = that factor in any direction (the ellipsoid of three equal
-  // axes is a sphere).
+TEST(SurfaceCorrection, ProbeIsTheUniaxialStressOfTheMaterial) {
+  // The lateral ratio found from the continuum energy: ν for PMB (1/4 in 3D, 1/3 in plane stress)
+  // and LPS 3D and plane stress, ν/(1 − ν) in plane strain (ε_zz = 0); the probe's continuum
+  // energy is then ½ E' ε² (E' = E, or E/(1 − ν²) in plane strain).
+  struct Row {
+    Config s;
+    double ratio, modulus;
+  };
+  const Row rows[] = {{{"pmb", "3d"}, 0.25, kE},
+                      {{"pmb", "plane_stress"}, 1.0 / 3.0, kE},
+                      {{"pmb", "plane_strain"}, 1.0 / 3.0, kE / (1.0 - 0.0625)},
+                      {{"lps", "3d", 0.3}, 0.3, kE},
+                      {{"lps", "plane_stress", 0.45}, 0.45, kE},
+                      {{"lps", "plane_strain", 0.2}, 0.25, kE / 0.96}};
+  for (const Row& row : rows) {
+    const pd::Model m = build(row.s, 5, 5, 5);
+    const int dims = m.nodes.dimension;
+    for (int d = 0; d < dims; ++d) {
+      const pd::StrainTensor p = pd::surface_probe_strain(m, 0, d);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          const double expected = a != b || a >= dims ? 0.0 : (a == d ? 1.0 : -row.ratio);
+          EXPECT_NEAR(p[static_cast<std::size_t>(3 * a + b)], expected, 1e-14) << row.s.model << " " << row.s.analysis;
+        }
+      EXPECT_NEAR(m.bond_model->continuum_energy_density(m, 0, p), 0.5 * row.modulus, 1e-12 * kE)
+          << row.s.model << " " << row.s.analysis;
+    }
+  }
+}
+
+TEST(SurfaceCorrection, BulkFactorIsTheContinuumOverTheLatticeEnergy) {
+  // Le & Bobaru's factor compares with the continuum, so on a bulk node the first pass gives
+  // W_cont/W_lattice of the probe, not 1: the correction takes out the bulk's quadrature error as
+  // well as the surface's. Every bulk node has the same factors.
   for (const char* analysis : {"3d", "plane_stress"}) {
-    const Config s{"pmb", analysis, 0.25, "energy"};
+    const Config s{"pmb", analysis};
     const int n = 13;
-    const pd::Model m = build(s, n, n, n);
+    pd::Model m = build(s, n, n, n);
     const bool plane = m.nodes.dimension == 2;
-    const std::vector<double> f = pd::surface_direction_factors(build(Config{"pmb", analysis}, n, n, n));
-    const double eps = 1e-5;
-    const double expected = m.bond_model->uniaxial_energy_density(m, 0, eps) / pmb_bulk_energy(m, eps);
+    const double nu = plane ? 1.0 / 3.0 : 0.25, eps = 1e-5;
+    const std::vector<double> f = pd::surface_direction_factors(m, 0);
+    EXPECT_FALSE(m.bonds.corrected());  // left as it was
+    const double expected = 0.5 * kE * eps * eps / pmb_bulk_energy(m, eps, nu);
     const std::size_t centre = pdtest::node_index(6, 6, plane ? 0 : 6, n, n);
     for (int d = 0; d < (plane ? 2 : 3); ++d) EXPECT_NEAR(f[3 * centre + d], expected, 1e-9) << analysis << " d=" << d;
     if (plane) EXPECT_EQ(f[3 * centre + 2], 1.0);
-    std::printf("[ surface  ] PMB %s bulk factor (continuum/lattice, m = 3, full volumes) = %.6f\n", analysis, expected);
-    // Every bond of the centre node joins two nodes with whole families: g = the bulk factor.
-    for (std::int64_t k = m.bonds.offsets[centre]; k < m.bonds.offsets[centre + 1]; ++k)
-      EXPECT_NEAR(m.bonds.surface_factor[static_cast<std::size_t>(k)], expected, 1e-9);
+    std::printf("[ surface  ] PMB %s bulk factor of the probe (continuum/lattice, m = 3, full volumes) = %.6f\n",
+                analysis, expected);
     // A corner node's family is an eighth (a quarter) of the whole: its factors are far above.
     EXPECT_GT(f[0], 1.5 * expected) << analysis;
-    // Both copies of every bond carry bitwise the same g.
-    for (std::size_t i = 0; i < m.nodes.size(); ++i)
-      for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
-        const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-        for (std::int64_t q = m.bonds.offsets[j]; q < m.bonds.offsets[j + 1]; ++q)
-          if (static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(q)]) == i)
-            ASSERT_EQ(m.bonds.surface_factor[static_cast<std::size_t>(k)], m.bonds.surface_factor[static_cast<std::size_t>(q)]);
+  }
+}
+
+TEST(SurfaceCorrection, PassesBringEveryNodesCorrectedProbeEnergyToTheContinuum) {
+  // With the factors applied, each node's probe energy against the continuum's: after one pass the
+  // neighbours' factors (the mean of the two ends) leave per cents near the surfaces; the
+  // refinement passes shrink that on the whole (the mean of |W_i(g)/W_cont − 1| over nodes and
+  // axes), though not at every corner node (the largest, printed too).
+  for (const Config& s : {Config{"pmb", "3d", 0.25, "energy"}, Config{"lps", "plane_stress", 0.3, "energy"}}) {
+    pd::Model m = build(s, 10, 8, 7);
+    const std::size_t n = m.nodes.size();
+    const int dims = m.nodes.dimension;
+    double worst[2] = {0.0, 0.0}, mean[2] = {0.0, 0.0};
+    for (int k = 0; k < 2; ++k) {
+      const int passes = k == 0 ? 0 : pd::kSurfacePasses;
+      m.bonds.surface_factor.clear();
+      const std::vector<double> f = pd::surface_direction_factors(m, passes);
+      // g from f as apply_surface_correction sets it, then the law again with them.
+      pd::Model c = build(s, 10, 8, 7);
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::int64_t q = c.bonds.offsets[i]; q < c.bonds.offsets[i + 1]; ++q) {
+          const auto j = static_cast<std::size_t>(c.bonds.neighbour[static_cast<std::size_t>(q)]);
+          const double l = std::sqrt(std::pow(c.nodes.x[0][j] - c.nodes.x[0][i], 2) + std::pow(c.nodes.x[1][j] - c.nodes.x[1][i], 2) +
+                                     std::pow(c.nodes.x[2][j] - c.nodes.x[2][i], 2));
+          c.bonds.surface_factor[static_cast<std::size_t>(q)] = pd::bond_surface_factor(
+              &f[3 * i], &f[3 * j], (c.nodes.x[0][j] - c.nodes.x[0][i]) / l, (c.nodes.x[1][j] - c.nodes.x[1][i]) / l,
+              (c.nodes.x[2][j] - c.nodes.x[2][i]) / l);
+        }
+      c.bond_model = pd::material_registry().get(s.model).make(c);
+      for (int d = 0; d < dims; ++d) {
+        const pd::StrainTensor p = pd::surface_probe_strain(c, 0, d);
+        const double eps = 1e-5;
+        pd::Vec3Array u = pd::make_vec3(n);
+        for (std::size_t i = 0; i < n; ++i)
+          for (std::size_t a = 0; a < 3; ++a) u[a][i] = eps * p[4 * a] * c.nodes.x[a][i];
+        const std::vector<double> w = c.bond_model->strain_energy_density(c, u);
+        pd::StrainTensor scaled = p;
+        for (double& v : scaled) v *= eps;
+        for (std::size_t i = 0; i < n; ++i) {
+          const double e = std::fabs(w[i] / c.bond_model->continuum_energy_density(c, i, scaled) - 1.0);
+          worst[k] = std::max(worst[k], e);
+          mean[k] += e / static_cast<double>(n * static_cast<std::size_t>(dims));
+        }
       }
+    }
+    std::printf("[ surface  ] %s %s: |W_i(g)/W_cont - 1| over the nodes and axes: mean %.4f, largest %.4f after one "
+                "pass; mean %.4f, largest %.4f after %d more\n", s.model.c_str(), s.analysis.c_str(), mean[0], worst[0],
+                mean[1], worst[1], pd::kSurfacePasses);
+    // Measured: mean 0.1851 → 0.1056 (PMB 3D), 0.0726 → 0.0378 (LPS plane stress); largest 0.41 →
+    // 0.51 and 0.16 → 0.10 (a corner's three factors cannot fit all its bonds' shares).
+    EXPECT_LT(mean[1], 0.75 * mean[0]) << s.model;
   }
 }
 
@@ -313,27 +385,40 @@ double apparent_stiffness(const Config& s) {
 
 }  // namespace
 
-TEST(SurfaceCorrection, ThinBarAndPlateInTensionHaveTheStiffnessOfTheMaterial) {
-  const char* only = std::getenv("PD_SURFACE_ONLY");
-  for (const Config& base : {Config{"pmb", "3d", 0.25}, Config{"lps", "3d", 0.3}, Config{"pmb", "plane_stress", 0.0},
-                             Config{"lps", "plane_stress", 0.3}}) {
-    if (only && std::string(only) != base.model + "-" + base.analysis) continue;
-    Config with = base;
-    with.correction = "energy";
-    const double without_ratio = apparent_stiffness(base), with_ratio = apparent_stiffness(with);
-    std::printf("[ surface  ] %s %s thin %s: E_apparent/E = %.4f without, %.4f with the energy correction\n",
-                base.model.c_str(), base.analysis.c_str(), base.analysis == "3d" ? "bar" : "plate", without_ratio,
-                with_ratio);
-    // Measured (m = 3, full volumes): without 0.7650, 1.1175, 0.9893, 1.1534; with 1.0387, 1.0116,
-    // 1.0419, 1.0426 (PMB 3D, LPS 3D, PMB plane stress, LPS plane stress). The correction matches
-    // each node's uniaxial-strain energy (C11) to the continuum; a bar in uniaxial stress also
-    // depends on C12, which the m = 3 lattice gets wrong in the bulk (the interior of a thick bar,
-    // MeasureStaticTension) — so 2 % holds for LPS in 3D only, and 4.5 % for all four.
-    EXPECT_NEAR(with_ratio, 1.0, base.model == "lps" && base.analysis == "3d" ? 0.02 : 0.045)
-        << base.model << " " << base.analysis;
-    if (base.model == "lps" || base.analysis == "3d")  // where the surface error is large, it shrinks
-      EXPECT_LT(std::fabs(with_ratio - 1.0), 0.5 * std::fabs(without_ratio - 1.0)) << base.model << " " << base.analysis;
-  }
+namespace {
+
+// The correction's apparent stiffness within 2 % of E, and the error without it printed and
+// asserted larger. Measured (m = 3, full volumes): without 0.7650, 1.1175, 0.9893, 1.1534; with
+// 0.9960, 0.9948, 0.9946, 0.9979 (PMB 3D, LPS 3D, PMB plane stress, LPS plane stress). The probe
+// is the uniaxial stress the bar is in, and the refinement passes fit each node's corrected energy
+// (core/surface_correction.hpp); with one uniaxial-strain probe and no passes it was 1.039, 1.012,
+// 1.042, 1.043.
+void expect_stiffness_of_the_material(const Config& base) {
+  Config with = base;
+  with.correction = "energy";
+  const double without_ratio = apparent_stiffness(base), with_ratio = apparent_stiffness(with);
+  std::printf("[ surface  ] %s %s thin %s: E_apparent/E = %.4f without, %.4f with the energy correction\n",
+              base.model.c_str(), base.analysis.c_str(), base.analysis == "3d" ? "bar" : "plate", without_ratio,
+              with_ratio);
+  EXPECT_NEAR(with_ratio, 1.0, 0.02) << base.model << " " << base.analysis;
+  EXPECT_LT(std::fabs(with_ratio - 1.0), std::fabs(without_ratio - 1.0)) << base.model << " " << base.analysis;
+  if (std::fabs(without_ratio - 1.0) > 0.05)  // where the surface error is large, it shrinks tenfold
+    EXPECT_LT(std::fabs(with_ratio - 1.0), 0.1 * std::fabs(without_ratio - 1.0)) << base.model << " " << base.analysis;
+}
+
+}  // namespace
+
+TEST(SurfaceCorrection, ThinBarInTensionHasTheStiffnessOfThePmbMaterial) {
+  expect_stiffness_of_the_material(Config{"pmb", "3d", 0.25});
+}
+TEST(SurfaceCorrection, ThinBarInTensionHasTheStiffnessOfTheLpsMaterial) {
+  expect_stiffness_of_the_material(Config{"lps", "3d", 0.3});
+}
+TEST(SurfaceCorrection, PlateInTensionHasTheStiffnessOfThePmbMaterial) {
+  expect_stiffness_of_the_material(Config{"pmb", "plane_stress", 0.0});
+}
+TEST(SurfaceCorrection, PlateInTensionHasTheStiffnessOfTheLpsMaterial) {
+  expect_stiffness_of_the_material(Config{"lps", "plane_stress", 0.3});
 }
 
 TEST(SurfaceCorrection, StaticTensionOfLpsInteriorStrains) {
@@ -347,9 +432,13 @@ TEST(SurfaceCorrection, StaticTensionOfLpsInteriorStrains) {
     double axial_tol, ratio_tol;
   };
   const Row rows[] = {
-      {{"lps", "3d", 0.3, "energy", "hhb"}, 0.04, 0.02},         // measured 0.9644, −0.73 %
-      {{"lps", "plane_strain", 0.45, "energy", "none"}, 0.03, 0.02},  // measured 0.9751, −0.59 %
-      {{"lps", "plane_stress", 0.3, "energy", "none"}, 0.03, 0.05},   // measured 0.9786, −4.60 %
+      // measured 1.0059, −0.50 % (0.9644, −0.73 % with the uniaxial-strain probe and no passes)
+      {{"lps", "3d", 0.3, "energy", "hhb"}, 0.02, 0.02},
+      // measured 1.0099, −0.81 % (0.9751, −0.59 % before)
+      {{"lps", "plane_strain", 0.45, "energy", "none"}, 0.02, 0.02},
+      // measured 1.0033, −5.36 % (0.9786, −4.60 % before: the lateral strain is what the probe's
+      // lateral part trades for the axial fit; its tolerance went from 5 % to 6 %)
+      {{"lps", "plane_stress", 0.3, "energy", "none"}, 0.02, 0.06},
   };
   const double sigma = 1e6;
   for (const Row& row : rows) {

@@ -94,8 +94,9 @@ class LpsModel : public BondModel {
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override;
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
-  // ½ C11 ε², C11 = K + 4μ/3 (3D) or κ + μ (2D: λ + 2μ in plane strain, E/(1 − ν²) in plane stress).
-  double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const override;
+  // (κ/2)(tr ε)² + μ ε^d:ε^d with i's block's κ, μ (uncorrected), ε^d = ε − (tr ε/d) I over the d
+  // axes of the analysis: the energy this law reproduces for a uniform strain (header comment).
+  double continuum_energy_density(const Model& model, std::size_t i, const StrainTensor& strain) const override;
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
@@ -127,7 +128,7 @@ class LpsModel : public BondModel {
   std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
   std::vector<double> a_;      // α_i / m_i
   std::vector<double> b_;      // d κ_i / m_i
-  std::vector<double> c11_;    // λ + 2μ of i's block, uncorrected (uniaxial_energy_density)
+  std::vector<double> kappa0_, mu0_;  // κ, μ of i's block, uncorrected (continuum_energy_density)
   // Set once by the operator of a decomposed run (set_decomposed), before any sweep; null: serial.
   mutable const Decomposed* decomposed_ = nullptr;
 

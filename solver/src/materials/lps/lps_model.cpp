@@ -23,7 +23,8 @@ LpsModel::LpsModel(const Model& model) {
   alpha_.assign(n, 0.0);
   a_.assign(n, 0.0);
   b_.assign(n, 0.0);
-  c11_.assign(n, 0.0);
+  kappa0_.assign(n, 0.0);
+  mu0_.assign(n, 0.0);
   const auto& X = model.nodes.x;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < static_cast<std::int64_t>(n); ++i64) {
@@ -49,7 +50,8 @@ LpsModel::LpsModel(const Model& model) {
     }
     m_[i] = m;
     const LpsModuli& mod = per_block.empty() ? LpsModuli{} : per_block[static_cast<std::size_t>(model.block_index[i])];
-    c11_[i] = d_ == 3 ? mod.kappa + 4.0 * mod.mu / 3.0 : mod.kappa + mod.mu;  // λ + 2μ of the analysis
+    kappa0_[i] = mod.kappa;
+    mu0_[i] = mod.mu;
     const double gbar = model.bonds.corrected() && m0 > 0.0 ? m / m0 : 1.0;
     kappa_[i] = mod.kappa * gbar;
     alpha_[i] = alpha_factor * mod.mu * gbar;
@@ -73,6 +75,8 @@ std::shared_ptr<const BondModel> LpsModel::for_piece(const Model&, const std::ve
   local->alpha_ = pick(alpha_);
   local->a_ = pick(a_);
   local->b_ = pick(b_);
+  local->kappa0_ = pick(kappa0_);
+  local->mu0_ = pick(mu0_);
   local->decomposed_ = nullptr;
   return local;
 }
@@ -100,8 +104,11 @@ double LpsModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, do
          (node_term(i) + node_term(j));
 }
 
-double LpsModel::uniaxial_energy_density(const Model&, std::size_t i, double eps) const {
-  return 0.5 * c11_[i] * eps * eps;
+double LpsModel::continuum_energy_density(const Model&, std::size_t i, const StrainTensor& strain) const {
+  const double tr = strain_trace(strain, d_);
+  // ε^d:ε^d = ε:ε − (tr ε)²/d
+  const double deviatoric = strain_contraction(strain, d_) - tr * tr / d_;
+  return 0.5 * kappa0_[i] * tr * tr + mu0_[i] * deviatoric;
 }
 
 namespace {

@@ -127,9 +127,11 @@ class PmbModel : public BondModel {
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override { return bond_damage(model); }
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;
-  // ¼ c ε² ∫ n_d⁴ |ξ| dV over the full horizon: c ε² πδ⁴/20 (3D), c ε² h πδ³/16 (2D) — ½(6E/5)ε²,
-  // ½(9E/8)ε², ½(6E/5)ε² in 3D, plane stress, plane strain with F1's c.
-  double uniaxial_energy_density(const Model& model, std::size_t i, double eps) const override;
+  // ¼ c ∫ (n·ε·n)² |ξ| dV over the full horizon (the linearised stretch s = n·ε·n), with
+  // ∫ n_a n_b n_c n_d dΩ = (4π/15)(δ_ab δ_cd + δ_ac δ_bd + δ_ad δ_bc) over the sphere and (π/4)(…)
+  // over the circle: (cπδ⁴/60)((tr ε)² + 2 ε:ε) in 3D, (chπδ³/48)(…) in 2D — linear elasticity with
+  // λ = μ (ν = 1/4; plane stress ν = 1/3) and, with F1's c, Young's modulus E.
+  double continuum_energy_density(const Model& model, std::size_t i, const StrainTensor& strain) const override;
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;

@@ -40,15 +40,18 @@ double PmbModel::bond_stiffness(const Model& m, std::size_t i, std::size_t j, do
   return m.nodes.volume[j] * m.bonds.volume_weight(length) * micromodulus / length;
 }
 
-double PmbModel::uniaxial_energy_density(const Model& m, std::size_t i, double eps) const {
+double PmbModel::continuum_energy_density(const Model& m, std::size_t i, const StrainTensor& strain) const {
   constexpr double kPi = 3.14159265358979323846;
   const auto nb = static_cast<std::size_t>(m.material.blocks);
   const auto bi = static_cast<std::size_t>(m.block_index[i]);
   const double c = m.material.micromodulus_pair[bi * nb + bi];
   const double delta = m.horizon;
-  // ∫ n_x⁴ dΩ = 4π/5 over the sphere, ∫ cos⁴φ dφ = 3π/4 over the circle; ∫ r³ dr = δ⁴/4, ∫ r² dr = δ³/3.
-  if (m.nodes.dimension == 3) return c * eps * eps * kPi * std::pow(delta, 4) / 20.0;
-  return c * eps * eps * m.thickness * kPi * std::pow(delta, 3) / 16.0;
+  const int dims = m.nodes.dimension == 3 ? 3 : 2;
+  const double tr = strain_trace(strain, dims);
+  const double quartic = tr * tr + 2.0 * strain_contraction(strain, dims);  // ∫(n·ε·n)² over directions ÷ (4π/15 or π/4)
+  // ∫ r³ dr = δ⁴/4, ∫ r² dr = δ³/3 (times h in 2D); ¼ c of the bond energy (pmb.hpp).
+  if (dims == 3) return c * kPi * std::pow(delta, 4) / 60.0 * quartic;
+  return c * m.thickness * kPi * std::pow(delta, 3) / 48.0 * quartic;
 }
 
 namespace {
