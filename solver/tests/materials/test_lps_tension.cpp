@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "core/surface_correction.hpp"
 #include "lattice.hpp"
 #include "lps_lattice.hpp"
 #include "one_thread.hpp"
@@ -36,7 +37,7 @@ struct Bar {
 struct Strains {
   double axial = 0.0;    // interior ε_xx E'/σ (1 in the continuum)
   double lateral = 0.0;  // interior −ε_yy/ε_xx / ν' (1 in the continuum)
-  double bulk_factor = 1.0;  // ḡ of the middle node: Σ ω|ξ|² V g / Σ ω|ξ|² V (1 uncorrected)
+  double bulk_factor = 1.0;  // the correction's factor ḡ on a bulk node (1 uncorrected)
   int iterations = 0;
   bool converged = false;
 };
@@ -57,18 +58,14 @@ Strains tension(const Bar& b) {
   const int inner = std::min(static_cast<int>(2.0 * b.horizon_factor), (b.width - 3) / 2);
   const pdtest::Tension t = pdtest::static_tension(m, b.nx, b.width, nz, kDx, kSigma, inner, b.load_layers);
   Strains s;
-  // ḡ scales the middle node's κ and α (lps_model.cpp: m_i/m0); in the bulk every bond's g is the
-  // same, so the bulk lattice is the uncorrected one with both moduli times ḡ.
+  // The correction multiplies a bulk node's κ and α, and every bond of it, by the same factor ḡ
+  // (lps_model.cpp: m_i/m0; a bond's g is the ellipsoid of its ends' direction factors, and a bulk
+  // node's are equal): its direction factor, found on the uncorrected model. The middle node's
+  // family is whole for W ≥ 2m + 1, so its factor is the bulk's even when its neighbours' are not.
   if (m.bonds.corrected()) {
-    const std::size_t i = pdtest::node_index(b.nx / 2, b.width / 2, nz / 2, b.nx, b.width);
-    double num = 0.0, den = 0.0;
-    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
-      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-      const double l2 = std::pow(pd::bond_length(m.nodes.x, i, j), 2);
-      num += l2 * m.bonds.surface_factor[static_cast<std::size_t>(k)];
-      den += l2;
-    }
-    s.bulk_factor = num / den;
+    c.surface_correction = "none";
+    const pd::Model bare = pd::build_model(c, pdtest::cubic_lattice(b.nx, b.width, nz, kDx, dim, 1e-3));
+    s.bulk_factor = pd::surface_direction_factors(bare)[3 * pdtest::node_index(b.nx / 2, b.width / 2, nz / 2, b.nx, b.width)];
   }
   s.axial = t.interior_xx * modulus(b) / kSigma;
   s.lateral = -t.interior_yy / t.interior_xx / ratio(b);
