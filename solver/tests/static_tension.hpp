@@ -21,9 +21,13 @@ struct Tension {
 
 // An nx × ny × nz lattice (nz = 1 in 2D) at spacing dx: u_x = 0 on its left face (x = 0), and u_y,
 // u_z (and u_z everywhere in 2D) held where needed against rigid motion; σ [Pa] on its right face as
-// the body force σ/dx on the last layer (each node carries σ dx² of the load). Fits over the middle
-// third in x: interior = nodes whose y (and z) index lies in [inner, n − 1 − inner].
-inline Tension static_tension(const pd::Model& m, int nx, int ny, int nz, double dx, double sigma, int inner) {
+// the body force σ/dx on the last layer (each node carries σ dx² of the load), or spread over the
+// last `load_layers` layers as σ/(load_layers dx) (a traction carried by a layer of about δ, as the
+// body-force loading of validation.md C7, rather than by the one row of surface nodes whose families
+// are the most truncated). Fits over the middle third in x: interior = nodes whose y (and z) index
+// lies in [inner, n − 1 − inner].
+inline Tension static_tension(const pd::Model& m, int nx, int ny, int nz, double dx, double sigma, int inner,
+                              int load_layers = 1) {
   const std::size_t n = m.nodes.size();
   if (static_cast<std::size_t>(nx) * ny * nz != n) return Tension{};  // not this lattice: not converged
   const bool plane = m.nodes.dimension == 2;
@@ -35,7 +39,8 @@ inline Tension static_tension(const pd::Model& m, int nx, int ny, int nz, double
   if (!plane) fixed[node_index(0, 0, nz / 2, nx, ny)][2] = true;  // no rotation about x
   pd::Vec3Array b = pd::make_vec3(n);
   for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j) b[0][node_index(nx - 1, j, k, nx, ny)] = sigma / dx;
+    for (int j = 0; j < ny; ++j)
+      for (int l = 1; l <= load_layers; ++l) b[0][node_index(nx - l, j, k, nx, ny)] = sigma / (load_layers * dx);
   const pd::Vec3Array zero = pd::make_vec3(n);
   const auto apply = [&](const pd::Vec3Array& x) {  // −J(0) x on the free components
     pd::Vec3Array y = pd::make_vec3(n);

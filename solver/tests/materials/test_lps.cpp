@@ -15,6 +15,7 @@
 #include "core/stability.hpp"
 #include "jacobian_check.hpp"
 #include "lattice.hpp"
+#include "lps_lattice.hpp"
 #include "materials/bond_model.hpp"
 #include "materials/lps/lps.hpp"
 #include "integrators/integrator.hpp"
@@ -404,28 +405,6 @@ TEST(Lps, StableStepOfTheModelIsItsBondStiffnessSum) {
   EXPECT_NEAR(pd::node_stiffness(m, i), sum, 1e-12 * sum);
 }
 
-namespace {
-
-// r_A of the cubic lattice (the axis shear's energy over the continuum's, as measured in the
-// strain-energy test above): Σ ω|ξ|² (n_x² − n_y²)² V / ((4/15) m) over a bulk node's family.
-double axis_shear_factor(const std::string& w) {
-  double a = 0.0, m = 0.0;
-  const double delta = 3.015;
-  for (int p = -3; p <= 3; ++p)
-    for (int q = -3; q <= 3; ++q)
-      for (int r = -3; r <= 3; ++r) {
-        const double l2 = p * p + q * q + r * r, l = std::sqrt(l2);
-        if (l2 == 0 || l > delta) continue;
-        const double wt = pd::influence(pd::influence_named(w), l, delta) * l2;
-        const double c = (p * p - q * q) / l2;
-        a += wt * c * c;
-        m += wt;
-      }
-  return a / (4.0 / 15.0 * m);
-}
-
-}  // namespace
-
 TEST(Lps, StaticTensionGivesTheLatticesPoissonRatio) {
   // validation.md C3 in 3D with ν = 0.3: a 36 × 15 × 15 bar (dx = 1 mm, δ = 3.015 dx), u_x = 0 on its
   // left face (and three components more against rigid motion), σ = 1 MPa as the body force σ/dx on
@@ -445,10 +424,9 @@ TEST(Lps, StaticTensionGivesTheLatticesPoissonRatio) {
   const double exx = tension.interior_xx, eyy = tension.interior_yy;
   // The cubic lattice's prediction: K exact (the dilatation is, on the discrete family), the axis
   // shear modulus μ·r_A: S11 = 1/(9K) + 1/(3μ r_A), S12 = 1/(9K) − 1/(6μ r_A).
-  const pd::LpsModuli k = pd::lps_moduli(kE, nu, "3d");
-  const double ra = axis_shear_factor(w);
-  const double lattice_xx = sigma * (1.0 / (9 * k.kappa) + 1.0 / (3 * k.mu * ra));
-  const double lattice_yy = sigma * (1.0 / (9 * k.kappa) - 1.0 / (6 * k.mu * ra));
+  // (lps_lattice.hpp)
+  const pdtest::BulkStrains bulk = pdtest::lps_bulk_tension(kE, nu, "3d", pdtest::axis_shear_factor(3, 3.015, w));
+  const double lattice_xx = bulk.axial * sigma / kE, lattice_yy = -bulk.lateral * lattice_xx;
   std::printf("[ lps      ] static tension ν = %.2f, ω = %s, %d CG iterations: ε_xx E/σ = %.4f (lattice %.4f), "
               "ε_yy E/σ = %.4f (lattice %.4f, continuum −ν = %.4f); apparent ν = %.4f (lattice %.4f)\n",
               nu, w.c_str(), iterations, exx * kE / sigma, lattice_xx * kE / sigma, eyy * kE / sigma,
