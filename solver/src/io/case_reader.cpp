@@ -356,6 +356,11 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
     if (q.linear_solver != "auto" && q.linear_solver != "direct" && q.linear_solver != "cg")
       ck.fail("quasi_static.linear_solver", "unknown value '" + q.linear_solver + "'; known: auto, direct, cg");
   }
+  if (const json* v = ck.optional(j, "preconditioner")) {
+    q.preconditioner = ck.string(*v, "quasi_static.preconditioner");
+    if (q.preconditioner != "auto" && q.preconditioner != "block_jacobi" && q.preconditioner != "amg")
+      ck.fail("quasi_static.preconditioner", "unknown value '" + q.preconditioner + "'; known: auto, block_jacobi, amg");
+  }
   if (const json* v = ck.optional(j, "cg_max_iterations"))
     q.cg_max_iterations = static_cast<int>(ck.integer(*v, "quasi_static.cg_max_iterations", 1, 100000000));
   return q;
@@ -453,7 +458,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"cracks[]", {"from", "to"}},
       {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
-      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "cg_max_iterations", "dt_initial", "dt_min",
+      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "preconditioner", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
                     "dt_min", "dt_max"}},

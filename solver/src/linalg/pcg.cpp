@@ -136,7 +136,7 @@ std::string PcgResult::message() const {
   return buffer;
 }
 
-PcgResult preconditioned_cg(const LinearOperator& A, const BlockJacobi& M, const std::vector<double>& b,
+PcgResult preconditioned_cg(const LinearOperator& A, const Preconditioner& M, const std::vector<double>& b,
                             std::vector<double>& x, const PcgSettings& settings) {
   PcgResult result;
   const std::size_t n = b.size();
