@@ -71,7 +71,7 @@ def tiny(tmp_path_factory):
     case["discretization"]["dx"] = 4.0e-3  # 50 × 10 × 4 = 2 000 nodes
     case["geometry"]["parameters"]["p"] = 4.0e-3
     case["quasi_static"]["preconditioner"] = "amg"  # auto would take block_jacobi at this size
-    case["time"]["end"] = 0.1                        # 5 load steps to 0.05 mm, below the first break
+    case["time"]["end"] = 0.1                        # 5 load steps to 0.08 mm, below the first break
     case["output"]["every_time"] = 0.02
     case["figures"]["times"] = [0.0, 0.1]
     yaml_path = case_dir / "tiny.yaml"
@@ -90,7 +90,8 @@ def test_a_tiny_beam_is_solved_with_amg_and_is_linear_before_the_first_break(tin
     t = np.array([float(r["time"]) for r in rows])
     force = np.array([-float(r["reaction_load_fy"]) for r in rows])
     assert t[-1] == pytest.approx(0.1, rel=1e-12)
-    assert all(float(r["broken_bonds"]) == 0 for r in rows)
+    broken = [int(r["broken_bonds"]) for r in rows]
+    assert broken[0] > 0 and broken == [broken[0]] * len(rows)  # the notch's bonds, and no more
     assert force[-1] > 0
-    stiffness = force[1:] / (5.0e-4 * t[1:])  # N/m: the load point at −0.5 mm × t
+    stiffness = force[1:] / (8.0e-4 * t[1:])  # N/m: the load point at −0.8 mm × t
     assert np.allclose(stiffness, stiffness[-1], rtol=1e-3)  # linear: PMB below the first break
