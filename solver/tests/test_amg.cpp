@@ -17,16 +17,12 @@ namespace {
 
 constexpr double kDx = 1e-3;
 
-// A 32×6×6 bar, δ = 3.015dx, its first two x-layers held in every direction: long in nodes, where
-// block-Jacobi's iteration count grows and a multigrid cycle's does not.
+// A 32×6×6 bar, δ = 3.015dx, its first two x-layers clamped and its last two held along x: long in
+// nodes, where block-Jacobi's iteration count grows and a multigrid cycle's does not.
 pd::Model held_bar() {
   pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0);
-  pd::Nodes nodes = pdtest::cubic_lattice(32, 6, 6, kDx, 3);
-  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)};
-  for (std::size_t i = 0; i < nodes.size(); ++i) left.member[i] = nodes.x[0][i] < 1.5 * kDx;
-  nodes.sets = {left};
-  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
-  return pd::build_model(c, std::move(nodes));
+  pdtest::clamp_left_pull_right(c, 0.0, 1.0, false);
+  return pd::build_model(c, pdtest::bar_with_grips(32, 6, 6, kDx));
 }
 
 }  // namespace
