@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
     pd::AmgPreconditioner hierarchy;
     start = std::chrono::steady_clock::now();
     cpu0 = cpu_seconds();
-    hierarchy.set_up(A, 3);
+    hierarchy.set_up(A, 3, dofs.component);
     std::printf("AMG set-up %.2f s wall, %.2f s CPU: %d levels, operator complexity %.2f, resident +%.2f GB "
                 "(estimated %.2f GB), peak RSS %.2f GB\n",
                 seconds_since(start), cpu_seconds() - cpu0, hierarchy.levels(), hierarchy.operator_complexity(),

@@ -54,7 +54,7 @@ TEST(Amg, CgWithAmgReachesTheBlockJacobiSolutionInFewerIterations) {
   ASSERT_TRUE(by_jacobi.converged()) << by_jacobi.message();
 
   pd::AmgPreconditioner amg;
-  amg.set_up(K, 3);
+  amg.set_up(K, 3, dofs.component);
   ASSERT_TRUE(amg.ready());
   EXPECT_GE(amg.levels(), 2);
   EXPECT_GT(amg.operator_complexity(), 1.0);
@@ -73,7 +73,7 @@ TEST(Amg, CgWithAmgReachesTheBlockJacobiSolutionInFewerIterations) {
   // The same hierarchy set up again gives the same bits (the restart of quasi_static relies on it),
   // and the cycle is a fixed linear map: applying it twice to the same r gives the same z.
   pd::AmgPreconditioner again;
-  again.set_up(K, 3);
+  again.set_up(K, 3, dofs.component);
   std::vector<double> z1, z2, z3;
   amg.apply(b, z1);
   amg.apply(b, z2);

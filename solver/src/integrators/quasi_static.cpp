@@ -158,7 +158,7 @@ void QuasiStatic::set_up_amg(const State& s, double t1) {
   // The definite variant, shifted: positive definite even with compressed bonds and loose nodes.
   SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, true);
   shift_diagonal(K);
-  amg_.set_up(K, op_.model().nodes.dimension);
+  amg_.set_up(K, op_.model().nodes.dimension, dofs_.component);
   ++amg_setups_;
   amg_u_ = s.u;
   amg_t_ = t1;

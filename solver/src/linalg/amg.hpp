@@ -6,8 +6,10 @@
 // (measured in cases/beam_3d/README.md and integrators/quasi_static.cpp).
 //
 // The three displacement components are coarsened as separate functions (the "unknown approach",
-// BoomerAMG's num_functions = 3), which keeps x, y and z apart on the coarse grids as elasticity
-// asks. hypre here is Debian's build, without OpenMP: a cycle gives the same bits on any thread
+// BoomerAMG's num_functions = 3 with the component of every dof given: a node held in some
+// components has fewer dofs, so hypre's default x, y, z, x, y, z, … would mislabel every dof after
+// it and coarsen components together), which keeps x, y and z apart on the coarse grids as
+// elasticity asks. hypre here is Debian's build, without OpenMP: a cycle gives the same bits on any thread
 // count. hypre is an MPI library: set_up initialises MPI in this process when the program has
 // not (a serial build, or pdsolve without mpirun) and finalises it at exit.
 //
@@ -33,14 +35,15 @@ class AmgPreconditioner : public Preconditioner {
 
   // Whether this build has hypre (PD_HYPRE).
   static bool available();
-  // Bytes the set-up is expected to hold for a matrix of `rows` rows and `nonzeros` stored entries:
-  // a copy of K in hypre's CSR and a hierarchy of operator complexity ~2.5, with the interpolation
-  // operators and work vectors. Calibrated on the 102,400-node bar (see the .cpp).
+  // Bytes at the peak of a set-up for a matrix of `rows` rows and `nonzeros` stored entries: the
+  // assembled K, hypre's copy of it and the hierarchy with its interpolation operators.
+  // Calibrated on a 102,400-node bar (see the .cpp).
   static std::uint64_t estimated_bytes(std::uint64_t rows, std::uint64_t nonzeros);
 
-  // Builds the hierarchy for K (symmetric positive definite, dofs numbered node by node with
-  // `functions` components per node: 3 in 3D). Throws pd::Error when hypre is not built in.
-  void set_up(const SparseMatrix& K, int functions);
+  // Builds the hierarchy for K (symmetric positive definite), whose dof k is component
+  // component[k] < functions of its node (FreeDofs::component; functions 3 in 3D). Throws
+  // pd::Error when hypre is not built in.
+  void set_up(const SparseMatrix& K, int functions, const std::vector<std::uint8_t>& component);
   bool ready() const;
   // z = one V-cycle from z = 0 for K z = r.
   void apply(const std::vector<double>& r, std::vector<double>& z) const override;

@@ -61,12 +61,13 @@ AmgPreconditioner::AmgPreconditioner() : impl_(std::make_unique<Impl>()) {}
 AmgPreconditioner::~AmgPreconditioner() = default;
 bool AmgPreconditioner::available() { return true; }
 
-// Calibration (cases/beam_3d/README.md, the 102,400-node bar): the resident memory the set-up added
-// over the run without it, per stored entry of K. K in hypre's CSR is 12 bytes per entry (value and
-// column) and BoomerAMG's levels, interpolation and strength matrices add about as much again per
-// level entry: some 36 bytes per entry of K, rounded up to 40 to keep the guard on the safe side.
+// Calibration (docs/performance.md §8: pd_linear_solvers 64 40 40 --amg, a 102,400-node bar, 9.84·10⁷
+// entries): the set-up added 2.59 GiB resident (hypre's copy of K, 12 bytes an entry, and the
+// hierarchy of operator complexity 1.56 with its interpolation: 28 bytes per entry of K), on top
+// of the assembled K it is built from (16 bytes an entry, freed after the set-up): a peak of some
+// 44 bytes per entry of K. The guard counts the peak.
 std::uint64_t AmgPreconditioner::estimated_bytes(std::uint64_t rows, std::uint64_t nonzeros) {
-  return 40 * nonzeros + 200 * rows;
+  return 45 * nonzeros + 200 * rows;
 }
 
 void AmgPreconditioner::clear() { impl_->release(); }
@@ -74,7 +75,7 @@ bool AmgPreconditioner::ready() const { return impl_->solver != nullptr; }
 int AmgPreconditioner::levels() const { return impl_->levels; }
 double AmgPreconditioner::operator_complexity() const { return impl_->complexity; }
 
-void AmgPreconditioner::set_up(const SparseMatrix& K, int functions) {
+void AmgPreconditioner::set_up(const SparseMatrix& K, int functions, const std::vector<std::uint8_t>& component) {
   if (K.rows > std::numeric_limits<HYPRE_Int>::max() || K.nonzeros() > static_cast<std::size_t>(std::numeric_limits<HYPRE_Int>::max()))
     throw Error("quasi_static.preconditioner: amg: the tangent has " + std::to_string(K.nonzeros()) +
                 " entries, more than this hypre (32-bit indices) takes; use preconditioner: block_jacobi");
@@ -115,6 +116,12 @@ void AmgPreconditioner::set_up(const SparseMatrix& K, int functions) {
   HYPRE_BoomerAMGSetMaxIter(m.solver, 1);  // one V-cycle: a fixed linear map, as CG needs
   HYPRE_BoomerAMGSetTol(m.solver, 0.0);    // no convergence test (no residual norms computed)
   HYPRE_BoomerAMGSetNumFunctions(m.solver, functions);  // x, y, z coarsened apart (the unknown approach)
+  if (functions > 1) {
+    // Each dof's component; hypre takes the array over (its destroy frees it), so hypre allocates it.
+    HYPRE_Int* dof_function = hypre_CTAlloc(HYPRE_Int, n, HYPRE_MEMORY_HOST);
+    for (HYPRE_Int r = 0; r < n; ++r) dof_function[r] = static_cast<HYPRE_Int>(component[static_cast<std::size_t>(r)]);
+    HYPRE_BoomerAMGSetDofFunc(m.solver, dof_function);
+  }
   // hypre's advice for 3D problems: a strength threshold of 0.5 (0.25 is for 2D), which keeps the
   // coarse operators sparse. The rest are hypre's defaults (HMIS coarsening, extended+i
   // interpolation, l1 Gauss–Seidel forward down / backward up: a symmetric cycle).

@@ -11,7 +11,7 @@ AmgPreconditioner::AmgPreconditioner() = default;
 AmgPreconditioner::~AmgPreconditioner() = default;
 bool AmgPreconditioner::available() { return false; }
 std::uint64_t AmgPreconditioner::estimated_bytes(std::uint64_t, std::uint64_t) { return 0; }
-void AmgPreconditioner::set_up(const SparseMatrix&, int) {
+void AmgPreconditioner::set_up(const SparseMatrix&, int, const std::vector<std::uint8_t>&) {
   throw Error("quasi_static.preconditioner: amg needs hypre's BoomerAMG, which this pdsolve was built without: "
               "install libhypre-dev (pipeline/install-deps.sh) and rebuild (cmake finds it: PD_HYPRE), or use "
               "preconditioner: block_jacobi (or auto)");
