@@ -585,7 +585,7 @@ std::vector<std::string> QuasiStatic::describe(double) const {
                          (use_amg_ ? "algebraic multigrid (hypre BoomerAMG, one V-cycle)" : "block-Jacobi") +
                          ", Eisenstat-Walker forcing (cg, "
                    : std::string("; tangent factorised by CHOLMOD (direct, ")) +
-          solver_reason_ + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "); load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
+          solver_reason_ + ")" + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
           " s, dt_max " + message_number(dt_max_) + " s"};
 }
 
