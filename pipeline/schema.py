@@ -264,6 +264,14 @@ CASE = {
                           "material has no assembled tangent, i.e. contact or model lps, or the "
                           "model is large, or the run is on several MPI ranks: run.log says which and "
                           "why); lps cannot use direct, nor a run on several MPI ranks", default="auto", choices=("auto", "direct", "cg")),
+        preconditioner=Key("string", "the preconditioner of CG (linear_solver cg): block_jacobi "
+                           "(the 3×3 node blocks of the tangent, matrix-free), amg (algebraic "
+                           "multigrid: one V-cycle of hypre's BoomerAMG on the assembled tangent, "
+                           "set up again after bonds break or when CG's iterations grow), or auto "
+                           "(amg for 3D models with at least 20 000 free dofs whose tangent can be "
+                           "assembled, when pdsolve has hypre and its estimated memory fits; "
+                           "block_jacobi otherwise, and on several MPI ranks, where amg is refused: run.log says which and why)",
+                           default="auto", choices=("auto", "block_jacobi", "amg")),
         cg_max_iterations=Key("integer", "CG iterations in one Newton iteration; then Newton goes "
                               "on with the iterate reached", default=5000, minimum=1,
                               maximum=100000000),

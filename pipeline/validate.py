@@ -402,6 +402,9 @@ def _check_materials(case: dict, checker: _Checker):
         elif integrator in ("quasi_static", "mixed") and case["quasi_static"].get("linear_solver") == "direct":
             checker.error(("quasi_static", "linear_solver"), "direct factorises the assembled tangent stiffness, which "
                           "the state-based model lps does not have; use linear_solver: cg (or auto)")
+        elif integrator in ("quasi_static", "mixed") and case["quasi_static"].get("preconditioner") == "amg":
+            checker.error(("quasi_static", "preconditioner"), "amg is set up on the assembled tangent stiffness, which "
+                          "the state-based model lps does not have; use preconditioner: block_jacobi (or auto)")
     influences = {m.get("influence") or "one" for m in materials.values() if m["model"] == "lps"}
     if len(influences) > 1:
         checker.error(("materials",), f"every block must use the same influence function, got {', '.join(sorted(influences))}")

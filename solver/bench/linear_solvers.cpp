@@ -7,10 +7,13 @@
 //     relative residuals 1e-1 (the first Eisenstat–Walker forcing term), 1e-4 and 1e-8;
 //   - by CHOLMOD (assembly, symbolic analysis + numeric factorisation, one solve), unless
 //     --no-direct; its memory is the factor's entries (8 bytes each, as CHOLMOD reports them) and
-//     the process's peak resident set.
+//     the process's peak resident set;
+//   - with --amg, by PCG preconditioned by one BoomerAMG V-cycle (linalg/amg.hpp, as
+//     quasi_static.preconditioner: amg does), set up on the assembled tangent: its set-up time and
+//     the resident memory it added (the calibration of AmgPreconditioner::estimated_bytes).
 // Prints one line per measurement.
 //
-//   pd_linear_solvers NX NY NZ [--no-direct]
+//   pd_linear_solvers NX NY NZ [--no-direct] [--amg]
 #include <omp.h>
 #include <sys/resource.h>
 #include <time.h>
@@ -23,6 +26,7 @@
 
 #include "core/model.hpp"
 #include "lattice.hpp"
+#include "linalg/amg.hpp"
 #include "linalg/cholesky.hpp"
 #include "linalg/pcg.hpp"
 #include "operator/force_operator.hpp"
@@ -40,6 +44,16 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+// The resident set now (/proc/self/statm's second field, in pages).
+double rss_gb() {
+  long pages = 0, resident = 0;
+  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(f);
+  }
+  return static_cast<double>(resident) * 4096.0 / (1024.0 * 1024.0 * 1024.0);
+}
+
 double peak_rss_gb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -50,11 +64,15 @@ double peak_rss_gb() {
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: pd_linear_solvers NX NY NZ [--no-direct]\n");
+    std::fprintf(stderr, "usage: pd_linear_solvers NX NY NZ [--no-direct] [--amg]\n");
     return 2;
   }
   const int nx = std::atoi(argv[1]), ny = std::atoi(argv[2]), nz = std::atoi(argv[3]);
-  const bool direct = !(argc > 4 && std::strcmp(argv[4], "--no-direct") == 0);
+  bool direct = true, amg = false;
+  for (int a = 4; a < argc; ++a) {
+    if (std::strcmp(argv[a], "--no-direct") == 0) direct = false;
+    else if (std::strcmp(argv[a], "--amg") == 0) amg = true;
+  }
   const double dx = 1e-3;
   pd::Case c = pdtest::lattice_case(3, "3d", dx, 3.015 * dx, 1e9, 1000.0, -1.0);
   pd::Nodes nodes = pdtest::cubic_lattice(nx, ny, nz, dx, 3);
@@ -115,8 +133,38 @@ int main(int argc, char** argv) {
                 time, cpu, 1e3 * time / std::max(r.iterations, 1), r.message().c_str());
     std::fflush(stdout);
   }
-  std::printf("peak RSS after PCG %.2f GB\n", peak_rss_gb());
+  std::printf("peak RSS after PCG %.2f GB (resident now %.2f GB)\n", peak_rss_gb(), rss_gb());
   std::fflush(stdout);
+  if (amg) {
+    start = std::chrono::steady_clock::now();
+    double cpu0 = cpu_seconds();
+    const pd::SparseMatrix A = op.assemble_stiffness(s, 1.0, dofs);
+    std::printf("assembly %.2f s wall, %.2f s CPU, %zu nonzeros, resident %.2f GB\n", seconds_since(start),
+                cpu_seconds() - cpu0, A.nonzeros(), rss_gb());
+    const double before = rss_gb();
+    pd::AmgPreconditioner hierarchy;
+    start = std::chrono::steady_clock::now();
+    cpu0 = cpu_seconds();
+    hierarchy.set_up(A, 3, dofs.component);
+    std::printf("AMG set-up %.2f s wall, %.2f s CPU: %d levels, operator complexity %.2f, resident +%.2f GB "
+                "(estimated %.2f GB), peak RSS %.2f GB\n",
+                seconds_since(start), cpu_seconds() - cpu0, hierarchy.levels(), hierarchy.operator_complexity(),
+                rss_gb() - before, static_cast<double>(pd::AmgPreconditioner::estimated_bytes(dofs.size(), A.nonzeros())) / (1024.0 * 1024.0 * 1024.0),
+                peak_rss_gb());
+    std::fflush(stdout);
+    for (double tol : {1e-1, 1e-4, 1e-8}) {
+      pd::PcgSettings settings;
+      settings.relative_tol = tol;
+      settings.max_iterations = 100000;
+      std::vector<double> x;
+      start = std::chrono::steady_clock::now();
+      cpu0 = cpu_seconds();
+      const pd::PcgResult r = pd::preconditioned_cg(K, hierarchy, b, x, settings);
+      std::printf("AMG-PCG to %.0e: %d iterations, %.2f s wall, %.2f s CPU, %s\n", tol, r.iterations, seconds_since(start),
+                  cpu_seconds() - cpu0, r.message().c_str());
+      std::fflush(stdout);
+    }
+  }
   if (!direct) return 0;
 
   start = std::chrono::steady_clock::now();

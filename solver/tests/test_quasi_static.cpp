@@ -226,10 +226,21 @@ bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
   return true;
 }
 
+// max |a.u − b.u| / max |b.u| over every component.
+double relative_difference(const pd::State& a, const pd::State& b) {
+  double error = 0.0, scale = 0.0;
+  for (std::size_t d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      error = std::max(error, std::fabs(a.u[d][i] - b.u[d][i]));
+      scale = std::max(scale, std::fabs(b.u[d][i]));
+    }
+  return error / scale;
+}
+
 // The pulled bar of PulledBarReachesEquilibriumEqualToOneDirectSolve to t = 1 with the given linear
 // solver on `threads` threads; returns the final state, and the describe() line.
 pd::State pull_bar(const std::string& solver, int threads, double strain, std::string* describe = nullptr,
-                   std::int64_t* cg_iterations = nullptr) {
+                   std::int64_t* cg_iterations = nullptr, const std::string& preconditioner = "auto") {
   const int saved = omp_get_max_threads();
   omp_set_num_threads(threads);
   pd::Model m = bar(strain);
@@ -237,6 +248,7 @@ pd::State pull_bar(const std::string& solver, int threads, double strain, std::s
   pd::QuasiStatic qs(op);
   pd::Case c = bar_case();
   c.quasi_static.linear_solver = solver;
+  c.quasi_static.preconditioner = preconditioner;
   qs.configure(c);
   if (describe) *describe = qs.describe(0.0).front();
   pd::State s(m.nodes.size());
@@ -248,6 +260,8 @@ pd::State pull_bar(const std::string& solver, int threads, double strain, std::s
     dt = qs.last_step().next_dt;
   }
   EXPECT_EQ(qs.uses_cg(), solver == "cg");
+  EXPECT_EQ(qs.uses_amg(), solver == "cg" && preconditioner == "amg");
+  if (qs.uses_amg()) EXPECT_GE(qs.amg_setups(), 1);
   EXPECT_LT(force_norm(m, s, true), 1e-8 * force_norm(m, s, false));  // equilibrium, as with direct
   if (cg_iterations) *cg_iterations = qs.cg_iterations();
   omp_set_num_threads(saved);
@@ -265,13 +279,8 @@ TEST(QuasiStatic, CgReachesTheEquilibriumOfTheDirectSolveBitwiseOnOneAndTwoThrea
   const pd::State cg1 = pull_bar("cg", 1, strain, &cg_line, &cg_iterations);
   const pd::State cg2 = pull_bar("cg", 2, strain);
   pull_bar("auto", 1, strain, &auto_line);
-  double error = 0.0, scale = 0.0;
-  for (std::size_t d = 0; d < 3; ++d)
-    for (std::size_t i = 0; i < direct.size(); ++i) {
-      error = std::max(error, std::fabs(cg1.u[d][i] - direct.u[d][i]));
-      scale = std::max(scale, std::fabs(direct.u[d][i]));
-    }
-  EXPECT_LT(error, 1e-8 * scale);
+  const double error = relative_difference(cg1, direct);
+  EXPECT_LT(error, 1e-8);
   EXPECT_TRUE(same_bits(cg1.u, cg2.u));
   EXPECT_TRUE(same_bits(cg1.f, cg2.f));
   EXPECT_GT(cg_iterations, 0);
@@ -279,8 +288,30 @@ TEST(QuasiStatic, CgReachesTheEquilibriumOfTheDirectSolveBitwiseOnOneAndTwoThrea
   EXPECT_NE(direct_line.find("CHOLMOD (direct, as the case file asks)"), std::string::npos) << direct_line;
   EXPECT_NE(cg_line.find("matrix-free CG"), std::string::npos) << cg_line;
   EXPECT_NE(auto_line.find("(direct, auto: 448 free dofs, below 20000 in 3D)"), std::string::npos) << auto_line;
-  std::printf("pulled bar, strain %g: cg %.3g relative from direct, %lld CG iterations in all\n", strain, error / scale,
+  std::printf("pulled bar, strain %g: cg %.3g relative from direct, %lld CG iterations in all\n", strain, error,
               static_cast<long long>(cg_iterations));
+}
+
+TEST(QuasiStatic, AmgPreconditionedCgReachesTheBlockJacobiEquilibrium) {
+  if (!pd::AmgPreconditioner::available()) GTEST_SKIP() << "built without hypre (PD_HYPRE off)";
+  const double strain = 1e-3;
+  std::string jacobi_line, amg_line;
+  std::int64_t jacobi_iterations = 0, amg_iterations = 0;
+  const pd::State jacobi = pull_bar("cg", 1, strain, &jacobi_line, &jacobi_iterations, "block_jacobi");
+  const pd::State amg = pull_bar("cg", 1, strain, &amg_line, &amg_iterations, "amg");
+  const pd::State amg2 = pull_bar("cg", 2, strain, nullptr, nullptr, "amg");
+  const double error = relative_difference(amg, jacobi);
+  EXPECT_LT(error, 1e-8);
+  EXPECT_TRUE(same_bits(amg.u, amg2.u));  // hypre's cycle is serial: the same bits on 2 threads
+  EXPECT_NE(jacobi_line.find("preconditioner block_jacobi: as the case file asks"), std::string::npos) << jacobi_line;
+  EXPECT_NE(amg_line.find("algebraic multigrid"), std::string::npos) << amg_line;
+  EXPECT_NE(amg_line.find("preconditioner amg: as the case file asks"), std::string::npos) << amg_line;
+  std::string auto_line;
+  pull_bar("cg", 1, strain, &auto_line);
+  EXPECT_NE(auto_line.find("preconditioner block_jacobi: auto, 448 free dofs, below 20000 in 3D"), std::string::npos)
+      << auto_line;
+  std::printf("pulled bar: amg %.3g relative from block_jacobi; CG iterations %lld (block-Jacobi) and %lld (AMG)\n",
+              error, static_cast<long long>(jacobi_iterations), static_cast<long long>(amg_iterations));
 }
 
 namespace {
@@ -372,7 +403,9 @@ TEST(QuasiStatic, ContactSolvesWithCgAndDirectIsRefusedWithTheReason) {
               left, right, gap / kDx, static_cast<long long>(qs.cg_iterations()));
 }
 
-TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) {
+namespace {
+
+void restart_continues_bitwise(const std::string& preconditioner) {
   pdtest::OneThread one;
   // The pulled bar (strain 1e-3 by t = 1) with half of the cross-section at x = 5.5dx cut (its bonds
   // broken before the start): the tangent is shifted as after damage, and the notch makes the
@@ -383,7 +416,7 @@ TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) {
     pd::QuasiStatic qs{op};
     pd::State s{m.nodes.size()};
     double t = 0.0, dt = 0.0;
-    Run() {
+    explicit Run(const std::string& preconditioner) {
       for (std::size_t i = 0; i < m.nodes.size(); ++i)
         for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
           const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
@@ -393,6 +426,7 @@ TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) {
         }
       pd::Case c = bar_case();
       c.quasi_static.linear_solver = "cg";
+      c.quasi_static.preconditioner = preconditioner;
       c.quasi_static.dt_max = 0.1;
       qs.configure(c);
       qs.initialize(s, 0.0);
@@ -404,10 +438,10 @@ TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) {
       dt = qs.last_step().next_dt;
     }
   };
-  Run a;
+  Run a(preconditioner);
   for (int k = 0; k < 4; ++k) a.step();
   const std::vector<char> saved = a.qs.save_state();
-  Run b;
+  Run b(preconditioner);
   b.s = a.s;
   b.t = a.t;
   b.dt = a.dt;
@@ -421,4 +455,13 @@ TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) {
   EXPECT_TRUE(same_bits(a.s.f, b.s.f));
   EXPECT_EQ(a.qs.last_step().iterations, b.qs.last_step().iterations);
   EXPECT_LT(force_norm(a.m, a.s, true), 1e-8 * force_norm(a.m, a.s, false));
+}
+
+}  // namespace
+
+TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) { restart_continues_bitwise("block_jacobi"); }
+
+TEST(QuasiStatic, AmgRunSavedAndRestoredMidRunContinuesBitwise) {
+  if (!pd::AmgPreconditioner::available()) GTEST_SKIP() << "built without hypre (PD_HYPRE off)";
+  restart_continues_bitwise("amg");
 }

@@ -97,6 +97,10 @@ def test_lps_refuses_what_factorises_the_tangent(tmp_path):
                     "quasi_static:\n  linear_solver: direct\n")
     with pytest.raises(CaseError, match="bar.yaml:11: quasi_static.linear_solver: direct factorises"):
         load_case(str(path))
+    path.write_text(textwrap.dedent(CASE).format(material=LPS) + "  integrator: quasi_static\n"
+                    "quasi_static:\n  preconditioner: amg\n")
+    with pytest.raises(CaseError, match="bar.yaml:11: quasi_static.preconditioner: amg is set up on the assembled"):
+        load_case(str(path))
 
 
 def test_an_lps_case_is_accepted_with_its_defaults(tmp_path):

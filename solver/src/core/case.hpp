@@ -58,6 +58,10 @@ struct QuasiStaticSettings {
   // "cg" (matrix-free preconditioned CG, an inexact Newton–Krylov iteration) or "auto" (cg when the
   // scene has no assembled tangent, contact, or when it is large; direct otherwise).
   std::string linear_solver = "auto";
+  // CG's preconditioner (integrators/quasi_static.cpp, choose_preconditioner): "block_jacobi" (the
+  // node blocks of K, matrix-free), "amg" (hypre's BoomerAMG on the assembled K: linalg/amg.hpp) or
+  // "auto" (amg for large 3D models when it fits in memory, block_jacobi otherwise).
+  std::string preconditioner = "auto";
   int cg_max_iterations = 5000;  // CG iterations per Newton iteration before it takes the iterate it has
 };
 

@@ -37,7 +37,7 @@ LinearSolverChoice choose_linear_solver(const ForceOperator& op, const Case& c, 
 }
 
 PcgResult solve_newton_system(const ForceOperator& op, const State& s, double t, const FreeDofs& dofs, const DofSums& sums,
-                              const std::vector<double>& diagonal, const BlockJacobi& M, const std::vector<double>& rhs,
+                              const std::vector<double>& diagonal, const Preconditioner& M, const std::vector<double>& rhs,
                               std::vector<double>& correction, PcgSettings settings, Vec3Array& x, Vec3Array& y) {
   const auto& volume = op.model().nodes.volume;
   // K v = −V ∂f/∂u·v + D v over the free dofs (v zero at the prescribed components and ghosts).

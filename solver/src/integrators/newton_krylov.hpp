@@ -37,7 +37,7 @@ LinearSolverChoice choose_linear_solver(const ForceOperator& op, const Case& c, 
 // curvature at the first iteration gives M⁻¹ rhs (Steihaug's first step, a descent direction for the
 // line search). x, y: scratch per node, sized to the state. Collective on a decomposed run.
 PcgResult solve_newton_system(const ForceOperator& op, const State& s, double t, const FreeDofs& dofs, const DofSums& sums,
-                              const std::vector<double>& diagonal, const BlockJacobi& M, const std::vector<double>& rhs,
+                              const std::vector<double>& diagonal, const Preconditioner& M, const std::vector<double>& rhs,
                               std::vector<double>& correction, PcgSettings settings, Vec3Array& x, Vec3Array& y);
 
 }  // namespace pd

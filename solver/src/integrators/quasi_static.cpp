@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
@@ -48,6 +50,111 @@ void QuasiStatic::choose_linear_solver(const Case& c) {
                                                              op_.model().nodes.dimension);
   use_cg_ = choice.use_cg;
   solver_reason_ = choice.reason;
+  // The preconditioner needs the whole model's free dofs and whether its tangent can be assembled.
+  const Decomposed* decomposed = op_.decomposed();
+  const auto local_free = static_cast<std::int64_t>(op_.free_dofs(op_.model().nodes.dimension).size());
+  const auto free = static_cast<std::size_t>(decomposed ? decomposed->total(local_free) : local_free);
+  choose_preconditioner(c, free, op_.missing_assembled_stiffness(State(op_.size()), 0.0).empty());
+}
+
+namespace {
+
+std::string format_gib(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.1f", value);
+  return buffer;
+}
+
+// MemAvailable of /proc/meminfo in bytes (0 when it cannot be read: then the guard does not refuse).
+std::uint64_t available_memory() {
+  std::ifstream in("/proc/meminfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("MemAvailable:", 0) == 0) {
+      std::istringstream fields(line.substr(13));
+      std::uint64_t kib = 0;
+      fields >> kib;
+      return kib * 1024;
+    }
+  return 0;
+}
+
+}  // namespace
+
+// block_jacobi or amg, and why (for describe()). Measured on a clamped 3D bar pulled along x
+// (tests and cases/beam_3d/README.md): at 102,400 nodes one Newton system to a 1e-8 residual took
+// block-Jacobi CG some 130 iterations and AMG-CG some 17; the hierarchy costs about its CG time
+// again to set up and ~30× block-Jacobi's memory, hence the guard. Below some 20,000 dofs the
+// set-up is not repaid.
+void QuasiStatic::choose_preconditioner(const Case& c, std::size_t free, bool assembled) {
+  const int dimension = op_.model().nodes.dimension;
+  const std::string& choice = settings_.preconditioner;
+  use_amg_ = false;
+  if (!use_cg_) {
+    preconditioner_reason_.clear();
+    return;
+  }
+  if (choice == "block_jacobi") {
+    preconditioner_reason_ = "block_jacobi: as the case file asks";
+    return;
+  }
+  // hypre is set up here on one process's assembled tangent: a decomposed run keeps block Jacobi,
+  // which is per node and so decomposes as it is.
+  const Decomposed* decomposed = op_.decomposed();
+  if (choice == "amg") {
+    if (decomposed)
+      throw Error(c.file.string() + ": quasi_static.preconditioner: amg is set up on one process and is not decomposed "
+                  "over MPI ranks (here " + std::to_string(decomposed->ranks()) +
+                  "); use preconditioner: block_jacobi (or auto), or run on one rank");
+    if (!assembled)
+      throw Error(c.file.string() + ": quasi_static.preconditioner: amg is set up on the assembled tangent, which " +
+                  op_.missing_assembled_stiffness(State(op_.size()), 0.0) +
+                  " does not have; use preconditioner: block_jacobi (or auto)");
+    if (!AmgPreconditioner::available())
+      throw Error(c.file.string() + ": quasi_static.preconditioner: amg needs hypre's BoomerAMG, which this pdsolve "
+                  "was built without: install libhypre-dev (pipeline/install-deps.sh) and rebuild, or use "
+                  "preconditioner: block_jacobi (or auto)");
+    use_amg_ = true;
+    preconditioner_reason_ = "amg: as the case file asks";
+    return;
+  }
+  const std::string dofs = std::to_string(free) + " free dofs";
+  if (decomposed) {
+    preconditioner_reason_ = "block_jacobi: auto, decomposed over " + std::to_string(decomposed->ranks()) + " MPI ranks";
+  } else if (dimension != 3 || free < kAmgFromDofs3d) {
+    preconditioner_reason_ = "block_jacobi: auto, " + dofs + (dimension == 3 ? ", below " + std::to_string(kAmgFromDofs3d) + " in 3D" : " in 2D");
+  } else if (!assembled) {
+    preconditioner_reason_ = "block_jacobi: auto, no assembled tangent for amg";
+  } else if (!AmgPreconditioner::available()) {
+    preconditioner_reason_ = "block_jacobi: auto, this pdsolve has no hypre for amg";
+  } else {
+    // The tangent's stored entries: a 3×3 block per node and two per bond (upper bound over free dofs).
+    const auto nonzeros = 3 * static_cast<std::uint64_t>(free) + 9 * static_cast<std::uint64_t>(op_.model().bonds.directed());
+    const std::uint64_t need = AmgPreconditioner::estimated_bytes(free, nonzeros), have = available_memory();
+    const double gib = 1024.0 * 1024.0 * 1024.0;
+    if (have > 0 && static_cast<double>(need) > kAmgMemoryShare * static_cast<double>(have)) {
+      preconditioner_reason_ = "block_jacobi: auto, amg would need about " + format_gib(static_cast<double>(need) / gib) +
+                               " GB, more than half of the " + format_gib(static_cast<double>(have) / gib) +
+                               " GB available (set preconditioner: amg to use it anyway)";
+    } else {
+      use_amg_ = true;
+      preconditioner_reason_ = "amg: auto, " + dofs + " in 3D, at least " + std::to_string(kAmgFromDofs3d) + "; about " +
+                               format_gib(static_cast<double>(need) / gib) + " GB for its hierarchy";
+    }
+  }
+}
+
+void QuasiStatic::set_up_amg(const State& s, double t1) {
+  const auto start = std::chrono::steady_clock::now();
+  // The definite variant, shifted: positive definite even with compressed bonds and loose nodes.
+  SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, true);
+  shift_diagonal(K);
+  amg_.set_up(K, op_.model().nodes.dimension, dofs_.component);
+  ++amg_setups_;
+  amg_u_ = s.u;
+  amg_t_ = t1;
+  amg_rate_ = 0.0;
+  amg_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void QuasiStatic::initialize(State& state, double t) {
@@ -94,15 +201,28 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
     for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
       for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a) blocks_[9 * g + static_cast<std::size_t>(4 * a)] += shift;
   }
-  preconditioner_.build(block_first_, blocks_);
+  const Preconditioner* M = &preconditioner_;
+  if (use_amg_) {
+    if (!amg_.ready()) set_up_amg(s, t1);
+    M = &amg_;
+  } else {
+    preconditioner_.build(block_first_, blocks_);
+  }
   PcgSettings settings;
   settings.relative_tol = eta;
   settings.absolute_tol = floor;
   settings.max_iterations = settings_.cg_max_iterations;
   diagonal_.assign(dofs_.size(), shift);  // K + shift·I
-  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, preconditioner_, rhs_, correction_,
+  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, *M, rhs_, correction_,
                                                settings, cg_x_, cg_y_);
   cg_iterations_ += result.iterations;
+  if (use_amg_ && result.iterations > 0 && result.residual > 0.0 && result.residual < result.initial_residual) {
+    // The rebuild rule (2) of quasi_static.hpp: iterations per tenfold reduction against the first
+    // solve's after the set-up.
+    const double rate = result.iterations / std::log10(result.initial_residual / result.residual);
+    if (amg_rate_ == 0.0) amg_rate_ = rate;
+    else if (rate > kAmgRebuildGrowth * amg_rate_) amg_.clear();
+  }
   ++cg_solves_;
   report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
   if (result.status == PcgResult::kNotConverged && !(result.residual < result.initial_residual)) {
@@ -207,6 +327,14 @@ std::vector<char> QuasiStatic::save_state() const {
     for (const auto& component : factor_u_)
       bytes.insert(bytes.end(), reinterpret_cast<const char*>(component.data()),
                    reinterpret_cast<const char*>(component.data() + component.size()));
+  if (use_cg_ && use_amg_) {  // where the hierarchy was set up (nothing added without amg: old checkpoints read)
+    const std::uint8_t have_amg = amg_.ready() ? 1 : 0;
+    put(have_amg), put(amg_t_), put(amg_rate_);
+    if (have_amg)
+      for (const auto& component : amg_u_)
+        bytes.insert(bytes.end(), reinterpret_cast<const char*>(component.data()),
+                     reinterpret_cast<const char*>(component.data() + component.size()));
+  }
   return bytes;
 }
 
@@ -217,7 +345,11 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   const bool have = bytes[kReportBytes] != 0;
   const std::size_t extra = fixed_part + (have ? 3 * n * sizeof(double) : 0);
   load_report(std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes)), 0);
-  if (bytes.size() != kReportBytes + extra) throw std::runtime_error("integrator state of the wrong size");
+  constexpr std::size_t amg_part = 1 + 2 * sizeof(double);
+  const bool amg = use_cg_ && use_amg_;
+  const bool have_amg = amg && bytes.size() > kReportBytes + extra && bytes[kReportBytes + extra] != 0;
+  const std::size_t amg_extra = amg ? amg_part + (have_amg ? 3 * n * sizeof(double) : 0) : 0;
+  if (bytes.size() != kReportBytes + extra + amg_extra) throw std::runtime_error("integrator state of the wrong size");
   const char* at = bytes.data() + kReportBytes + 1;
   const bool definite = *at++ != 0, shifted = *at++ != 0;
   double t = 0.0;
@@ -233,6 +365,19 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
       throw std::runtime_error("the saved tangent could not be factorised again");
   }
   factorisations_ = factorisations;
+  amg_.clear();
+  if (amg) {
+    ++at;  // have_amg, read above
+    double amg_t = 0.0, amg_rate = 0.0;
+    std::memcpy(&amg_t, at, sizeof amg_t), at += sizeof amg_t;
+    std::memcpy(&amg_rate, at, sizeof amg_rate), at += sizeof amg_rate;
+    if (have_amg) {
+      State s(n);
+      for (auto& component : s.u) std::memcpy(component.data(), at, n * sizeof(double)), at += n * sizeof(double);
+      set_up_amg(s, amg_t);  // the same K, the same hierarchy (hypre's serial set-up is deterministic)
+      amg_rate_ = amg_rate;
+    }
+  }
 }
 
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
@@ -361,6 +506,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       broke_total.broken += broke.broken;
       broke_total.energy += broke.energy;
       have_factor_ = false;  // the tangent lost bonds
+      amg_.clear();          // and the hierarchy too (rule (1) of quasi_static.hpp)
       broken_since_start_ = true;
       if (++rounds >= settings_.max_breaking_rounds) {
         failure_reason_ = "bonds kept breaking through " + std::to_string(rounds) + " re-solves at one load (" +
@@ -413,17 +559,25 @@ std::string QuasiStatic::linear_algebra_summary() const {
                 factorise_seconds_, static_cast<long long>(solves_), solve_seconds_);
   if (!use_cg_) return buffer;
   // On the matrix-free path every CG iteration is one J·x product, about one force evaluation.
-  return std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +
-         std::to_string(cg_iterations_) + " iterations (J·x products)";
+  std::string text = std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +
+                     std::to_string(cg_iterations_) + " iterations (J·x products)";
+  if (use_amg_) {
+    std::snprintf(buffer, sizeof buffer, ", %d AMG set-ups in %.3f s (last: %d levels, operator complexity %.2f)",
+                  amg_setups_, amg_seconds_, amg_.levels(), amg_.operator_complexity());
+    text += buffer;
+  }
+  return text;
 }
 
 std::vector<std::string> QuasiStatic::describe(double) const {
   return {"quasi_static: Newton with line search to residual " + message_number(settings_.residual_tol) +
           " × the load and correction TOL " + message_number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
           message_number(settings_.p) +
-          (use_cg_ ? "; linear solves by matrix-free CG with block-Jacobi, Eisenstat-Walker forcing (cg, "
-                   : "; tangent factorised by CHOLMOD (direct, ") +
-          solver_reason_ + "); load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
+          (use_cg_ ? std::string("; linear solves by matrix-free CG with ") +
+                         (use_amg_ ? "algebraic multigrid (hypre BoomerAMG, one V-cycle)" : "block-Jacobi") +
+                         ", Eisenstat-Walker forcing (cg, "
+                   : std::string("; tangent factorised by CHOLMOD (direct, ")) +
+          solver_reason_ + ")" + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
           " s, dt_max " + message_number(dt_max_) + " s"};
 }
 

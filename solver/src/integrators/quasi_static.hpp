@@ -26,10 +26,22 @@
 // unchanged. It needs no assembled tangent, so contact and the state-based LPS law work (LPS gives
 // its own diagonal blocks: materials/lps/lps_tangent.cpp); a direction of negative curvature
 // (an indefinite tangent after damage) ends CG with its iterate so far (Steihaug 1983).
+//
+// quasi_static.preconditioner: amg (or auto on large 3D models) preconditions that CG by one
+// V-cycle of algebraic multigrid (linalg/amg.hpp) set up on the assembled tangent (its definite
+// variant, diagonal shifted by kDiagonalShift: a preconditioner must be positive definite, and need
+// not be K). The hierarchy is reused across Newton iterations and load steps; it is set up again
+// (1) after bonds break (the tangent lost them: cracks are where an old hierarchy is worst), and
+// (2) when a CG solve needs more than kAmgRebuildGrowth × the iterations per tenfold residual
+// reduction of the first solve after the set-up (the tangent has drifted from the one it was built
+// on, by large rotations or compressed bonds). The point of the set-up (u, t) and that first rate
+// are checkpointed, and load_state sets the hierarchy up again there: hypre's serial set-up is
+// deterministic, so a restarted run continues bitwise.
 #pragma once
 #include <memory>
 
 #include "integrators/integrator.hpp"
+#include "linalg/amg.hpp"
 #include "linalg/cholesky.hpp"
 #include "linalg/pcg.hpp"
 #include "integrators/newton_krylov.hpp"
@@ -63,17 +75,24 @@ class QuasiStatic : public Integrator {
   // and of the solves with its factor; this process's only: a restarted run counts from the restart).
   std::string linear_algebra_summary() const override;
   bool uses_cg() const { return use_cg_; }
+  bool uses_amg() const { return use_cg_ && use_amg_; }
+  int amg_setups() const { return amg_setups_; }  // since configure (not checkpointed)
   std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
   int cg_solves() const { return cg_solves_; }
   // Auto picks cg at or above this many free dofs in 3D (measured: see the .cpp).
   static constexpr std::size_t kCgFromDofs3d = pd::kCgFromDofs3d;
+  // Auto picks amg (when CG is used, the tangent can be assembled and hypre is built in) from this
+  // many free dofs in 3D, if its estimated memory is below kAmgMemoryShare of the memory available.
+  static constexpr std::size_t kAmgFromDofs3d = 20000;
+  static constexpr double kAmgMemoryShare = 0.5;
+  static constexpr double kAmgRebuildGrowth = 2.0;
   const QuasiStaticSettings& settings() const { return settings_; }
 
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
   // A step needing more than max_breaking_rounds re-solves, or not converging at dt_min, fails.
   void limit(int max_breaking_rounds, double dt_min);
   // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
-  void forget_factorisation() { have_factor_ = false; }
+  void forget_factorisation() { have_factor_ = false, amg_.clear(); }
   // Why the last step() threw StepFailed, in a few words for run.log.
   const std::string& failure_reason() const { return failure_reason_; }
   double dt_min() const { return dt_min_; }
@@ -117,6 +136,17 @@ class QuasiStatic : public Integrator {
   void choose_linear_solver(const Case& c);
   std::string cg_failure_;
   BlockJacobi preconditioner_;
+  // Algebraic multigrid (see the head of this file): the choice and why, the hierarchy, where it
+  // was set up, and the first solve's iterations per tenfold reduction after it (0: none yet).
+  void choose_preconditioner(const Case& c, std::size_t free, bool assembled);
+  void set_up_amg(const State& s, double t1);
+  bool use_amg_ = false;
+  std::string preconditioner_reason_;
+  AmgPreconditioner amg_;
+  Vec3Array amg_u_;
+  double amg_t_ = 0.0, amg_rate_ = 0.0;
+  int amg_setups_ = 0;
+  double amg_seconds_ = 0.0;
   std::vector<std::int64_t> block_first_;
   std::vector<double> blocks_, cg_rhs_, diagonal_;
   Vec3Array cg_x_, cg_y_;

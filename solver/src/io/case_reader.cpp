@@ -365,6 +365,11 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
     if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("quasi_static.") + name);
   if (q.dt_min && q.dt_max && *q.dt_min > *q.dt_max) ck.fail("quasi_static.dt_min", "is larger than quasi_static.dt_max");
   read_linear_solver(ck, j, "quasi_static", q.linear_solver, q.cg_max_iterations);
+  if (const json* v = ck.optional(j, "preconditioner")) {
+    q.preconditioner = ck.string(*v, "quasi_static.preconditioner");
+    if (q.preconditioner != "auto" && q.preconditioner != "block_jacobi" && q.preconditioner != "amg")
+      ck.fail("quasi_static.preconditioner", "unknown value '" + q.preconditioner + "'; known: auto, block_jacobi, amg");
+  }
   return q;
 }
 
@@ -461,7 +466,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"cracks[]", {"from", "to"}},
       {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
-      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "cg_max_iterations", "dt_initial", "dt_min",
+      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "preconditioner", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
                     "dt_min", "dt_max", "linear_solver", "cg_max_iterations"}},

@@ -137,6 +137,8 @@ json describe_case() {
   keys["quasi_static.max_breaking_rounds"] =
       defaulted("integer", q.max_breaking_rounds, {{"minimum", 1}, {"maximum", 100000000}});
   keys["quasi_static.linear_solver"] = defaulted("string", q.linear_solver, {{"choices", {"auto", "direct", "cg"}}});
+  keys["quasi_static.preconditioner"] =
+      defaulted("string", q.preconditioner, {{"choices", {"auto", "block_jacobi", "amg"}}});
   keys["quasi_static.cg_max_iterations"] =
       defaulted("integer", q.cg_max_iterations, {{"minimum", 1}, {"maximum", 100000000}});
   keys["quasi_static.dt_initial"] = defaulted("number", value_or_null(q.dt_initial), {{"above", 0.0}, {"unit", "s"}});

@@ -150,7 +150,7 @@ std::string PcgResult::message() const {
   return buffer;
 }
 
-PcgResult preconditioned_cg(const LinearOperator& A, const BlockJacobi& M, const std::vector<double>& b,
+PcgResult preconditioned_cg(const LinearOperator& A, const Preconditioner& M, const std::vector<double>& b,
                             std::vector<double>& x, const PcgSettings& settings) {
   PcgResult result;
   const DotProduct dot = settings.dot ? settings.dot : DotProduct(fixed_order_dot);

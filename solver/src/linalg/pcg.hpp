@@ -1,7 +1,8 @@
 // Preconditioned conjugate gradients (Hestenes & Stiefel 1952; Saad, "Iterative methods for sparse
 // linear systems", 2003, alg. 9.1) for A x = b with A symmetric positive definite and given only as
-// its action y = A x (a callback: the matrix-free tangent of operator/force_operator.hpp), and the
-// block-Jacobi preconditioner M = blockdiag(A_ii), one small block per node (its free components).
+// its action y = A x (a callback: the matrix-free tangent of operator/force_operator.hpp), and a
+// preconditioner (linalg/preconditioner.hpp): here block-Jacobi, M = blockdiag(A_ii), one small block
+// per node (its free components); algebraic multigrid in linalg/amg.hpp.
 //
 // Every dot product and norm is summed in a fixed order that does not depend on the thread count
 // (fixed-size chunks, each summed serially, the chunk sums added serially in chunk order), so a
@@ -11,6 +12,8 @@
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "linalg/preconditioner.hpp"
 
 namespace pd {
 
@@ -27,7 +30,7 @@ double fixed_order_sum(const std::vector<double>& terms);
 // M⁻¹ for M = blockdiag(M_1, …, M_n): block g covers the unknowns first[g] … first[g+1]−1 (1 to 3 of
 // them: a node's free components, numbered together by FreeDofs). Each block is inverted once, by
 // its LDLᵀ factorisation written out for ≤ 3×3 (a closed form, not a sparse factorisation).
-class BlockJacobi {
+class BlockJacobi : public Preconditioner {
  public:
   // blocks[9g..9g+8]: block g row-major in a 3×3 frame (only its leading k×k part is read, k its
   // size). A block whose LDLᵀ meets a pivot ≤ 1e-12 × its largest diagonal entry (not positive
@@ -36,7 +39,7 @@ class BlockJacobi {
   // preconditioner stays symmetric positive definite whatever the blocks are.
   void build(const std::vector<std::int64_t>& first, const std::vector<double>& blocks);
   // z = M⁻¹ r.
-  void apply(const std::vector<double>& r, std::vector<double>& z) const;
+  void apply(const std::vector<double>& r, std::vector<double>& z) const override;
   std::int64_t fallbacks() const { return fallbacks_; }  // blocks that were not positive definite
 
  private:
@@ -73,7 +76,7 @@ struct PcgResult {
 // on a failed solve: kNotConverged after max_iterations, with x the last iterate; kIndefinite when
 // a search direction has pᵀA p ≤ 0 (A not positive definite), with x the iterate before it (the
 // truncated CG step of Steihaug 1983, still a descent direction for the quadratic model).
-PcgResult preconditioned_cg(const LinearOperator& A, const BlockJacobi& M, const std::vector<double>& b,
+PcgResult preconditioned_cg(const LinearOperator& A, const Preconditioner& M, const std::vector<double>& b,
                             std::vector<double>& x, const PcgSettings& settings);
 
 }  // namespace pd
