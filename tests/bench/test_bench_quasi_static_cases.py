@@ -54,6 +54,7 @@ def test_speedup_line_has_the_issue_format():
                     "0.77x, peak force 1.23e-02")
     assert re.match(r"^speedup \w+: mixed [0-9.]+ s against explicit [0-9.]+ s \([\w.+-]+, [0-9.e+-]+ m/s\): "
                     r"[0-9.e+]+x, peak force [0-9.e+-]+$", line)
+    assert qs.speedup_line("traction", 29.96, explicit, 23.07, 0.0123, mixed_same_crack=False) == line + ", crack elsewhere"
     assert qs.speedup_line("plate_with_hole", 2.0, None, math.nan, 0.03) == \
         "speedup plate_with_hole: mixed 2.000 s against no explicit run as accurate, peak force 3.00e-02"
 
