@@ -79,7 +79,7 @@ def test_where_time_goes_counts_static_and_explicit_steps_from_the_history():
     h = {"step": np.array([0, 1, 2, 3, 4, 5, 6.0]), "time": np.linspace(0.0, 6.0, 7),
          "mode": np.array([1, 1, 1, 1, 0, 0, 0.0]), "iterations": np.array([0, 4, 5, 9, 1, 1, 1.0]),
          "wall_time": np.array([0.0, 1.0, 2.0, 4.0, 4.1, 4.2, 4.3])}
-    assert qs.where_time_goes(h) == pytest.approx({"static_steps": 3, "newton_iterations": 18, "explicit_steps": 3,
+    assert qs.where_time_goes(h) == pytest.approx({"static_steps": 3, "newton_iterations": 18, "explicit_steps": 3, "implicit_steps": 0,
                                                    "static_wall": 4.0, "explicit_wall": 0.3})
 
 
