@@ -1,7 +1,7 @@
 """The logic of bench/quasi_static_cases.py (traction and plate_with_hole in make bench-accuracy) on
 made-up data: where the reference search stops, which explicit run is mixed's rival, the speedup
 line, the crack position of two symmetric cracks, and the count of where a mixed run's time goes.
-No solver runs here (the benchmark itself takes minutes)."""
+One quick end-to-end run of traction at dx × 8 (about 10 s); the full benchmark takes minutes."""
 import math
 import os
 import re
@@ -91,3 +91,32 @@ def test_grip_displacement_of_a_ramped_velocity_and_of_a_table():
     table = {"boundary_conditions": [{"set": "right", "kind": "displacement", "component": 0, "times": [0.0, 4.0],
                                       "values": [0.0, 2.0]}]}
     assert qs.grip_displacement(table, np.array([1.0, 4.0])) == pytest.approx([0.5, 2.0])
+
+
+def test_quick_traction_runs_end_to_end_and_its_speedup_line_matches_the_rows(tmp_path):
+    """`--quick --problems traction` (dx × 8, 488 nodes; some 10 s): the rows, the reference found,
+    and the last line the issue's speedup line for the mixed row in the csv."""
+    import csv
+    import subprocess
+
+    solver = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+    if not os.path.exists(solver):
+        pytest.fail(f"{solver} is missing: build it with `make solver`")
+    result = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+                             "--solver", solver, "--out", str(tmp_path)], cwd=ROOT, capture_output=True, text=True,
+                            timeout=600)
+    assert result.returncode == 0, result.stdout + result.stderr
+    with open(tmp_path / "accuracy.csv", newline="", encoding="utf-8") as stream:
+        rows = list(csv.DictReader(stream))
+    assert {r["scheme"] for r in rows} >= {"verlet-alpha0", "quasi_static", "mixed"}
+    assert sum(r["reference"] == "True" for r in rows) == 1
+    mixed = next(r for r in rows if r["scheme"] == "mixed")
+    assert mixed["status"] == "ok" and int(mixed["static_steps"]) > 0
+    found = re.match(r"^speedup traction: mixed ([0-9.]+) s against explicit ([0-9.]+) s \((verlet-alpha[0-9.e+]+), "
+                     r"([0-9.e+-]+) m/s\): ([0-9.e+]+)x, peak force ([0-9.e+-]+)(, crack elsewhere)?$",
+                     result.stdout.splitlines()[-1])
+    assert found, result.stdout.splitlines()[-1]
+    assert float(found.group(6)) == pytest.approx(float(mixed["peak_error"]), rel=1e-2)
+    assert float(found.group(5)) == pytest.approx(float(found.group(2)) / float(found.group(1)), rel=3e-2)
+    assert any(r["scheme"] == found.group(3) and float(r["parameter"]) == float(found.group(4))
+               and float(r["peak_error"]) <= 0.02 and r["same_crack"] == "True" for r in rows)
