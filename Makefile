@@ -224,7 +224,9 @@ bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
 # exact limit, the adaptive step over a sweep of TOL, on a wave and on a fracture problem, against a
 # Verlet run at 1/16 of the step; and (issue 13) quasi-static tension with fracture: Verlet at
 # several loading rates and damping values, quasi_static and mixed, against the rate-converged
-# Verlet run, ending with a speedup line; ACCURACY_ARGS=--quick for a smoke run (docs/accuracy.md).
+# Verlet run, ending with a speedup line; the same on cases/traction and plate_with_hole (their
+# mixed.yaml on a lattice 4x coarser than the case's: ACCURACY_ARGS=--full-resolution for the case's
+# own, --coarsen N for another); ACCURACY_ARGS=--quick for a smoke run (docs/accuracy.md).
 ACCURACY_ARGS ?=
 bench-accuracy: $(SOLVER) | $(DEPS)
 	$(PY) -m bench.accuracy --solver $(SOLVER) --out out/bench $(ACCURACY_ARGS)

@@ -16,14 +16,17 @@ A third problem, quasi-static tension with fracture (bench/tension.py, issue 13)
 pulled by its grips, Verlet at several grip speeds and damping values, quasi_static and mixed,
 against the explicit run whose loading rate has converged (found here by halving the speed); the
 error is that of the peak force, the csv rows add the displacement at the peak, the curve up to it,
-the crack's position and the cost in force-evaluation equivalents. The output ends with one
+the crack's position and the cost in force-evaluation equivalents. The same on the project's
+cases traction and plate_with_hole (bench/quasi_static_cases.py: their mixed.yaml, on a lattice
+--coarsen times coarser than the case's, 4 by default). The output ends with one
 `speedup <problem>: ...` line per problem that has a mixed row.
 
 Writes out/bench/accuracy.csv (a row per run) and out/bench/accuracy.png (log-log error against
 wall time and against force evaluations).
 
     /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 1] [--repeat 3] [--quick]
-                                       [--problems wave,fracture,tension]
+                                       [--problems wave,fracture,tension,traction,plate_with_hole]
+                                       [--coarsen 4 | --full-resolution] [--halvings 7] [--pairs 2]
 """
 from __future__ import annotations
 
@@ -44,9 +47,10 @@ sys.path.insert(0, ROOT)
 from postprocess.series import read_frame, read_series  # noqa: E402
 from preprocess.cloud import NodeCloud  # noqa: E402
 from preprocess.node_file import write_node_file  # noqa: E402
-from bench import tension  # noqa: E402
+from bench import quasi_static_cases, tension  # noqa: E402
 
 DX = 1.0e-3
+PROBLEMS = ("wave", "fracture", "tension", "traction", "plate_with_hole")
 
 
 def strip_problem(directory: str) -> dict:
@@ -319,14 +323,16 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="runs of a case shorter than 2 s; the fastest counts")
     parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"), help="where the csv, png and runs go")
     parser.add_argument("--quick", action="store_true", help="fewer runs, no repeats (a smoke test of the benchmark)")
-    parser.add_argument("--problems", default="wave,fracture,tension",
-                        help="comma-separated subset of wave, fracture, tension (default: all three)")
+    parser.add_argument("--problems", default=",".join(PROBLEMS),
+                        help=f"comma-separated subset of {', '.join(PROBLEMS)} (default: all)")
+    quasi_static_cases.add_arguments(parser)
     args = parser.parse_args(argv)
+    quasi_static_cases.settle_arguments(args)
     chosen = [name.strip() for name in args.problems.split(",") if name.strip()]
-    unknown = sorted(set(chosen) - {"wave", "fracture", "tension"})
+    unknown = sorted(set(chosen) - set(PROBLEMS))
     if unknown or not chosen:
         parser.error(f"--problems {args.problems}: unknown {', '.join(unknown) or 'empty list'}; "
-                     "choose from wave, fracture, tension")
+                     f"choose from {', '.join(PROBLEMS)}")
     if not os.path.isfile(args.solver):
         parser.error(f"{args.solver} is missing: build it with `make solver`")
     repeat = 1 if args.quick else max(1, args.repeat)
@@ -366,6 +372,7 @@ def main(argv=None) -> int:
                   f"wall {r['wall']:7.3f} s  error {e:.3g}", flush=True)
     if "tension" in chosen:
         tension_runs(args, repeat, rows)
+    speedups = [quasi_static_cases.runs(args, rows, name) for name in quasi_static_cases.CASES if name in chosen]
     fieldnames = []
     for r in rows:
         fieldnames += [key for key in r if key not in fieldnames]
@@ -381,6 +388,8 @@ def main(argv=None) -> int:
         line = tension.speedup_line(rows, problem_name)
         if line:
             print(line)
+    for line in speedups:
+        print(line)
     return 0
 
 
@@ -405,7 +414,7 @@ def plot(rows: list[dict], path: str, threads: int):
                         ax.annotate(f"{p[2]:g}", (p[0], p[1]), fontsize=6, xytext=(3, 3), textcoords="offset points")
             ax.set_xlabel(xlabel)
             ax.set_ylabel({"wave": "relative L2 error of displacement", "fracture": "relative L2 error of final damage",
-                           "tension": "relative error of the peak force"}[problem])
+                           }.get(problem, "relative error of the peak force"))
             ax.set_title(f"{problem}: error against {xlabel.split(' [')[0]}")
             ax.grid(alpha=0.3, which="both")
             ax.legend(fontsize="small")
