@@ -63,6 +63,15 @@ struct BarRun {
     dt = mixed.last_step().next_dt;
     for (auto& line : mixed.take_log_lines()) log.push_back(line);
   }
+  // Steps to the end (at most 100000), the mode of each.
+  std::vector<int> to_end() {
+    std::vector<int> modes;
+    while (t < kEnd * (1 - 1e-12) && modes.size() < 100000u) {
+      step();
+      modes.push_back(*mixed.step_mode());
+    }
+    return modes;
+  }
 };
 
 bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
@@ -75,12 +84,8 @@ bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
 
 TEST(Mixed, QuasiStaticUntilTheBarSnapsThenExplicit) {
   BarRun run;
-  std::vector<int> modes;
-  while (run.t < kEnd * (1 - 1e-12)) {
-    run.step();
-    modes.push_back(*run.mixed.step_mode());
-    ASSERT_LT(modes.size(), 100000u);
-  }
+  const std::vector<int> modes = run.to_end();
+  ASSERT_LT(modes.size(), 100000u);
   ASSERT_GE(modes.size(), 3u);
   EXPECT_EQ(modes.front(), pd::Mixed::kQuasiStatic);
   // Breaking starts near s0 = 1e-3 of 4e-3 at the end: the snap comes in the first half.
@@ -343,12 +348,8 @@ TEST(Mixed, ReturnsToQuasiStaticOnceTheBarHasSeparatedWhateverItsRinging) {
   // The snapped halves ring undamped (no kinetic-energy rule would ever end the explicit phase);
   // arrest_steps steps after the cracks have cut the bar, the load steps finish the run.
   BarRun run;
-  std::vector<int> modes;
-  while (run.t < kEnd * (1 - 1e-12)) {
-    run.step();
-    modes.push_back(*run.mixed.step_mode());
-    ASSERT_LT(modes.size(), 100000u);
-  }
+  const std::vector<int> modes = run.to_end();
+  ASSERT_LT(modes.size(), 100000u);
   const auto said = [&run](const std::string& what) {
     return std::find_if(run.log.begin(), run.log.end(), [&](const std::string& line) { return line.find(what) != std::string::npos; });
   };
