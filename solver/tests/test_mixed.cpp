@@ -12,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "core/time_step_rule.hpp"
+#include "integrators/load_path.hpp"
 #include "integrators/mixed.hpp"
 #include "lattice.hpp"
 
@@ -62,6 +63,15 @@ struct BarRun {
     dt = mixed.last_step().next_dt;
     for (auto& line : mixed.take_log_lines()) log.push_back(line);
   }
+  // Steps to the end (at most 100000), the mode of each.
+  std::vector<int> to_end() {
+    std::vector<int> modes;
+    while (t < kEnd * (1 - 1e-12) && modes.size() < 100000u) {
+      step();
+      modes.push_back(*mixed.step_mode());
+    }
+    return modes;
+  }
 };
 
 bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
@@ -74,12 +84,8 @@ bool same_bits(const pd::Vec3Array& a, const pd::Vec3Array& b) {
 
 TEST(Mixed, QuasiStaticUntilTheBarSnapsThenExplicit) {
   BarRun run;
-  std::vector<int> modes;
-  while (run.t < kEnd * (1 - 1e-12)) {
-    run.step();
-    modes.push_back(*run.mixed.step_mode());
-    ASSERT_LT(modes.size(), 100000u);
-  }
+  const std::vector<int> modes = run.to_end();
+  ASSERT_LT(modes.size(), 100000u);
   ASSERT_GE(modes.size(), 3u);
   EXPECT_EQ(modes.front(), pd::Mixed::kQuasiStatic);
   // Breaking starts near s0 = 1e-3 of 4e-3 at the end: the snap comes in the first half.
@@ -290,4 +296,71 @@ TEST(Mixed, StartedImplicitReturnsToImplicitWhenTheCrackArrests) {
   for (std::size_t d = 0; d < 3; ++d)
     for (double u : state.u[d]) ASSERT_TRUE(std::isfinite(u));
   std::printf("mixed from implicit, arrested crack: %zu steps; %s\n", modes.size(), log[1].c_str());
+}
+
+namespace {
+// Breaks every bond across the plane x = cut, except `keep` of them.
+void cut_bar(pd::Model& m, double cut, int keep) {
+  const auto& x = m.nodes.x[0];
+  for (std::size_t i = 0; i < m.bonds.nodes(); ++i)
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+      const double lo = std::min(x[i], x[j]), hi = std::max(x[i], x[j]);
+      if (lo < cut && hi > cut) m.bonds.broken[static_cast<std::size_t>(k)] = 1;
+    }
+  // Heal `keep` bonds (both directed copies) between the two nodes nearest the plane on the axis.
+  for (std::size_t i = 0; i < m.bonds.nodes() && keep > 0; ++i)
+    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1] && keep > 0; ++k) {
+      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+      if (x[i] < cut && x[j] > cut) {
+        m.bonds.broken[static_cast<std::size_t>(k)] = 0;
+        for (std::int64_t q = m.bonds.offsets[j]; q < m.bonds.offsets[j + 1]; ++q)
+          if (static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(q)]) == i) m.bonds.broken[static_cast<std::size_t>(q)] = 0;
+        --keep;
+      }
+    }
+}
+}  // namespace
+
+TEST(LoadPath, SeparatedOnlyWhenEveryBondBetweenTheGripsIsCut) {
+  pd::Model bar = breakable_bar();  // clamped left grip, pulled right grip: two groups
+  const pd::LoadPath path(bar);
+  EXPECT_TRUE(path.linked_uncut());
+  EXPECT_FALSE(path.separated(bar.bonds));
+  const double cut = 5.5 * kDx;
+  cut_bar(bar, cut, 1);  // one bond left across: still linked
+  EXPECT_FALSE(path.separated(bar.bonds));
+  cut_bar(bar, cut, 0);
+  EXPECT_TRUE(path.separated(bar.bonds));
+  EXPECT_TRUE(pd::LoadPath(bar).linked_uncut());  // from every bond, broken or not: restart-proof
+
+  // One grip only (the right end free): no load path between prescribed motions to cut.
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
+  pd::Model cantilever = pd::build_model(c, pdtest::bar_with_grips(kNx, kNy, kNz, kDx));
+  const pd::LoadPath one(cantilever);
+  cut_bar(cantilever, cut, 0);
+  EXPECT_FALSE(one.linked_uncut());
+  EXPECT_FALSE(one.separated(cantilever.bonds));
+}
+
+TEST(Mixed, ReturnsToQuasiStaticOnceTheBarHasSeparatedWhateverItsRinging) {
+  // The snapped halves ring undamped (no kinetic-energy rule would ever end the explicit phase);
+  // arrest_steps steps after the cracks have cut the bar, the load steps finish the run.
+  BarRun run;
+  const std::vector<int> modes = run.to_end();
+  ASSERT_LT(modes.size(), 100000u);
+  const auto said = [&run](const std::string& what) {
+    return std::find_if(run.log.begin(), run.log.end(), [&](const std::string& line) { return line.find(what) != std::string::npos; });
+  };
+  const auto cut = said("the cracks have cut the load path between the prescribed motions"), back = said("explicit → quasi-static (");
+  ASSERT_NE(cut, run.log.end());
+  ASSERT_NE(back, run.log.end());
+  EXPECT_LT(cut, back);  // said when it happens, then the return
+  EXPECT_NE(back->find("(the cracks cut the load path between the prescribed motions 50 steps ago)"),
+            std::string::npos) << *back;
+  EXPECT_EQ(modes.back(), pd::Mixed::kQuasiStatic);
+  EXPECT_TRUE(pd::LoadPath(run.model).separated(run.model.bonds));
+  const auto explicit_steps = std::count(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kExplicit));
+  std::printf("snapped bar: %zu steps, %td explicit; %s\n", modes.size(), explicit_steps, back->c_str());
 }

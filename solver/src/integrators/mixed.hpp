@@ -15,7 +15,11 @@
 //   has stayed below mixed.kinetic_fraction × the strain energy for mixed.arrest_steps steps in a
 //   row. The next load step solves equilibrium from the current state; the kinetic energy left is
 //   given up (added to the damping work, so that the energy balance still closes, and said in
-//   run.log).
+//   run.log). Also when the cracks have cut every load path between two prescribed motions that the
+//   uncut body linked (the specimen has separated, integrators/load_path.hpp), mixed.arrest_steps
+//   steps after the cut, whatever the kinetic energy and the bonds that still break in the ringing: the halves then hang each from its grip
+//   and ring undamped for ever (measured on cases/traction: the kinetic energy stays above the strain
+//   energy), which the quasi-static answer does without; the load steps finish the loading.
 //
 // mixed.start: implicit puts generalized-α implicit dynamics (integrators/implicit.hpp) in the
 // place of the quasi-static load steps, for loads where inertia matters but is slow next to the
@@ -41,6 +45,7 @@
 
 #include "integrators/implicit.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/load_path.hpp"
 #include "integrators/quasi_static.hpp"
 #include "integrators/verlet.hpp"
 
@@ -99,6 +104,14 @@ class Mixed : public Integrator {
   double static_dt_ = 0.0;       // the load step proposed when the quasi-static mode was left [s]
   int switches_ = 0;
   std::int64_t breaking_steps_ = 0;  // implicit steps in a row in which bonds broke
+  // The grips' load path (load_path.hpp) and whether the cracks have cut it: arrest_steps steps
+  // after they have, the quasi-static home returns whatever the kinetic energy (the separated
+  // halves ring undamped; that motion is not the quasi-static answer). The first load step then is
+  // tentative (kTentativeIterations); if it fails, the rule is given up for the run.
+  std::optional<LoadPath> load_path_;
+  bool separated_ = false;
+  bool separation_given_up_ = false;  // a tentative load step after the separation failed
+  static constexpr int kTentativeIterations = 10;
   std::vector<std::uint8_t> broken_before_;  // the bonds' state before a quasi-static attempt
   std::vector<double> critical_before_;      // and the per-node s0 of LAMMPS's α rule
   std::vector<std::string> log_lines_;

@@ -383,9 +383,14 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
   double previous = HUGE_VAL;
   double eta = kEtaMax;  // the forcing term of the matrix-free path
-  for (int k = 1; k <= settings_.max_iterations; ++k) {
-    op_.evaluate(s, t1);
-    ++report_.force_evaluations;
+  bool evaluated = false;  // s.f is already the force at s.u (the line search's accepted trial)
+  const int max_iterations = iteration_cap_ > 0 ? std::min(iteration_cap_, settings_.max_iterations) : settings_.max_iterations;
+  for (int k = 1; k <= max_iterations; ++k) {
+    if (!evaluated) {
+      op_.evaluate(s, t1);
+      ++report_.force_evaluations;
+    }
+    evaluated = false;
     const double residual = residual_norm(s);
     if (!std::isfinite(residual)) return false;
     const double load = load_scale(s, t1);
@@ -456,7 +461,10 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       if (halving == 5) break;
       op_.evaluate(trial_, t1);
       ++report_.force_evaluations;
-      if (residual_norm(trial_) < residual) break;
+      if (residual_norm(trial_) < residual) {
+        evaluated = true;  // the next iteration's force is this one (the force is a function of u)
+        break;
+      }
       alpha *= 0.5;
     }
     // Σ Δu² and Σ (u − u_n)² one by one in dof order (over the ranks: parallel/dof_sums.hpp).
@@ -471,19 +479,26 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     const std::vector<double> norms = sums_.sums({&terms_, &motion_terms_});
     step_norm = norms[0];
     motion = norms[1];
-    std::swap(s.u, trial_.u);
+    // The whole state when trial_ was evaluated at the accepted u (its force, energy densities and
+    // term energies), else only u: trial_ was copied from s, so nothing else differs.
+    if (evaluated) std::swap(s, trial_);
+    else std::swap(s.u, trial_.u);
     omega = motion > 0.0 ? std::sqrt(step_norm / motion) : 0.0;  // eq. 2.6 for Newton
     iterations = k;
     if (!std::isfinite(omega)) return false;
   }
-  op_.evaluate(s, t1);
-  ++report_.force_evaluations;
+  if (!evaluated) {
+    op_.evaluate(s, t1);
+    ++report_.force_evaluations;
+  }
   return residual_norm(s) <= settings_.residual_tol * load_scale(s, t1) && omega <= settings_.tol;
 }
 
 void QuasiStatic::step(State& state, double& t, double& dt) {
   report_ = StepReport{};
   failure_reason_.clear();
+  iteration_cap_ = try_once_iterations_;  // this step only
+  try_once_iterations_ = 0;
   report_.force_evaluations = 0;
   // From the bonds themselves, not a flag carried along: a restarted run (or a pre-cracked body)
   // shifts its tangent exactly as the uninterrupted run does.
@@ -493,6 +508,10 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     const double t1 = t + h;
     State s = state;
     op_.advance_prescribed_motion(state.u, s.u, s.v, t, t1, h, false);
+    if (guess_from_velocity_)  // the predictor (see quasi_static.hpp); v_n = 0 at the start
+      for (std::size_t d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < s.size(); ++i)
+          if (!op_.fixed()[d][i]) s.u[d][i] = state.u[d][i] + h * state.v[d][i];
     int iterations = 0, total = 0, rounds = 0;
     double omega = 0.0;
     bool converged = true;
@@ -522,8 +541,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       for (std::size_t d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < s.size(); ++i)
           if (!op_.fixed()[d][i]) s.v[d][i] = (s.u[d][i] - state.u[d][i]) / h;
-      op_.evaluate(s, t1);
-      ++report_.force_evaluations;
+      // s.f is already the force at the equilibrium with these bonds: solve_equilibrium returns true
+      // only just after evaluating it, and a breaking round that broke nothing changed no bond.
       op_.update_work(s, t1, h);
       state = std::move(s);
       report_.iterations = std::max(total, 1);
@@ -539,6 +558,12 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved. The
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     have_factor_ = false;
+    if (iteration_cap_ > 0) {
+      failure_reason_ = "the tentative load step reached no equilibrium in " + std::to_string(iteration_cap_) +
+                        " Newton iterations (last correction ω = " + message_number(omega) + ")";
+      throw StepFailed("the tentative quasi-static load step at t = " + message_number(t1) + " s reached no equilibrium in " +
+                       std::to_string(iteration_cap_) + " Newton iterations");
+    }
     if (h <= dt_min_ * (1.0 + 1e-12)) {
       failure_reason_ = "no equilibrium at the smallest load step " + message_number(dt_min_) + " s (last correction ω = " +
                         message_number(omega) + ")";

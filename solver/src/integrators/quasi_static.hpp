@@ -8,6 +8,11 @@
 // the first bond failure PMB is nearly linear, so one factorisation serves many steps); otherwise
 // the tangent is assembled and factorised again.
 //
+// Newton starts from u_n + Δt·v_n at the free components, v_n the mean velocity of the last load
+// step: the linear extrapolation of the load path, which is the
+// equilibrium itself while the response is linear (PMB below its first failure), so the first
+// residual is that of the nonlinearity only and Newton needs fewer corrections.
+//
 // Converged when ω_K = ‖Δu‖/‖u_K − u_n‖ ≤ tol (eq. 2.6 for Newton's corrections) and either
 // ‖V f‖ ≤ residual_tol × the load (‖reactions‖ + ‖body forces‖) or the residual has stopped falling
 // (the round-off floor of the stretches, ~1e-16/strain of the load, above residual_tol at small strain). Then bonds over their critical
@@ -91,6 +96,12 @@ class QuasiStatic : public Integrator {
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
   // A step needing more than max_breaking_rounds re-solves, or not converging at dt_min, fails.
   void limit(int max_breaking_rounds, double dt_min);
+  // Whether the next step's Newton starts from u_n + Δt·v_n (see step()); false after an explicit
+  // step, whose velocity is the motion of the vibrating body, not the rate of the load path.
+  void guess_from_velocity(bool use) { guess_from_velocity_ = use; }
+  // For the next step only: a single attempt at the step asked for (no halving) and at most
+  // max_iterations Newton iterations: a tentative step, which fails fast.
+  void try_once(int max_iterations) { try_once_iterations_ = max_iterations; }
   // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
   void forget_factorisation() { have_factor_ = false, amg_.clear(); }
   // Why the last step() threw StepFailed, in a few words for run.log.
@@ -107,6 +118,9 @@ class QuasiStatic : public Integrator {
   void shift_diagonal(SparseMatrix& K) const;
   static constexpr double kDiagonalShift = 1e-8;
   bool broken_since_start_ = false;  // a bond has broken in this run (then K is shifted, see .cpp)
+  bool guess_from_velocity_ = true;
+  int try_once_iterations_ = 0;  // the cap of try_once (0: none)
+  int iteration_cap_ = 0;        // the step in progress's (0: none)
 
   ForceOperator& op_;
   QuasiStaticSettings settings_;
