@@ -45,10 +45,21 @@ void Mixed::initialize(State& state, double t) {
   breaking_steps_ = 0;
   log_lines_.clear();
   // From the bond list with every bond, broken or not: the same before and after a restart.
-  // On a decomposed run the piece holds only its own rows of the bond graph: the separation rule
-  // is off there (not yet decomposed), and mixed returns to quasi-static on the kinetic rule only.
-  if (home_ == kQuasiStatic && !op_.decomposed()) load_path_.emplace(op_.model());
+  // On a decomposed run the piece holds only its own rows of the bond graph: the groups come from
+  // the whole model (load_path_cut).
+  if (home_ == kQuasiStatic) load_path_.emplace(whole_ ? *whole_ : op_.model());
   separated_ = false;
+}
+
+// Serial: the piece is the model. Decomposed: the owned rows' broken flags gathered into the whole
+// model's bond list on rank 0 (as for a frame), judged there, and rank 0's verdict taken by all
+// (the least of 0 = cut on rank 0 and 1 elsewhere). Collective.
+bool Mixed::load_path_cut() const {
+  const Decomposed* dec = op_.decomposed();
+  if (!dec || !whole_) return load_path_->separated(op_.model().bonds);
+  dec->gather_broken(op_.model().bonds, whole_->bonds);
+  const bool cut = dec->rank() == 0 && load_path_->separated(whole_->bonds);
+  return dec->minimum(cut ? 0.0 : 1.0) == 0.0;
 }
 
 void Mixed::to_explicit(State&, double t, const std::string& reason) {
@@ -165,7 +176,7 @@ void Mixed::step(State& state, double& t, double& dt) {
   if (report_.broken_now > 0) {
     cracked_ = true;
     // The graph changes only when bonds break: one O(bonds) pass then.
-    if (load_path_ && !separated_ && (separated_ = load_path_->separated(op_.model().bonds)))
+    if (load_path_ && !separated_ && (separated_ = load_path_cut()))
       log_lines_.push_back("mixed: t = " + message_number(t) +
                            " s: the cracks have cut the load path between the prescribed motions");
   }
@@ -228,7 +239,8 @@ void Mixed::load_state(const std::vector<char>& bytes) {
     std::uint8_t given_up = 0;
     get(given_up);
     separation_given_up_ = given_up != 0;
-    separated_ = load_path_ && load_path_->separated(op_.model().bonds);
+    // A restart restored the whole model's broken flags on every rank (run/start.cpp) before this.
+    separated_ = load_path_ && load_path_->separated(whole_ ? whole_->bonds : op_.model().bonds);
     static_.load_state(inner);
   }
 }

@@ -134,6 +134,7 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
   p->integrator = integrator_registry().get(c.time.integrator)(*p->op);
+  if (p->decomposed) p->integrator->set_whole_model(p->model);
   // The adaptive step's default Δt_max needs the exact limit (Lanczos), which the operator of a
   // piece cannot give (ForceOperator::exact_time_step): every rank computes it on the whole model,
   // the same bits as the serial run's configure() does.
