@@ -39,6 +39,12 @@ def read_series(pvd_path: str) -> list[tuple[float, str]]:
         except ValueError:
             raise PostprocessError(f"{pvd_path}: DataSet {number}: timestep '{time}' is not a number") from None
         path = os.path.normpath(os.path.join(base, file))
+        if file.endswith(".pvtu"):
+            # output.parallel_frames: pieces (formats.md §4): one .vtu per MPI rank, with ghosts.
+            raise PostprocessError(f"{pvd_path}: lists {file}, a frame in pieces (one .vtu per MPI rank, "
+                                   f"output.parallel_frames: pieces), which postprocess does not read; "
+                                   f"open frames.pvd in ParaView, or run the case again with "
+                                   f"output.parallel_frames: gathered (the default)")
         if not os.path.isfile(path):
             raise PostprocessError(f"{pvd_path}: lists {file}, which does not exist ({path}); "
                                    f"rerun the solver (make case=<case>)")

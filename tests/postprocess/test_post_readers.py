@@ -105,6 +105,16 @@ def test_series_errors(run2d, tmp_path):
         read_series(str(tmp_path / "frames.pvd"))
 
 
+def test_series_refuses_frames_in_pieces_clearly(tmp_path):
+    """output.parallel_frames: pieces (an MPI run) lists .pvtu files, which postprocess does not read."""
+    (tmp_path / "frames").mkdir()
+    (tmp_path / "frames" / "frame_000000.pvtu").write_text("<VTKFile/>")
+    synth.write_pvd(tmp_path / "frames.pvd", [(0.0, "frames/frame_000000.pvtu")])
+    with pytest.raises(PostprocessError, match=r"frame_000000\.pvtu, a frame in pieces .*output\.parallel_frames: "
+                                               r"gathered \(the default\)"):
+        read_series(str(tmp_path / "frames.pvd"))
+
+
 # ---------------------------------------------------------------- one frame
 
 def test_frame_returns_points_point_data_and_broken_bonds_exactly(run2d):

@@ -473,7 +473,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
-                  "restart_every_steps", "precision", "compression", "fields", "gmsh"}},
+                  "restart_every_steps", "precision", "compression", "fields", "gmsh", "parallel_frames"}},
   };
   return keys;
 }
@@ -627,7 +627,8 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   for (auto [name, slot, choices] :
        {std::tuple{"precision", &c.output.precision, std::vector<std::string>{"float32", "float64"}},
         std::tuple{"compression", &c.output.compression, std::vector<std::string>{"zlib", "none"}},
-        std::tuple{"gmsh", &c.output.gmsh, std::vector<std::string>{"all", "figures", "none"}}}) {
+        std::tuple{"gmsh", &c.output.gmsh, std::vector<std::string>{"all", "figures", "none"}},
+        std::tuple{"parallel_frames", &c.output.parallel_frames, std::vector<std::string>{"gathered", "pieces"}}}) {
     const std::string key = std::string("output.") + name;
     if (const json* j = ck.optional(output, name)) *slot = ck.string(*j, key);
     if (std::find(choices.begin(), choices.end(), *slot) == choices.end())

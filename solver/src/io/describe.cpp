@@ -178,6 +178,8 @@ json describe_case() {
   keys["output.fields"] = defaulted("strings", o.fields, {{"choices", frame_fields()}});
   keys["output.gmsh"] = defaulted("string", o.gmsh, {{"choices", {"all", "figures", "none"}},
                                                      {"note", "postprocess only: checked to be one of the choices"}});
+  keys["output.parallel_frames"] = defaulted("string", o.parallel_frames, {{"choices", {"gathered", "pieces"}},
+                                                                           {"note", "several MPI ranks only"}});
   keys["figures"] = defaulted("object", json::object(), {{"note", "postprocess only: checked to be an object"}});
 
   // Every key the reader accepts is described, and nothing else (blocks: id, name + the material's).

@@ -37,6 +37,11 @@ FrameFormat frame_format_of(const OutputSettings& output) {
 
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
                  std::int64_t step, const FrameFormat& format) {
+  write_vtu(path, frame_grid(model, state, time, step, format), format.zlib ? VtuCompression::zlib : VtuCompression::none);
+}
+
+VtuGrid frame_grid(const Model& model, const State& state, double time, std::int64_t step, const FrameFormat& format,
+                   const FramePiece* piece) {
   const std::size_t n = model.nodes.size();
   VtuGrid g;
   // TIME and step stay exact: readers match frames to history.csv rows and the .pvd by them.
@@ -99,7 +104,22 @@ void write_frame(const std::filesystem::path& path, const Model& model, const St
   g.offsets = make_array("offsets", offs);
   g.types = make_array("types", types);
   g.cell_data.push_back(make_array("broken_bond", broken_flag));
-  write_vtu(path, g, format.zlib ? VtuCompression::zlib : VtuCompression::none);
+  if (piece) {
+    // A ghost's point and vertex cell are its owner's (VTK's DUPLICATEPOINT, DUPLICATECELL = 1);
+    // line cells come from owned rows only (a ghost's row is empty), so each bond is in one piece.
+    std::vector<std::uint8_t> ghost_point(n), ghost_cell(n + lines, 0);
+    for (std::size_t l = 0; l < n; ++l) ghost_point[l] = ghost_cell[l] = piece->owned[l] ? 0 : 1;
+    g.point_data.push_back(make_array("node_id", piece->global));
+    g.point_data.push_back(make_array("vtkGhostType", ghost_point));
+    g.cell_data.push_back(make_array("vtkGhostType", ghost_cell));
+  }
+  return g;
+}
+
+std::string frame_piece_file(std::size_t k, int rank) {
+  char name[80];
+  std::snprintf(name, sizeof name, "frames/frame_%06zu_p%d.vtu", k, rank);
+  return name;
 }
 
 namespace {
@@ -108,13 +128,13 @@ double clock_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string frame_file(std::size_t k) {
+}  // namespace
+
+std::string OutputWriter::frame_file(std::size_t k) const {
   char name[64];
-  std::snprintf(name, sizeof name, "frames/frame_%06zu.vtu", k);
+  std::snprintf(name, sizeof name, "frames/frame_%06zu.%s", k, format_.pieces ? "pvtu" : "vtu");
   return name;
 }
-
-}  // namespace
 
 OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns,
                            const OutputResume* resume, FrameFormat format)
@@ -161,12 +181,13 @@ OutputWriter::OutputWriter(std::filesystem::path output_dir, const std::vector<s
   write_pvd();
   // Frames of an earlier, longer run (or written after the checkpoint) would otherwise sit next to
   // the new ones.
-  static const std::regex frame_name("frame_([0-9]{6})\\.vtu(\\.part)?");
+  // A run in pieces (output.parallel_frames) names frame_NNNNNN.pvtu and frame_NNNNNN_pR.vtu.
+  static const std::regex frame_name("frame_([0-9]{6})(_p[0-9]+\\.vtu|\\.vtu|\\.pvtu)(\\.part)?");
   std::smatch match;
   for (const auto& entry : std::filesystem::directory_iterator(dir_ / "frames")) {
     const std::string name = entry.path().filename().string();
     if (entry.is_regular_file() && std::regex_match(name, match, frame_name) &&
-        (match[2].matched || std::stoul(match[1].str()) >= frames_.size()))
+        (match[3].matched || std::stoul(match[1].str()) >= frames_.size()))
       std::filesystem::remove(entry.path());
   }
   if (resume) {
@@ -211,6 +232,34 @@ void OutputWriter::frame(const Model& model, const State& state, double time, st
   flush_history();
 }
 
+void OutputWriter::frame_of_pieces(const VtuGrid& rank0_grid, int ranks, double time) {
+  const std::size_t k = frames_.size();
+  // VTK's PUnstructuredGrid: the arrays every piece holds (name, type, components), then the pieces,
+  // relative to the .pvtu's directory (frames/).
+  std::ostringstream text;
+  const auto declare = [&text](const char* section, const std::vector<VtuArray>& arrays) {
+    text << "    <" << section << ">\n";
+    for (const VtuArray& a : arrays)
+      text << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\" NumberOfComponents=\""
+           << a.components << "\"/>\n";
+    text << "    </" << section << ">\n";
+  };
+  text << "<?xml version=\"1.0\"?>\n"
+       << "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+       << "  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  declare("PPointData", rank0_grid.point_data);
+  declare("PCellData", rank0_grid.cell_data);
+  text << "    <PPoints>\n      <PDataArray type=\"" << rank0_grid.points.type << "\" NumberOfComponents=\"3\"/>\n"
+       << "    </PPoints>\n";
+  for (int r = 0; r < ranks; ++r)
+    text << "    <Piece Source=\"" << std::filesystem::path(frame_piece_file(k, r)).filename().string() << "\"/>\n";
+  text << "  </PUnstructuredGrid>\n</VTKFile>\n";
+  write_file_atomically(dir_ / frame_file(k), text.str());
+  frames_.emplace_back(time, frame_file(k));
+  write_pvd();
+  flush_history();
+}
+
 int OutputWriter::drop_frames_after(double time) {
   std::vector<std::string> dropped;
   while (!frames_.empty() && frames_.back().first > time) {
@@ -223,6 +272,15 @@ int OutputWriter::drop_frames_after(double time) {
     std::error_code ignored;
     std::filesystem::remove(dir_ / file, ignored);
   }
+  if (format_.pieces)  // and their pieces, written by every rank
+    for (const auto& entry : std::filesystem::directory_iterator(dir_ / "frames")) {
+      const std::string name = entry.path().filename().string();
+      static const std::regex piece_name("frame_([0-9]{6})_p[0-9]+\\.vtu");
+      std::smatch match;
+      std::error_code ignored;
+      if (std::regex_match(name, match, piece_name) && std::stoul(match[1].str()) >= frames_.size())
+        std::filesystem::remove(entry.path(), ignored);
+    }
   return static_cast<int>(dropped.size());
 }
 

@@ -12,6 +12,7 @@
 #include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/state.hpp"
+#include "io/vtu.hpp"
 
 namespace pd {
 
@@ -33,6 +34,9 @@ struct FrameFormat {
   bool float32 = true;  // point fields as Float32 (the reference points stay Float64)
   bool zlib = true;     // vtkZLibDataCompressor blocks
   std::vector<std::string> fields = {"displacement", "velocity", "damage", "block"};
+  // output.parallel_frames: pieces, on a decomposed run (several ranks) only: frames.pvd names
+  // frame_NNNNNN.pvtu files, each naming one frame_NNNNNN_pR.vtu per rank R.
+  bool pieces = false;
 };
 
 // The FrameFormat that a case's output section asks for.
@@ -46,6 +50,21 @@ const std::vector<std::string>& frame_fields();
 // damage, block); vertex cells then one line cell per broken bond (i < j); FieldData TIME and step.
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
                  std::int64_t step, const FrameFormat& format = FrameFormat{});
+
+// A decomposed run's nodes (parallel/local_model.hpp's LocalPiece): 1 for a node this rank owns, 0
+// for a ghost, and every local node's global number.
+struct FramePiece {
+  const std::vector<std::uint8_t>& owned;
+  const std::vector<std::int32_t>& global;
+};
+// The grid write_frame writes; with `piece`, a rank's piece of the frame: its local nodes (owned and
+// ghosts: a broken bond to a ghost keeps its line cell) with vtkGhostType marking the ghosts' points
+// and vertex cells as duplicates (VTK's DUPLICATEPOINT and DUPLICATECELL, 1), so a reader shows each
+// node once, and the point array node_id (the global node number).
+VtuGrid frame_grid(const Model& model, const State& state, double time, std::int64_t step, const FrameFormat& format,
+                   const FramePiece* piece = nullptr);
+// frames/frame_NNNNNN_pR.vtu: rank R's piece of frame k (output.parallel_frames: pieces).
+std::string frame_piece_file(std::size_t k, int rank);
 
 // Where a restarted run picks up its output (io/checkpoint.hpp): the frames written so far and
 // the length of history.csv at the checkpoint.
@@ -71,6 +90,10 @@ class OutputWriter {
   OutputWriter& operator=(const OutputWriter&) = delete;
 
   void frame(const Model& model, const State& state, double time, std::int64_t step);  // + frames.pvd
+  // Frame frames_written() of a decomposed run in pieces, once every rank wrote its piece
+  // (frame_piece_file): frame_NNNNNN.pvtu naming the `ranks` pieces, declaring the arrays of
+  // `rank0_grid` (every piece has the same arrays), + frames.pvd.
+  void frame_of_pieces(const VtuGrid& rank0_grid, int ranks, double time);
   void history(const HistoryRow& row);
   // Writes the buffered rows to history.csv (whole lines, one write); throws pd::Error on failure.
   void flush_history();
@@ -85,6 +108,7 @@ class OutputWriter {
 
  private:
   void write_pvd() const;
+  std::string frame_file(std::size_t k) const;  // relative to dir_: a .vtu, or a .pvtu in pieces
   std::filesystem::path dir_;
   FrameFormat format_;
   std::vector<std::pair<double, std::string>> frames_;  // (time, relative file)

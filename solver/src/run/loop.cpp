@@ -105,9 +105,26 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     out->history(r);
   };
   std::vector<std::pair<std::int64_t, double>> frames_here;  // (step, t) of the frames this process wrote
+  // output.parallel_frames: pieces. Every rank writes its piece (its nodes and ghosts, io/output.hpp
+  // frame_grid), then rank 0 the .pvtu naming them. Collective. The frame number is rank 0's (the
+  // broadcast also keeps the other ranks from writing before rank 0's OutputWriter has cleared the
+  // frames of an earlier run).
+  const auto frame_in_pieces = [&]() {
+    std::vector<double> k{out ? static_cast<double>(out->frames_written()) : 0.0};
+    dec->broadcast(k);
+    FrameFormat format = frame_format_of(p.c.output);
+    const LocalPiece& piece = dec->piece();
+    const FramePiece nodes{piece.owned, piece.global};
+    const VtuGrid grid = frame_grid(piece.model, state, loop.t, loop.step, format, &nodes);
+    write_vtu(p.c.output_dir / frame_piece_file(static_cast<std::size_t>(k[0]), dec->rank()), grid,
+              format.zlib ? VtuCompression::zlib : VtuCompression::none);
+    dec->total(0);  // every piece is on disk before the .pvtu names it
+    if (out) out->frame_of_pieces(grid, dec->ranks(), loop.t);
+  };
   const auto frame = [&](double dt_taken) {
-    const State& st = output_state();
-    if (out) out->frame(model, st, loop.t, loop.step);
+    const State& st = output_state();  // the history row's columns read the whole state
+    if (p.frames_in_pieces()) frame_in_pieces();
+    else if (out) out->frame(model, st, loop.t, loop.step);
     frames_here.emplace_back(loop.step, loop.t);
     history_row(dt_taken, &st);
     schedule.frame_written(loop);

@@ -24,6 +24,8 @@ struct Prepared {
   // operator then works on the piece's model. Null on one rank: the serial path.
   std::unique_ptr<Decomposed> decomposed;
   bool writes_output() const { return !decomposed || decomposed->rank() == 0; }
+  // output.parallel_frames: pieces on a decomposed run (one rank writes gathered frames).
+  bool frames_in_pieces() const { return decomposed && c.output.parallel_frames == "pieces"; }
   double build_seconds = 0.0;  // wall time of build_model
 
   // The time step (time.dt stable | exact | fixed, × safety_factor; adaptive.dt_initial first).

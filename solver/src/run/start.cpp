@@ -142,7 +142,8 @@ std::unique_ptr<OutputWriter> open_output(const RunOptions& opt, const Prepared&
                                           const HistoryColumns& columns) {
   if (!p.writes_output()) return nullptr;
   // The frames' format (output.precision, compression, fields) reaches the writer here.
-  const FrameFormat format = frame_format_of(p.c.output);
+  FrameFormat format = frame_format_of(p.c.output);
+  format.pieces = p.frames_in_pieces();
   if (!s.restarting) return std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), nullptr, format);
   try {
     return std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), &s.resume, format);
