@@ -49,8 +49,8 @@ def assembled(pvtu):
     ids, data, bonds = [], {}, set()
     for piece in pieces_of(pvtu):
         frame = read_frame(str(piece))
-        node = frame.point_data["node_id"].astype(np.int64)
-        owned = frame.point_data["vtkGhostType"] == 0
+        node = frame.point_data["node_id"].astype(np.int64).reshape(-1)
+        owned = frame.point_data["vtkGhostType"].reshape(-1) == 0
         ids.append(node[owned])
         for name in ("displacement", "velocity", "damage", "block"):
             data.setdefault(name, []).append(frame.point_data[name][owned])
