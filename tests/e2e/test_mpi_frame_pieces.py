@@ -103,7 +103,7 @@ def test_postprocess_refuses_a_series_in_pieces_clearly(runs):
 PV_SCRIPT = """
 import sys
 from paraview.simple import PVDReader, UpdatePipeline, servermanager
-from vtk.numpy_interface import dataset_adapter as dsa
+from paraview.vtk.numpy_interface import dataset_adapter as dsa
 reader = PVDReader(FileName=sys.argv[1])
 times = list(reader.TimestepValues)
 for t in times:
