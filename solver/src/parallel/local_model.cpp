@@ -29,7 +29,8 @@ std::vector<std::int32_t> owned_only(const std::vector<std::int32_t>& nodes, con
 // The piece from g's per-node data and the rows of the owned nodes: owned node i's row is rows'
 // row row_of(i) (neighbours numbered globally). g's own bond list is not read.
 template <class RowOf>
-LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank, const BondList& rows, RowOf row_of) {
+LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank, const BondList& rows, RowOf row_of,
+                      BondList* take = nullptr) {
   const std::size_t n = g.nodes.size();
   LocalPiece p;
   p.rank = rank;
@@ -78,25 +79,44 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
   // ascending); a ghost's row is empty.
   m.bonds.volume_weight = g.bonds.volume_weight;
   m.bonds.offsets.assign(nl + 1, 0);
-  std::size_t owned_bonds = 0;
-  for (std::size_t l = 0; l < nl; ++l)
-    if (p.owned[l]) owned_bonds += static_cast<std::size_t>(rows.offsets[row_of(static_cast<std::size_t>(p.global[l])) + 1] -
-                                                            rows.offsets[row_of(static_cast<std::size_t>(p.global[l]))]);
-  m.bonds.neighbour.reserve(owned_bonds);  // exactly: no vector's doubling slack in the peak memory
-  m.bonds.broken.reserve(owned_bonds);
-  if (rows.corrected()) m.bonds.surface_factor.reserve(owned_bonds);
-  for (std::size_t l = 0; l < nl; ++l) {
-    const auto i = static_cast<std::size_t>(p.global[l]);
-    if (p.owned[l]) {
-      const std::size_t r = row_of(i);
-      for (std::int64_t k = rows.offsets[r]; k < rows.offsets[r + 1]; ++k) {
-        m.bonds.neighbour.push_back(local_of[static_cast<std::size_t>(rows.neighbour[static_cast<std::size_t>(k)])]);
-        m.bonds.broken.push_back(rows.broken[static_cast<std::size_t>(k)]);
-        // The surface-correction factors were computed on the whole model (core/model.cpp): the serial bits.
-        if (rows.corrected()) m.bonds.surface_factor.push_back(rows.surface_factor[static_cast<std::size_t>(k)]);
+  if (take) {
+    // The owned rows, ascending by node, are in local order too (a ghost's row between them is
+    // empty): the piece takes their arrays and renumbers the neighbours in place, so the rows are
+    // never held twice (the peak memory of a rank that builds only its rows).
+    for (std::size_t l = 0; l < nl; ++l) {
+      std::int64_t length = 0;
+      if (p.owned[l]) {
+        const std::size_t r = row_of(static_cast<std::size_t>(p.global[l]));
+        length = rows.offsets[r + 1] - rows.offsets[r];
       }
+      m.bonds.offsets[l + 1] = m.bonds.offsets[l] + length;
     }
-    m.bonds.offsets[l + 1] = static_cast<std::int64_t>(m.bonds.neighbour.size());
+    m.bonds.neighbour = std::move(take->neighbour);
+    for (std::int32_t& j : m.bonds.neighbour) j = local_of[static_cast<std::size_t>(j)];
+    m.bonds.broken = std::move(take->broken);
+    m.bonds.surface_factor = std::move(take->surface_factor);
+    *take = BondList{};
+  } else {
+    std::size_t owned_bonds = 0;
+    for (std::size_t l = 0; l < nl; ++l)
+      if (p.owned[l]) owned_bonds += static_cast<std::size_t>(rows.offsets[row_of(static_cast<std::size_t>(p.global[l])) + 1] -
+                                                              rows.offsets[row_of(static_cast<std::size_t>(p.global[l]))]);
+    m.bonds.neighbour.reserve(owned_bonds);  // exactly: no vector's doubling slack in the peak memory
+    m.bonds.broken.reserve(owned_bonds);
+    if (rows.corrected()) m.bonds.surface_factor.reserve(owned_bonds);
+    for (std::size_t l = 0; l < nl; ++l) {
+      const auto i = static_cast<std::size_t>(p.global[l]);
+      if (p.owned[l]) {
+        const std::size_t r = row_of(i);
+        for (std::int64_t k = rows.offsets[r]; k < rows.offsets[r + 1]; ++k) {
+          m.bonds.neighbour.push_back(local_of[static_cast<std::size_t>(rows.neighbour[static_cast<std::size_t>(k)])]);
+          m.bonds.broken.push_back(rows.broken[static_cast<std::size_t>(k)]);
+          // The surface-correction factors were computed on the whole model (core/model.cpp): the serial bits.
+          if (rows.corrected()) m.bonds.surface_factor.push_back(rows.surface_factor[static_cast<std::size_t>(k)]);
+        }
+      }
+      m.bonds.offsets[l + 1] = static_cast<std::int64_t>(m.bonds.neighbour.size());
+    }
   }
 
   // Conditions act on owned nodes only: a ghost's motion is its owner's.
@@ -126,7 +146,7 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   return make_piece(g, owner, rank, g.bonds, [](std::size_t i) { return i; });
 }
 
-LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank, const BondList& owned_rows) {
+LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank, BondList owned_rows) {
   // Owned node i's row: its place among the owned nodes (ascending, as build_bond_rows was given them).
   std::vector<std::int32_t> row(g.nodes.size(), -1);
   std::int32_t next = 0;
@@ -135,7 +155,8 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   if (static_cast<std::size_t>(next) + 1 != owned_rows.offsets.size())
     throw Error("make_local_piece: " + std::to_string(owned_rows.offsets.size() - 1) + " rows given for " +
                 std::to_string(next) + " owned nodes");
-  return make_piece(g, owner, rank, owned_rows, [&row](std::size_t i) { return static_cast<std::size_t>(row[i]); });
+  return make_piece(g, owner, rank, owned_rows, [&row](std::size_t i) { return static_cast<std::size_t>(row[i]); },
+                    &owned_rows);
 }
 
 std::vector<double> to_local(const LocalPiece& piece, const std::vector<double>& a) { return pick(a, piece.global); }

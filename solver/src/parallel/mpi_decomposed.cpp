@@ -35,11 +35,10 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
   for (std::size_t i = 0; i < decomposition_.owner.size(); ++i)
     if (decomposition_.owner[i] == rank_) rows.push_back(static_cast<std::int32_t>(i));
   {
-    // The owned rows only: ≈ 1/R of the whole list, freed once the piece has renumbered them.
+    // The owned rows only: ≈ 1/R of the whole list, renumbered in place into the piece.
     BondList owned = build_bond_rows(skeleton.nodes.x, cutoff, rows);
-    owned.volume_weight = skeleton.bonds.volume_weight;
     cut_crossing_bonds(cracks, skeleton.nodes.x, owned, &rows);  // pre-cracks (notches) start broken
-    piece_ = make_local_piece(skeleton, decomposition_.owner, rank_, owned);
+    piece_ = make_local_piece(skeleton, decomposition_.owner, rank_, std::move(owned));
   }
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
