@@ -7,8 +7,10 @@
 #include <cstring>
 #include <set>
 
+#include "core/cracks.hpp"
 #include "core/error.hpp"
 #include "lattice.hpp"
+#include "materials/bond_model.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "parallel/decomposition.hpp"
 #include "parallel/local_model.hpp"
@@ -185,4 +187,51 @@ TEST(LocalPiece, CarriesTheBreakingOrderThePerNodeCriticalStretchAndTheSurfaceFa
   EXPECT_FALSE(plain.model.break_after_force);
   EXPECT_TRUE(plain.model.node_critical_stretch.empty());
   EXPECT_FALSE(plain.model.bonds.corrected());
+}
+
+// A rank that builds only its own rows (issue 15: memory per rank falls with the rank count) gets
+// the piece it would cut from the whole model, bit for bit: the same counts, owners, ghosts, rows,
+// pre-cracked flags and LAMMPS s0 of its owned nodes — with the whole list never built.
+TEST(LocalPiece, BuiltFromItsOwnRowsIsThePieceOfTheWholeModel) {
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 70e9, 2700.0, 0.5);
+  c.partial_volume = "hhb";  // a widened family: the cut-off is the rule's, not δ
+  c.cracks.push_back(pd::CrackSegment{{4.5 * kDx, -1.0, 0.0}, {4.5 * kDx, 3.5 * kDx, 0.0}});
+  const pd::Model whole = pd::build_model(c, pdtest::cubic_lattice(12, 9, 8, kDx, 3));
+  pd::Model skeleton = pd::build_model_without_bonds(c, pdtest::cubic_lattice(12, 9, 8, kDx, 3));
+  EXPECT_TRUE(skeleton.bonds.neighbour.empty());
+  skeleton.bonds.offsets = pd::count_bonds(skeleton.nodes.x, pd::bond_search_cutoff(c));
+  ASSERT_EQ(skeleton.bonds.offsets, whole.bonds.offsets);
+  skeleton.bond_model = pd::material_registry().get("pmb").make(skeleton);
+  std::int64_t broken_in_whole = 0;
+  for (std::uint8_t b : whole.bonds.broken) broken_in_whole += b;
+  ASSERT_GT(broken_in_whole, 0);  // the crack cut some bonds
+  const std::vector<double> s0 = pd::initial_node_critical_stretch(whole.material, whole.block_index, whole.bonds);
+  const pd::Decomposition d = pd::decompose(whole.nodes.x, whole.bonds, 3, whole.horizon);
+  ASSERT_EQ(pd::decompose(skeleton.nodes.x, skeleton.bonds.offsets, 3, skeleton.horizon).owner, d.owner);
+  std::int64_t broken_in_pieces = 0, held = 0;
+  for (int r = 0; r < 3; ++r) {
+    std::vector<std::int32_t> rows;
+    for (std::size_t i = 0; i < d.owner.size(); ++i)
+      if (d.owner[i] == r) rows.push_back(static_cast<std::int32_t>(i));
+    pd::BondList owned = pd::build_bond_rows(skeleton.nodes.x, pd::bond_search_cutoff(c), rows);
+    pd::cut_crossing_bonds(c.cracks, skeleton.nodes.x, owned, &rows);
+    const pd::LocalPiece own = pd::make_local_piece(skeleton, d.owner, r, owned);
+    const pd::LocalPiece cut = pd::make_local_piece(whole, d.owner, r);
+    EXPECT_EQ(own.global, cut.global);
+    EXPECT_EQ(own.owned, cut.owned);
+    EXPECT_EQ(own.model.bonds.offsets, cut.model.bonds.offsets);
+    EXPECT_EQ(own.model.bonds.neighbour, cut.model.bonds.neighbour);
+    EXPECT_EQ(own.model.bonds.broken, cut.model.bonds.broken);
+    EXPECT_EQ(own.model.bonds.volume_weight.outer, whole.bonds.volume_weight.outer);
+    EXPECT_LT(own.model.bonds.directed(), whole.bonds.directed());
+    held += static_cast<std::int64_t>(own.model.bonds.directed());
+    for (std::uint8_t b : own.model.bonds.broken) broken_in_pieces += b;
+    const std::vector<double> own_s0 = pd::initial_node_critical_stretch(own.model.material, own.model.block_index, own.model.bonds);
+    for (std::int32_t l : own.owned_local)
+      EXPECT_EQ(own_s0[static_cast<std::size_t>(l)], s0[static_cast<std::size_t>(own.global[static_cast<std::size_t>(l)])]);
+  }
+  EXPECT_EQ(held, static_cast<std::int64_t>(whole.bonds.directed()));  // every row on exactly one rank
+  EXPECT_EQ(broken_in_pieces, broken_in_whole);
+  pd::BondList wrong = pd::build_bond_rows(skeleton.nodes.x, pd::bond_search_cutoff(c), {0, 1});
+  EXPECT_THROW(pd::make_local_piece(skeleton, d.owner, 0, wrong), pd::Error);
 }

@@ -33,6 +33,17 @@ def test_two_ranks_send_one_message_of_their_face_layers_and_two_ordered_sums_pe
         assert float(r["peak_rss_mb"]) > 0.0
 
 
+def test_the_bond_count_of_a_run_whose_ranks_build_only_their_rows_is_the_serial_one():
+    """On 2 ranks each builds only its own rows (the whole list is only counted): the directed bonds
+    the row reports, and so its bond updates per second, are still the whole brick's."""
+    from bench.mpi_ranks import run_ours
+    (serial,) = run_ours(EXE, 12, 3, 1, 1)
+    assert int(serial["directed_bonds"]) > 100 * 12 ** 3 // 2
+    for r in run_ours(EXE, 12, 3, 2, 1):
+        assert r["directed_bonds"] == serial["directed_bonds"]
+        assert float(r["bond_updates_per_s"]) > 0.0
+
+
 def test_one_rank_takes_the_serial_path_and_sends_nothing():
     from bench.mpi_ranks import run_ours
     (r,) = run_ours(EXE, 12, 3, 1, 1)

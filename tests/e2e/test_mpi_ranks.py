@@ -12,6 +12,7 @@ ranks before any output.
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 
@@ -188,6 +189,39 @@ def test_run_log_says_how_the_run_was_decomposed(runs):
         log = (runs[name] / "run.log").read_text()
         assert f"decomposed over {ranks} MPI ranks" in log, log
         assert "ghosts in all" in log
+
+
+def bonds_held(log):
+    """run.log's directed bonds in all (2 × its "bonds" count) and the directed bonds each rank holds."""
+    total = 2 * int(re.search(r"^nodes \d+, bonds (\d+) ", log, re.M).group(1))
+    line = re.search(r"^directed bonds held per rank \(of (\d+)\):(.*)$", log, re.M)
+    assert line, log
+    assert int(line.group(1)) == total
+    held = [int(n) for n in re.findall(r"rank \d+ (\d+)", line.group(2))]
+    return total, held, line.group(0)
+
+
+def test_each_rank_holds_the_rows_of_its_own_nodes_only(runs):
+    """A pmb plate at dt: stable needs no whole bond list: each rank builds only the rows of the nodes
+    it owns (issue 15), so the ranks' bonds add up to the model's, each once, and no rank holds more
+    than its share (before, every rank also held the whole list: held > total on each)."""
+    for name, ranks in (("np2", 2), ("np3", 3), ("np2t2", 2)):
+        total, held, line = bonds_held((runs[name] / "run.log").read_text())
+        assert len(held) == ranks, line
+        assert sum(held) == total, line
+        assert all(0 < h < 0.6 * total for h in held), line
+        assert "each rank built only the rows of its own nodes" in line
+
+
+def test_a_feature_that_reads_whole_rows_keeps_the_whole_list_and_says_so(variant_runs):
+    """LPS (its per-node constants), the adaptive step's default dt_max and dt: exact (the exact limit's
+    Lanczos on the whole model) keep the whole bond list on every rank, and run.log says which."""
+    kind, folders = variant_runs
+    total, held, line = bonds_held((folders["np2"] / "run.log").read_text())
+    reason = {"loads": "indenters", "lps": "blocks[].model lps", "adaptive": "adaptive without dt_max",
+              "exact": "time.dt exact"}[kind]
+    assert f"every rank holds the whole bond list too, for {reason}" in line, line
+    assert all(h > total for h in held), line
 
 
 def test_what_is_not_decomposed_is_refused_before_any_output(prepared):

@@ -32,46 +32,82 @@ void for_each_partner(const Vec3Array& x, const CellGrid& grid, double cutoff2, 
 
 }  // namespace
 
-BondList build_bonds(const Vec3Array& x, double horizon) {
-  const std::size_t n = x[0].size();
+namespace {
+
+void check_search(std::size_t n, double horizon) {
   if (n > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw Error("too many nodes for 32-bit neighbour indices: " + std::to_string(n));
   if (!(horizon > 0.0) || !std::isfinite(horizon)) throw Error("horizon must be a finite number > 0");
-  BondList bonds;
-  bonds.offsets.assign(n + 1, 0);
-  if (n == 0) return bonds;
-  const double cutoff = horizon * (1.0 + kHorizonTolerance);
-  const double* const xp[3] = {x[0].data(), x[1].data(), x[2].data()};
-  const CellGrid grid = make_cell_grid(xp, n, cutoff);
-  const double cutoff2 = cutoff * cutoff;
+}
 
-  // Two passes (count, then fill) so that each node's row is written by one thread only.
+// The partner counts of the given rows (rows[r] a node, or every node when rows is null): offsets
+// of their CSR rows. Throws pd::Error for coinciding nodes (the first met).
+std::vector<std::int64_t> count_rows(const Vec3Array& x, const CellGrid& grid, double cutoff2,
+                                     const std::vector<std::int32_t>* rows) {
+  const std::size_t count_of_rows = rows ? rows->size() : x[0].size();
+  std::vector<std::int64_t> offsets(count_of_rows + 1, 0);
   std::string error;
 #pragma omp parallel for schedule(dynamic, 256)
-  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+  for (std::int64_t r = 0; r < static_cast<std::int64_t>(count_of_rows); ++r) {
     try {
+      const auto i = rows ? static_cast<std::size_t>((*rows)[static_cast<std::size_t>(r)]) : static_cast<std::size_t>(r);
       std::int64_t count = 0;
-      for_each_partner(x, grid, cutoff2, static_cast<std::size_t>(i), [&](std::int32_t) { ++count; });
-      bonds.offsets[static_cast<std::size_t>(i) + 1] = count;
+      for_each_partner(x, grid, cutoff2, i, [&](std::int32_t) { ++count; });
+      offsets[static_cast<std::size_t>(r) + 1] = count;
     } catch (const Error& e) {
 #pragma omp critical(pd_bond_error)
       if (error.empty()) error = e.what();
     }
   }
   if (!error.empty()) throw Error(error);
-  for (std::size_t i = 0; i < n; ++i) bonds.offsets[i + 1] += bonds.offsets[i];
-  const auto total = static_cast<std::size_t>(bonds.offsets[n]);
+  for (std::size_t r = 0; r < count_of_rows; ++r) offsets[r + 1] += offsets[r];
+  return offsets;
+}
+
+// Two passes (count, then fill) so that each row is written by one thread only.
+BondList build_rows(const Vec3Array& x, double horizon, const std::vector<std::int32_t>* rows) {
+  const std::size_t n = x[0].size();
+  check_search(n, horizon);
+  BondList bonds;
+  bonds.offsets.assign((rows ? rows->size() : n) + 1, 0);
+  if (n == 0) return bonds;
+  const double cutoff = horizon * (1.0 + kHorizonTolerance);
+  const double* const xp[3] = {x[0].data(), x[1].data(), x[2].data()};
+  const CellGrid grid = make_cell_grid(xp, n, cutoff);
+  const double cutoff2 = cutoff * cutoff;
+  bonds.offsets = count_rows(x, grid, cutoff2, rows);
+  const std::size_t count_of_rows = bonds.offsets.size() - 1;
+  const auto total = static_cast<std::size_t>(bonds.offsets.back());
   bonds.neighbour.resize(total);
   bonds.broken.assign(total, 0);
 
 #pragma omp parallel for schedule(dynamic, 256)
-  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-    std::int32_t* row = bonds.neighbour.data() + bonds.offsets[static_cast<std::size_t>(i)];
+  for (std::int64_t r = 0; r < static_cast<std::int64_t>(count_of_rows); ++r) {
+    const auto i = rows ? static_cast<std::size_t>((*rows)[static_cast<std::size_t>(r)]) : static_cast<std::size_t>(r);
+    std::int32_t* row = bonds.neighbour.data() + bonds.offsets[static_cast<std::size_t>(r)];
     std::int32_t* end = row;
-    for_each_partner(x, grid, cutoff2, static_cast<std::size_t>(i), [&](std::int32_t j) { *end++ = j; });
+    for_each_partner(x, grid, cutoff2, i, [&](std::int32_t j) { *end++ = j; });
     std::sort(row, end);  // ascending j: deterministic order, better locality
   }
   return bonds;
+}
+
+}  // namespace
+
+BondList build_bonds(const Vec3Array& x, double horizon) { return build_rows(x, horizon, nullptr); }
+
+BondList build_bond_rows(const Vec3Array& x, double horizon, const std::vector<std::int32_t>& rows) {
+  return build_rows(x, horizon, &rows);
+}
+
+std::vector<std::int64_t> count_bonds(const Vec3Array& x, double horizon) {
+  const std::size_t n = x[0].size();
+  check_search(n, horizon);
+  if (n == 0) return {0};
+  const double cutoff = horizon * (1.0 + kHorizonTolerance);
+  const double* const xp[3] = {x[0].data(), x[1].data(), x[2].data()};
+  const CellGrid grid = make_cell_grid(xp, n, cutoff);
+  return count_rows(x, grid, cutoff * cutoff, nullptr);
 }
 
 }  // namespace pd

@@ -57,5 +57,12 @@ struct BondList {
 // Cell list with bins of edge ≥ the cut-off: O(N) in the number of nodes, never O(N²).
 // Throws pd::Error if two nodes coincide.
 BondList build_bonds(const Vec3Array& x, double horizon);
+// The rows of the nodes `rows` only (row r is node rows[r]'s, neighbours numbered globally, in
+// the same ascending order build_bonds gives them): a rank of a decomposed run builds the rows it
+// owns without the whole list (issue 15). Offsets have rows.size() + 1 entries.
+BondList build_bond_rows(const Vec3Array& x, double horizon, const std::vector<std::int32_t>& rows);
+// build_bonds's offsets alone (the partners counted, not stored): 8 bytes per node instead of
+// ≈ 5 per directed bond. Throws what build_bonds throws.
+std::vector<std::int64_t> count_bonds(const Vec3Array& x, double horizon);
 
 }  // namespace pd

@@ -21,15 +21,17 @@ bool segments_cross(const double p[2], const double q[2], const double a[2], con
          ((pq_a > 0.0 && pq_b < 0.0) || (pq_a < 0.0 && pq_b > 0.0));
 }
 
-std::int64_t cut_crossing_bonds(const std::vector<CrackSegment>& cracks, const Vec3Array& x, BondList& bonds) {
+std::int64_t cut_crossing_bonds(const std::vector<CrackSegment>& cracks, const Vec3Array& x, BondList& bonds,
+                                const std::vector<std::int32_t>* rows) {
   if (cracks.empty()) return 0;
   const auto n = static_cast<std::int64_t>(bonds.nodes());
   std::int64_t cut = 0;  // integer sum: exact in any order
 #pragma omp parallel for schedule(static) reduction(+ : cut)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const auto ii = static_cast<std::size_t>(i);
+  for (std::int64_t r = 0; r < n; ++r) {
+    const auto row = static_cast<std::size_t>(r);
+    const auto ii = rows ? static_cast<std::size_t>((*rows)[row]) : row;
     const double p[2] = {x[0][ii], x[1][ii]};
-    for (std::int64_t k = bonds.offsets[ii]; k < bonds.offsets[ii + 1]; ++k) {
+    for (std::int64_t k = bonds.offsets[row]; k < bonds.offsets[row + 1]; ++k) {
       const auto j = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(k)]);
       const double q[2] = {x[0][j], x[1][j]};
       for (const auto& crack : cracks) {

@@ -18,6 +18,9 @@ bool segments_cross(const double p[2], const double q[2], const double a[2], con
 
 // Marks every bond crossing one of the cracks as broken (both stored copies); returns how many
 // bonds that is, each counted once.
-std::int64_t cut_crossing_bonds(const std::vector<CrackSegment>& cracks, const Vec3Array& x, BondList& bonds);
+// rows: row r of `bonds` is node rows[r]'s (build_bond_rows); null: row i is node i's. The count
+// is of the bonds cut from their lower-numbered end (each once over the whole model).
+std::int64_t cut_crossing_bonds(const std::vector<CrackSegment>& cracks, const Vec3Array& x, BondList& bonds,
+                                const std::vector<std::int32_t>* rows = nullptr);
 
 }  // namespace pd

@@ -14,10 +14,7 @@
 
 namespace pd {
 
-namespace {
-
-// s0_i of LAMMPS's rule at rest (every s_ij = 0): max_j s0_ij over i's intact bonds, +inf without
-// one — what LAMMPS's set-up force pass leaves before the first step (validation.md F5).
+// LAMMPS's s0_i at rest (core/model.hpp).
 std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
                                                   const BondList& bonds) {
   const std::size_t n = bonds.nodes(), nb = static_cast<std::size_t>(table.blocks);
@@ -35,9 +32,11 @@ std::vector<double> initial_node_critical_stretch(const MaterialTable& table, co
   return s0;
 }
 
-}  // namespace
+double bond_search_cutoff(const Case& c) {
+  return bond_cutoff(partial_volume_registry().get(c.partial_volume), c.horizon, c.grid_spacing);
+}
 
-Model build_model(const Case& c, Nodes nodes) {
+Model build_model_without_bonds(const Case& c, Nodes nodes) {
   const std::size_t n = nodes.size();
   const std::string where = c.nodes_file.string() + ": ";
   if (nodes.dimension != c.dimension)
@@ -83,15 +82,22 @@ Model build_model(const Case& c, Nodes nodes) {
   m.conditions = make_conditions(c, nodes);
   // A partial-volume rule may widen the family (HHB) and weights each bond by ν (validation.md F3).
   const PartialVolumeRule& rule = partial_volume_registry().get(c.partial_volume);
-  const double cutoff = bond_cutoff(rule, c.horizon, c.grid_spacing);
-  m.bonds = build_bonds(nodes.x, cutoff);
+  const double cutoff = bond_search_cutoff(c);
   apply_partial_volume(rule, c.horizon, c.grid_spacing, m.bonds);
-  cut_crossing_bonds(c.cracks, nodes.x, m.bonds);  // pre-cracks (notches) start broken
   m.contact = plan_contact(c, m.block_index, cutoff * (1.0 + kHorizonTolerance));
   m.indenters = c.indenters;
   m.break_after_force = c.breaking_order == "lammps";
-  if (m.material.node_rule()) m.node_critical_stretch = initial_node_critical_stretch(m.material, m.block_index, m.bonds);
   m.nodes = std::move(nodes);
+  return m;
+}
+
+Model build_model(const Case& c, Nodes nodes) {
+  Model m = build_model_without_bonds(c, std::move(nodes));
+  BondList bonds = build_bonds(m.nodes.x, bond_search_cutoff(c));
+  bonds.volume_weight = m.bonds.volume_weight;
+  m.bonds = std::move(bonds);
+  cut_crossing_bonds(c.cracks, m.nodes.x, m.bonds);  // pre-cracks (notches) start broken
+  if (m.material.node_rule()) m.node_critical_stretch = initial_node_critical_stretch(m.material, m.block_index, m.bonds);
   m.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(m);
   // Factors from the law's own energy on each node's family (pre-cracks are free surfaces); every
   // kernel reads them from the bonds.

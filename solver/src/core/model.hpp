@@ -52,6 +52,17 @@ struct Model {
 
 // Checks the node file against the case (blocks in range, sets present) and builds the bonds.
 Model build_model(const Case& c, Nodes nodes);
+// build_model without the bonds (issue 15: a decomposed run's ranks build their own rows): the
+// nodes, per-node data, material, conditions, contact plan and the bonds' volume weight; bonds'
+// rows, pre-cracks, LAMMPS's s0, the law and the surface correction are left to the caller.
+Model build_model_without_bonds(const Case& c, Nodes nodes);
+// The bond search's cut-off: the horizon, widened by the partial-volume rule's family (HHB).
+double bond_search_cutoff(const Case& c);
+// s0_i of LAMMPS's rule at rest (every s_ij = 0): max_j s0_ij over i's intact bonds, +inf without
+// one — what LAMMPS's set-up force pass leaves before the first step (validation.md F5). A row of
+// `bonds` per node of `block` (an empty row: +inf).
+std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
+                                                  const BondList& bonds);
 
 // Broken bonds, each counted once (both stored copies of a bond break together).
 std::int64_t broken_bond_count(const Model& model);

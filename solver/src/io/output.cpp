@@ -36,12 +36,13 @@ FrameFormat frame_format_of(const OutputSettings& output) {
 }
 
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
-                 std::int64_t step, const FrameFormat& format) {
-  write_vtu(path, frame_grid(model, state, time, step, format), format.zlib ? VtuCompression::zlib : VtuCompression::none);
+                 std::int64_t step, const FrameFormat& format, const FrameBonds* bonds) {
+  write_vtu(path, frame_grid(model, state, time, step, format, nullptr, bonds),
+            format.zlib ? VtuCompression::zlib : VtuCompression::none);
 }
 
 VtuGrid frame_grid(const Model& model, const State& state, double time, std::int64_t step, const FrameFormat& format,
-                   const FramePiece* piece) {
+                   const FramePiece* piece, const FrameBonds* bonds) {
   const std::size_t n = model.nodes.size();
   VtuGrid g;
   // TIME and step stay exact: readers match frames to history.csv rows and the .pvd by them.
@@ -62,14 +63,14 @@ VtuGrid frame_grid(const Model& model, const State& state, double time, std::int
   if (wanted("displacement")) g.point_data.push_back(vec3("displacement", state.u));
   if (wanted("velocity")) g.point_data.push_back(vec3("velocity", state.v));
   if (wanted("damage")) {
-    const std::vector<double> damage = model.bond_model->damage(model);
+    const std::vector<double> damage = bonds ? bonds->damage : model.bond_model->damage(model);
     g.point_data.push_back(format.float32 ? make_array_as<float>("damage", damage) : make_array("damage", damage));
   }
   if (wanted("block")) g.point_data.push_back(make_array("block", model.nodes.block));  // an integer: as is
 
   // Cells: a vertex per node, then a line per broken bond (each once, from its end i < j), in node
   // order. Counted per node in parallel, so a frame does not walk every bond on one thread.
-  const auto& b = model.bonds;
+  const auto& b = bonds ? bonds->broken_lines : model.bonds;
   std::vector<std::int64_t> first_line(n + 1, 0);  // broken bonds i < j before node i
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
@@ -224,9 +225,9 @@ void OutputWriter::write_pvd() const {
   write_file_atomically(dir_ / "frames.pvd", pvd.str());
 }
 
-void OutputWriter::frame(const Model& model, const State& state, double time, std::int64_t step) {
+void OutputWriter::frame(const Model& model, const State& state, double time, std::int64_t step, const FrameBonds* bonds) {
   const std::string name = frame_file(frames_.size());
-  write_frame(dir_ / name, model, state, time, step, format_);
+  write_frame(dir_ / name, model, state, time, step, format_, bonds);
   frames_.emplace_back(time, name);
   write_pvd();
   flush_history();

@@ -48,8 +48,17 @@ const std::vector<std::string>& frame_fields();
 
 // One frame as a VTU grid: reference points, the chosen point fields (displacement, velocity,
 // damage, block); vertex cells then one line cell per broken bond (i < j); FieldData TIME and step.
+struct FrameBonds;
 void write_frame(const std::filesystem::path& path, const Model& model, const State& state, double time,
-                 std::int64_t step, const FrameFormat& format = FrameFormat{});
+                 std::int64_t step, const FrameFormat& format = FrameFormat{}, const FrameBonds* bonds = nullptr);
+
+// What a frame reads from the bonds, given instead of model.bonds by a decomposed run whose ranks
+// build only their own rows (issue 15): the damage per node and the broken bonds as rows (only
+// those with j > i need be there; Decomposed::gather_broken_lines), both in global node order.
+struct FrameBonds {
+  const std::vector<double>& damage;
+  const BondList& broken_lines;
+};
 
 // A decomposed run's nodes (parallel/local_model.hpp's LocalPiece): 1 for a node this rank owns, 0
 // for a ghost, and every local node's global number.
@@ -62,7 +71,7 @@ struct FramePiece {
 // and vertex cells as duplicates (VTK's DUPLICATEPOINT and DUPLICATECELL, 1), so a reader shows each
 // node once, and the point array node_id (the global node number).
 VtuGrid frame_grid(const Model& model, const State& state, double time, std::int64_t step, const FrameFormat& format,
-                   const FramePiece* piece = nullptr);
+                   const FramePiece* piece = nullptr, const FrameBonds* bonds = nullptr);
 // frames/frame_NNNNNN_pR.vtu: rank R's piece of frame k (output.parallel_frames: pieces).
 std::string frame_piece_file(std::size_t k, int rank);
 
@@ -89,7 +98,8 @@ class OutputWriter {
   OutputWriter(const OutputWriter&) = delete;
   OutputWriter& operator=(const OutputWriter&) = delete;
 
-  void frame(const Model& model, const State& state, double time, std::int64_t step);  // + frames.pvd
+  void frame(const Model& model, const State& state, double time, std::int64_t step,
+             const FrameBonds* bonds = nullptr);  // + frames.pvd
   // Frame frames_written() of a decomposed run in pieces, once every rank wrote its piece
   // (frame_piece_file): frame_NNNNNN.pvtu naming the `ranks` pieces, declaring the arrays of
   // `rank0_grid` (every piece has the same arrays), + frames.pvd.

@@ -68,6 +68,13 @@ class Decomposed {
   // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
   // frames' damage reads). Collective.
   virtual void gather_broken(const BondList& local, BondList& global) const = 0;
+  // The broken bonds of the owned rows, each once from its lower-numbered end (j > i), as rows of
+  // the whole model on rank 0: lines.offsets over every node, lines.neighbour the global j's in row
+  // order, lines.broken all 1 (empty elsewhere). What a gathered frame's line cells need, without
+  // the whole bond list (issue 15). Collective.
+  virtual void gather_broken_lines(const BondList& local, BondList& lines) const = 0;
+  // Every rank's value, rank after rank, on rank 0 (empty elsewhere): run.log's per-rank lines. Collective.
+  virtual std::vector<double> per_rank(double value) const = 0;
   // Rank 0's bytes on every rank (MPI_Bcast): what rank 0 alone read (a checkpoint file, or the
   // error it met reading it) so that every rank decides alike. Collective.
   virtual std::string broadcast(const std::string& bytes_on_rank_0) const = 0;
@@ -108,5 +115,12 @@ struct Model;
 // A run on several MPI ranks: the model decomposed over them (parallel/mpi_decomposed); null for a
 // run on one rank (or a build without MPI), which then takes the serial path. Collective.
 std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global);
+struct CrackSegment;
+// The same without the whole bond list (issue 15): `skeleton` is build_model_without_bonds's model
+// with every node's row length in bonds.offsets (core/bonds count_bonds) and its law; each rank
+// builds only the rows of the nodes it owns (cut-off, pre-cracks). Its piece is bitwise the one
+// decompose_over_ranks cuts from the whole model. Collective.
+std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model& skeleton, double cutoff,
+                                                      const std::vector<CrackSegment>& cracks);
 
 }  // namespace pd

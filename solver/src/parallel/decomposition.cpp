@@ -51,6 +51,10 @@ std::vector<std::uint64_t> morton_keys(const Vec3Array& x) {
 }
 
 Decomposition decompose(const Vec3Array& x, const BondList& bonds, int ranks, double horizon) {
+  return decompose(x, bonds.offsets, ranks, horizon);
+}
+
+Decomposition decompose(const Vec3Array& x, const std::vector<std::int64_t>& offsets, int ranks, double horizon) {
   const auto n = static_cast<std::int64_t>(x[0].size());
   if (ranks < 1) throw Error("decomposition: " + std::to_string(ranks) + " ranks; at least 1 is needed");
   if (ranks > n)
@@ -68,7 +72,7 @@ Decomposition decompose(const Vec3Array& x, const BondList& bonds, int ranks, do
     return ka != kb ? ka < kb : a < b;
   });
   const auto work_of = [&](std::int64_t i) {
-    return 1 + bonds.offsets[static_cast<std::size_t>(i) + 1] - bonds.offsets[static_cast<std::size_t>(i)];
+    return 1 + offsets[static_cast<std::size_t>(i) + 1] - offsets[static_cast<std::size_t>(i)];
   };
   std::int64_t total = 0;
   for (std::int64_t i = 0; i < n; ++i) total += work_of(i);

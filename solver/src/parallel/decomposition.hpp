@@ -30,5 +30,8 @@ std::vector<std::uint64_t> morton_keys(const Vec3Array& x);
 // if a rank would get no node, or if a piece fits inside one horizon (its largest side < δ: its
 // ghosts would outnumber its own nodes and a rank would compute mostly copies).
 Decomposition decompose(const Vec3Array& x, const BondList& bonds, int ranks, double horizon);
+// The same from the rows' offsets alone (core/bonds count_bonds): what a rank that builds only its
+// own rows knows before it builds them.
+Decomposition decompose(const Vec3Array& x, const std::vector<std::int64_t>& offsets, int ranks, double horizon);
 
 }  // namespace pd

@@ -2,6 +2,9 @@
 #include "parallel/local_model.hpp"
 
 #include <algorithm>
+#include <string>
+
+#include "core/error.hpp"
 
 namespace pd {
 
@@ -23,9 +26,11 @@ std::vector<std::int32_t> owned_only(const std::vector<std::int32_t>& nodes, con
   return out;
 }
 
-}  // namespace
-
-LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank) {
+// The piece from g's per-node data and the rows of the owned nodes: owned node i's row is rows'
+// row row_of(i) (neighbours numbered globally). g's own bond list is not read.
+template <class RowOf>
+LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank, const BondList& rows, RowOf row_of,
+                      BondList* take = nullptr) {
   const std::size_t n = g.nodes.size();
   LocalPiece p;
   p.rank = rank;
@@ -35,8 +40,9 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   for (std::size_t i = 0; i < n; ++i) {
     if (owner[i] != rank) continue;
     wanted[i] = 1;
-    for (std::int64_t k = g.bonds.offsets[i]; k < g.bonds.offsets[i + 1]; ++k)
-      wanted[static_cast<std::size_t>(g.bonds.neighbour[static_cast<std::size_t>(k)])] = 1;
+    const std::size_t r = row_of(i);
+    for (std::int64_t k = rows.offsets[r]; k < rows.offsets[r + 1]; ++k)
+      wanted[static_cast<std::size_t>(rows.neighbour[static_cast<std::size_t>(k)])] = 1;
   }
   std::vector<std::int32_t> local_of(n, -1);
   for (std::size_t i = 0; i < n; ++i)
@@ -73,16 +79,44 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   // ascending); a ghost's row is empty.
   m.bonds.volume_weight = g.bonds.volume_weight;
   m.bonds.offsets.assign(nl + 1, 0);
-  for (std::size_t l = 0; l < nl; ++l) {
-    const auto i = static_cast<std::size_t>(p.global[l]);
-    if (p.owned[l])
-      for (std::int64_t k = g.bonds.offsets[i]; k < g.bonds.offsets[i + 1]; ++k) {
-        m.bonds.neighbour.push_back(local_of[static_cast<std::size_t>(g.bonds.neighbour[static_cast<std::size_t>(k)])]);
-        m.bonds.broken.push_back(g.bonds.broken[static_cast<std::size_t>(k)]);
-        // The surface-correction factors were computed on the whole model (core/model.cpp): the serial bits.
-        if (g.bonds.corrected()) m.bonds.surface_factor.push_back(g.bonds.surface_factor[static_cast<std::size_t>(k)]);
+  if (take) {
+    // The owned rows, ascending by node, are in local order too (a ghost's row between them is
+    // empty): the piece takes their arrays and renumbers the neighbours in place, so the rows are
+    // never held twice (the peak memory of a rank that builds only its rows).
+    for (std::size_t l = 0; l < nl; ++l) {
+      std::int64_t length = 0;
+      if (p.owned[l]) {
+        const std::size_t r = row_of(static_cast<std::size_t>(p.global[l]));
+        length = rows.offsets[r + 1] - rows.offsets[r];
       }
-    m.bonds.offsets[l + 1] = static_cast<std::int64_t>(m.bonds.neighbour.size());
+      m.bonds.offsets[l + 1] = m.bonds.offsets[l] + length;
+    }
+    m.bonds.neighbour = std::move(take->neighbour);
+    for (std::int32_t& j : m.bonds.neighbour) j = local_of[static_cast<std::size_t>(j)];
+    m.bonds.broken = std::move(take->broken);
+    m.bonds.surface_factor = std::move(take->surface_factor);
+    *take = BondList{};
+  } else {
+    std::size_t owned_bonds = 0;
+    for (std::size_t l = 0; l < nl; ++l)
+      if (p.owned[l]) owned_bonds += static_cast<std::size_t>(rows.offsets[row_of(static_cast<std::size_t>(p.global[l])) + 1] -
+                                                              rows.offsets[row_of(static_cast<std::size_t>(p.global[l]))]);
+    m.bonds.neighbour.reserve(owned_bonds);  // exactly: no vector's doubling slack in the peak memory
+    m.bonds.broken.reserve(owned_bonds);
+    if (rows.corrected()) m.bonds.surface_factor.reserve(owned_bonds);
+    for (std::size_t l = 0; l < nl; ++l) {
+      const auto i = static_cast<std::size_t>(p.global[l]);
+      if (p.owned[l]) {
+        const std::size_t r = row_of(i);
+        for (std::int64_t k = rows.offsets[r]; k < rows.offsets[r + 1]; ++k) {
+          m.bonds.neighbour.push_back(local_of[static_cast<std::size_t>(rows.neighbour[static_cast<std::size_t>(k)])]);
+          m.bonds.broken.push_back(rows.broken[static_cast<std::size_t>(k)]);
+          // The surface-correction factors were computed on the whole model (core/model.cpp): the serial bits.
+          if (rows.corrected()) m.bonds.surface_factor.push_back(rows.surface_factor[static_cast<std::size_t>(k)]);
+        }
+      }
+      m.bonds.offsets[l + 1] = static_cast<std::int64_t>(m.bonds.neighbour.size());
+    }
   }
 
   // Conditions act on owned nodes only: a ghost's motion is its owner's.
@@ -104,6 +138,25 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
   // registry on the local model; a law whose per-node constants need whole rows copies them.
   m.bond_model = g.bond_model->for_piece(m, p.global, material_registry().get(g.bond_model->name()).make);
   return p;
+}
+
+}  // namespace
+
+LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank) {
+  return make_piece(g, owner, rank, g.bonds, [](std::size_t i) { return i; });
+}
+
+LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& owner, int rank, BondList owned_rows) {
+  // Owned node i's row: its place among the owned nodes (ascending, as build_bond_rows was given them).
+  std::vector<std::int32_t> row(g.nodes.size(), -1);
+  std::int32_t next = 0;
+  for (std::size_t i = 0; i < owner.size(); ++i)
+    if (owner[i] == rank) row[i] = next++;
+  if (static_cast<std::size_t>(next) + 1 != owned_rows.offsets.size())
+    throw Error("make_local_piece: " + std::to_string(owned_rows.offsets.size() - 1) + " rows given for " +
+                std::to_string(next) + " owned nodes");
+  return make_piece(g, owner, rank, owned_rows, [&row](std::size_t i) { return static_cast<std::size_t>(row[i]); },
+                    &owned_rows);
 }
 
 std::vector<double> to_local(const LocalPiece& piece, const std::vector<double>& a) { return pick(a, piece.global); }

@@ -32,6 +32,12 @@ struct LocalPiece {
 // owned rows, neighbours renumbered, flags copied), material, and the conditions restricted to
 // owned nodes. The law is built again from the registry on the local model.
 LocalPiece make_local_piece(const Model& global, const std::vector<std::int32_t>& owner, int rank);
+// The same without the whole bond list (issue 15): `global` holds the per-node data only
+// (build_model_without_bonds), and owned_rows the rows of this rank's owned nodes in ascending
+// node order, neighbours numbered globally (core/bonds build_bond_rows), pre-cracks cut. The piece
+// is the one make_local_piece gives from the whole model, bit for bit. The rows' arrays become the
+// piece's (pass them with std::move: they are then never held twice).
+LocalPiece make_local_piece(const Model& global, const std::vector<std::int32_t>& owner, int rank, BondList owned_rows);
 
 // a_local[l] = a_global[global[l]] for every local node (owned and ghost).
 Vec3Array to_local(const LocalPiece& piece, const Vec3Array& a_global);

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/cracks.hpp"
+
 namespace pd {
 
 namespace {
@@ -24,6 +26,29 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& global)
   piece_ = make_local_piece(global, decomposition_.owner, rank_);
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
+}
+
+MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks)
+    : comm_(comm), decomposition_(decompose(skeleton.nodes.x, skeleton.bonds.offsets, size_of(comm), skeleton.horizon)) {
+  MPI_Comm_rank(comm, &rank_);
+  std::vector<std::int32_t> rows;  // the owned nodes, ascending
+  for (std::size_t i = 0; i < decomposition_.owner.size(); ++i)
+    if (decomposition_.owner[i] == rank_) rows.push_back(static_cast<std::int32_t>(i));
+  {
+    // The owned rows only: ≈ 1/R of the whole list, renumbered in place into the piece.
+    BondList owned = build_bond_rows(skeleton.nodes.x, cutoff, rows);
+    cut_crossing_bonds(cracks, skeleton.nodes.x, owned, &rows);  // pre-cracks (notches) start broken
+    piece_ = make_local_piece(skeleton, decomposition_.owner, rank_, std::move(owned));
+  }
+  halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
+  sum_ = std::make_unique<OrderedSum>(comm, piece_);
+  // LAMMPS's s0 at rest: the owned rows give the owned nodes' (the serial values: the same rows),
+  // and the ghosts take their owners' (a ghost's row is empty here).
+  if (skeleton.material.node_rule()) {
+    piece_.model.node_critical_stretch =
+        initial_node_critical_stretch(piece_.model.material, piece_.model.block_index, piece_.model.bonds);
+    halo_->exchange(piece_.model.node_critical_stretch);
+  }
 }
 
 std::int64_t MpiDecomposed::total(std::int64_t local) const {
@@ -126,6 +151,21 @@ void MpiDecomposed::gather_entries(const std::vector<std::int32_t>& global_node,
 
 void MpiDecomposed::broadcast(std::vector<double>& values) const {
   MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, 0, comm_);
+}
+
+std::vector<double> MpiDecomposed::per_rank(double value) const { return rows_on_rank_0(&value, 1); }
+
+void MpiDecomposed::gather_broken_lines(const BondList& local, BondList& lines) const {
+  sum_->gather_lines(local, piece_.global, lines);
+}
+
+std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model& skeleton, double cutoff,
+                                                      const std::vector<CrackSegment>& cracks) {
+  int initialized = 0, ranks = 1;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  if (ranks == 1) return nullptr;
+  return std::make_unique<MpiDecomposed>(MPI_COMM_WORLD, skeleton, cutoff, cracks);
 }
 
 std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global) {

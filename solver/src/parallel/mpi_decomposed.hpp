@@ -21,6 +21,11 @@ class MpiDecomposed : public Decomposed {
   // piece, halo and sums. Throws pd::Error on every rank alike for a decomposition that cannot
   // work (parallel/decomposition.hpp), so no rank waits for another.
   MpiDecomposed(MPI_Comm comm, const Model& global);
+  // The same without the whole bond list: `skeleton` has the per-node data and, in bonds.offsets,
+  // every node's row length (build_model_without_bonds, count_bonds); this rank builds the rows of
+  // its owned nodes (cut-off `cutoff`, pre-cracks `cracks`) and nothing else. The same piece, bit
+  // for bit.
+  MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks);
 
   int rank() const override { return rank_; }
   int ranks() const override { return decomposition_.ranks; }
@@ -47,6 +52,8 @@ class MpiDecomposed : public Decomposed {
   void broadcast(std::vector<double>& values) const override;
   void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
   std::string broadcast(const std::string& bytes_on_rank_0) const override;
+  std::vector<double> per_rank(double value) const override;
+  void gather_broken_lines(const BondList& local, BondList& lines) const override;
   Traffic traffic() const override;
   std::vector<std::string> traffic_report(std::int64_t steps) const override;
 

@@ -99,6 +99,45 @@ void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
   }
 }
 
+void OrderedSum::gather_lines(const BondList& local, const std::vector<std::int32_t>& global, BondList& lines) const {
+  std::vector<std::int32_t> ends;  // the owned rows' broken partners j > i, row after row
+  std::vector<double> per_node(local.nodes(), 0.0);
+  for (std::int32_t l : owned_local_) {
+    const auto i = static_cast<std::size_t>(l);
+    for (std::int64_t k = local.offsets[i]; k < local.offsets[i + 1]; ++k) {
+      const std::int32_t j = global[static_cast<std::size_t>(local.neighbour[static_cast<std::size_t>(k)])];
+      if (local.broken[static_cast<std::size_t>(k)] && j > global[i]) {
+        ends.push_back(j);
+        per_node[i] += 1.0;
+      }
+    }
+  }
+  const std::vector<double> count = gather(per_node);  // rank 0: per node, in global order (exact integers)
+  const double start = MPI_Wtime();
+  const int mine = static_cast<int>(ends.size());
+  std::vector<int> counts(rank_ == 0 ? static_cast<std::size_t>(ranks_) : 0), starts(counts.size() + 1, 0);
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+  for (std::size_t r = 0; r < counts.size(); ++r) starts[r + 1] = starts[r] + counts[r];
+  std::vector<std::int32_t> all(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
+  MPI_Gatherv(ends.data(), mine, MPI_INT32_T, all.data(), counts.data(), starts.data(), MPI_INT32_T, 0, comm_);
+  ++calls_;
+  bytes_ += static_cast<std::int64_t>(sizeof(std::int32_t) * ends.size());
+  seconds_ += MPI_Wtime() - start;
+  lines = BondList{};
+  if (rank_ != 0) return;
+  const auto n = static_cast<std::size_t>(global_nodes_);
+  lines.offsets.assign(n + 1, 0);
+  for (std::size_t g = 0; g < n; ++g) lines.offsets[g + 1] = lines.offsets[g] + static_cast<std::int64_t>(count[g]);
+  lines.neighbour.resize(all.size());
+  lines.broken.assign(all.size(), 1);
+  // The entries came rank after rank, each rank's rows in its owned order (gathered_node_).
+  std::size_t at = 0;
+  for (std::int32_t g32 : gathered_node_) {
+    const auto g = static_cast<std::size_t>(g32);
+    for (std::int64_t k = lines.offsets[g]; k < lines.offsets[g + 1]; ++k) lines.neighbour[static_cast<std::size_t>(k)] = all[at++];
+  }
+}
+
 double OrderedSum::sum(const std::vector<double>& per_node, double start) const {
   double total = start;
   const std::vector<double> ordered = gather(per_node);

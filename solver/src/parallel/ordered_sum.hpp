@@ -30,6 +30,9 @@ class OrderedSum {
   // The broken flags of the owned rows of `local` (the piece's bond list) into the same rows of
   // `global` (the whole model's), on rank 0. Collective.
   void gather_rows(const BondList& local, BondList& global) const;
+  // The broken bonds j > i of the owned rows of `local` (global: the piece's global numbers), as
+  // rows of the whole model on rank 0 (Decomposed::gather_broken_lines). Collective.
+  void gather_lines(const BondList& local, const std::vector<std::int32_t>& global, BondList& lines) const;
   // Gathers so far (sums included), the bytes this rank sent in them, and their wall time.
   std::int64_t calls() const { return calls_; }
   std::int64_t bytes_sent() const { return bytes_; }

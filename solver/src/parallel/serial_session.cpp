@@ -27,5 +27,6 @@ RankInfo world_ranks() { return RankInfo{}; }
 void abort_ranks(int code) { std::exit(code); }
 bool built_with_mpi() { return false; }
 std::unique_ptr<Decomposed> decompose_over_ranks(const Model&) { return nullptr; }
+std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model&, double, const std::vector<CrackSegment>&) { return nullptr; }
 
 }  // namespace pd

@@ -81,7 +81,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     gathered.f = dec->gather(state.f);
     gathered.w = dec->gather(state.w);
     gathered.copy_totals(state);
-    dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
+    if (p.whole_bonds) dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
     return gathered;
   };
 
@@ -121,9 +121,20 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     dec->total(0);  // every piece is on disk before the .pvtu names it
     if (out) out->frame_of_pieces(grid, dec->ranks(), loop.t);
   };
+  // A gathered frame of a run whose ranks hold only their rows: the damage per node and the broken
+  // bonds' line cells come from the pieces (Decomposed::gather_broken_lines), not the whole list.
+  const auto frame_from_rows = [&](const State& st) {
+    const LocalPiece& piece = dec->piece();
+    const std::vector<double> damage = dec->gather(piece.model.bond_model->damage(piece.model));  // owned rows: the serial bits
+    BondList lines;
+    dec->gather_broken_lines(piece.model.bonds, lines);
+    const FrameBonds bonds{damage, lines};
+    if (out) out->frame(model, st, loop.t, loop.step, &bonds);
+  };
   const auto frame = [&](double dt_taken) {
     const State& st = output_state();  // the history row's columns read the whole state
     if (p.frames_in_pieces()) frame_in_pieces();
+    else if (!p.whole_bonds) frame_from_rows(st);
     else if (out) out->frame(model, st, loop.t, loop.step);
     frames_here.emplace_back(loop.step, loop.t);
     history_row(dt_taken, &st);
@@ -153,11 +164,18 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
         dec && model.contact.pairs && contact_list.rebuilds() > 0 ? dec->gather(contact_list.u_build()) : Vec3Array{};
     // Collective too: an integrator's per-node state is gathered on rank 0 (integrators/implicit.cpp).
     std::vector<char> integrator_state = p.integrator->save_state();
+    // Ranks holding only their rows: the broken flags in the whole list's order, on rank 0 for the
+    // write only (1 byte per directed bond, freed after it).
+    if (!p.whole_bonds) {
+      if (out) p.model.bonds.broken.assign(static_cast<std::size_t>(p.directed_bonds()), 0);
+      dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
+    }
     if (!out) return;
     out->flush_history();
     LoopState saved = loop;
     saved.wall_time = wall_before + seconds_since(loop_start);
     write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, std::move(integrator_state), contact_u_build));
+    if (!p.whole_bonds) std::vector<std::uint8_t>().swap(p.model.bonds.broken);
   };
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,

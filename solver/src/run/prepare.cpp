@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "forces/indenter.hpp"
 #include "io/case_reader.hpp"
 #include "io/node_file.hpp"
+#include "materials/bond_model.hpp"
 #include "parallel/local_model.hpp"
 #include "parallel/session.hpp"
 #include "run/schedule.hpp"
@@ -102,7 +104,25 @@ void check_decomposable(const Prepared& p) {
 
 }  // namespace
 
+std::string whole_bonds_reason(const Case& c) {
+  // Each needs rows of nodes a rank does not own: the exact limit's Lanczos runs on the whole model
+  // (dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the indenters' depth
+  // bound), the surface correction's passes and LPS's per-node constants read whole rows, and
+  // mixed's load-path check walks the whole bond graph.
+  const std::string law = c.blocks.empty() ? std::string("pmb") : c.blocks[0].model;
+  if (law != "pmb") return "blocks[].model " + law;
+  if (c.surface_correction != "none") return "surface_correction " + c.surface_correction;
+  if (c.time.integrator == "mixed") return "time.integrator mixed (its load-path check)";
+  if (c.time.dt_rule != "stable" || c.time.safety_factor > 1.0) return "time.dt " + c.time.dt_rule + " (the exact limit)";
+  if (c.time.integrator == "adaptive" && !c.adaptive.dt_max) return "adaptive without dt_max (the exact limit)";
+  if (!c.indenters.empty()) return "indenters (their stable depth)";
+  return "";
+}
+
 double Prepared::exact_limit() {
+  // Not computable from one rank's rows: NaN, "not computed" (whole_bonds_reason keeps every case
+  // that needs it on the whole model; only a failed run's diagnosis asks for it then).
+  if (!whole_bonds) return std::nan("");
   if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
   return dt_exact;
 }
@@ -120,16 +140,38 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
       throw Error(c.file.string() + ": node_sets: '" + name + "' has no array 'set_" + name + "' in " +
                   c.nodes_file.string());
   const auto build_start = Clock::now();
-  p->model = build_model(c, std::move(nodes));
+  // On several ranks each builds only its own rows when nothing needs the whole list (issue 15):
+  // every rank counts every node's partners (8 bytes a node: the decomposition balances by them).
+  p->whole_bonds = world_ranks().size == 1 || !whole_bonds_reason(c).empty();
+  if (p->whole_bonds) {
+    p->model = build_model(c, std::move(nodes));
+  } else {
+    p->model = build_model_without_bonds(c, std::move(nodes));
+    p->model.bonds.offsets = count_bonds(p->model.nodes.x, bond_search_cutoff(c));
+    p->model.bond_model = material_registry().get("pmb").make(p->model);
+    // LAMMPS's s0 per node: each piece computes its own; the whole array (8 bytes a node) is where
+    // rank 0 gathers it for a checkpoint and a restart reads it back.
+    if (p->model.material.node_rule())
+      p->model.node_critical_stretch.assign(p->model.nodes.size(), std::numeric_limits<double>::infinity());
+  }
   p->build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
   check_materials(*p);
 
-  choose_dt(*p);
+  if (p->whole_bonds) choose_dt(*p);
   p->max_steps = c.time.max_steps;
   if (opt.max_steps) p->max_steps = std::min(p->max_steps, *opt.max_steps);
   if (world_ranks().size > 1) {
     check_decomposable(*p);
-    p->decomposed = decompose_over_ranks(p->model);
+    const auto rows_start = Clock::now();
+    p->decomposed = p->whole_bonds ? decompose_over_ranks(p->model)
+                                   : decompose_rows_over_ranks(p->model, bond_search_cutoff(c), c.cracks);
+    if (!p->whole_bonds) {
+      p->build_seconds += std::chrono::duration<double>(Clock::now() - rows_start).count();
+      // Eq. 2.5 is a least over nodes of their rows' sums: each rank's over its owned rows, then the
+      // least of those (exact), the serial value.
+      p->dt_stable = p->decomposed->minimum(stable_time_step(p->decomposed->piece().model));
+      p->dt = explicit_time_step(c, p->dt_stable, [&p] { return p->exact_limit(); });
+    }
   }
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
@@ -170,8 +212,8 @@ void log_setup(RunLog& log, const Prepared& p) {
   const Case& c = p.c;
   const Model& model = p.model;
   const std::size_t n = model.nodes.size();
-  log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(model.bonds.directed() / 2) + " (" +
-           format("%.1f", static_cast<double>(model.bonds.directed()) / static_cast<double>(n)) +
+  log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(p.directed_bonds() / 2) + " (" +
+           format("%.1f", static_cast<double>(p.directed_bonds()) / static_cast<double>(n)) +
            " per node), built in " + format("%.3f", p.build_seconds) + " s");
   log.line("analysis " + c.analysis + ", horizon " + format("%.6g", c.horizon) + " m = " +
            format("%.4g", c.horizon / c.grid_spacing) + " dx");
@@ -200,6 +242,12 @@ void log_setup(RunLog& log, const Prepared& p) {
              std::to_string(ghosts) + " ghosts in all, " +
              format("%.3f", static_cast<double>(ghosts) / static_cast<double>(n)) + " per owned node; " +
              "frames, history and run.log from rank 0");
+    // What each rank holds of the bonds: its piece's rows, and the whole list too if it kept it.
+    const std::vector<double> held = d.per_rank(static_cast<double>(d.piece().model.bonds.directed() + model.bonds.directed()));
+    std::string text = "directed bonds held per rank (of " + std::to_string(p.directed_bonds()) + "):";
+    for (std::size_t r = 0; r < held.size(); ++r) text += " rank " + std::to_string(r) + " " + format("%.0f", held[r]) + (r + 1 < held.size() ? "," : "");
+    log.line(text + (p.whole_bonds ? "; every rank holds the whole bond list too, for " + whole_bonds_reason(c)
+                                   : "; each rank built only the rows of its own nodes (the node data of the whole cloud: on every rank)"));
   }
   if (p.indenter_watch)
     for (const auto& ind : model.indenters) {

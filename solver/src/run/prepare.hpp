@@ -19,7 +19,13 @@ namespace pd {
 struct Prepared {
   Case c;
   int threads = 0;  // OpenMP's, after --threads
-  Model model;  // the whole model (on every rank of a decomposed run: output and run.log read it)
+  // The whole model. On a decomposed run every rank holds its per-node data (output and run.log
+  // read it); its bond list only when whole_bonds (rows_per_rank_reason() says why), else just the
+  // rows' offsets — each rank built only its owned rows, in decomposed->piece() (issue 15).
+  Model model;
+  bool whole_bonds = true;
+  // Directed bonds of the whole model (each bond twice), held or not.
+  std::int64_t directed_bonds() const { return model.bonds.offsets.empty() ? 0 : model.bonds.offsets.back(); }
   // A run on several MPI ranks (issue 15): this rank's piece, its ghosts and the ordered sums; the
   // operator then works on the piece's model. Null on one rank: the serial path.
   std::unique_ptr<Decomposed> decomposed;
@@ -54,6 +60,10 @@ struct Prepared {
   Prepared(const Prepared&) = delete;
   Prepared& operator=(const Prepared&) = delete;
 };
+
+// Why a decomposed run of case c keeps the whole bond list on every rank: the feature that reads
+// it, or empty when each rank can build only its own rows (issue 15).
+std::string whole_bonds_reason(const Case& c);
 
 // Throws pd::Error for bad input (naming the file), before anything is written.
 std::unique_ptr<Prepared> prepare(const RunOptions& options);

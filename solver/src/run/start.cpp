@@ -36,6 +36,15 @@ Checkpoint read_checkpoint_on_ranks(const RunOptions& opt, const Decomposed* d) 
   return parse_checkpoint(d->broadcast(bytes), opt.restart.string());
 }
 
+// Broken bonds of the whole model, each once: from the whole list, or from the ranks' rows (each
+// bond's two copies are in the rows of its two ends, on one rank or two).
+std::int64_t broken_bonds(const Prepared& p) {
+  if (p.whole_bonds) return broken_bond_count(p.model);
+  std::int64_t flags = 0;
+  for (std::uint8_t b : p.decomposed->piece().model.bonds.broken) flags += b;
+  return p.decomposed->total(flags) / 2;
+}
+
 // A decomposed run's piece of the restored state: the checkpoint holds the whole model's state in
 // global node order (whatever rank count wrote it), and each rank takes its owned nodes and their
 // ghosts — exact copies, as a halo exchange would make them — and its rows' broken flags.
@@ -63,13 +72,14 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   if (checkpoint.nodes_hash != s.nodes_hash)
     throw Error(where + "the checkpoint belongs to another node file (or " + p.c.nodes_file.string() +
                 " changed since it was written)");
-  if (checkpoint.nodes != n || checkpoint.directed_bonds != model.bonds.directed() || checkpoint.broken_flags.size() != model.bonds.directed() ||
+  const auto directed = static_cast<std::size_t>(p.directed_bonds());
+  if (checkpoint.nodes != n || checkpoint.directed_bonds != directed || checkpoint.broken_flags.size() != directed ||
       checkpoint.node_critical_stretch.size() != model.node_critical_stretch.size() ||
       checkpoint.integrator != integrator.name() ||
       (model.contact.pairs && checkpoint.contact_rebuilds > 0 && checkpoint.contact_u_build[0].size() != n))
     throw Error(where + "the checkpoint does not fit this model (" + std::to_string(checkpoint.nodes) + " nodes, " +
                 std::to_string(checkpoint.directed_bonds / 2) + " bonds, integrator " + checkpoint.integrator + "; here " +
-                std::to_string(n) + ", " + std::to_string(model.bonds.directed() / 2) + ", " + integrator.name() + ")");
+                std::to_string(n) + ", " + std::to_string(directed / 2) + ", " + integrator.name() + ")");
   if (checkpoint.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
   // Checked before any rank takes its piece: every rank holds the same whole state and decides alike
   // (a serial run checks after restore, in start_or_restore).
@@ -81,6 +91,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   model.bonds.broken = std::move(checkpoint.broken_flags);
   if (p.decomposed) restore_piece(p, checkpoint.state, s);
   else s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
+  if (!p.whole_bonds) std::vector<std::uint8_t>().swap(model.bonds.broken);  // the rows are in the piece now
   model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
   if (p.decomposed && !model.node_critical_stretch.empty())  // the piece's owned nodes and ghosts, global order
     p.decomposed->piece().model.node_critical_stretch = to_local(p.decomposed->piece(), model.node_critical_stretch);
@@ -128,7 +139,7 @@ Start start_or_restore(const RunOptions& opt, Prepared& p) {
     }
     p.integrator->initialize(s.state, 0.0);
     s.loop.dt = p.dt;
-    s.loop.broken = broken_bond_count(p.model);
+    s.loop.broken = broken_bonds(p);
   }
   if (first_non_finite(s.state) >= 0)
     throw Error((s.restarting ? opt.restart.string() + ": the checkpoint's state" : p.c.file.string() + ": the initial state") +
@@ -165,7 +176,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, 
   k.case_hash = s.case_hash;
   k.nodes_hash = s.nodes_hash;
   k.nodes = model.nodes.size();
-  k.directed_bonds = model.bonds.directed();
+  k.directed_bonds = static_cast<std::size_t>(p.directed_bonds());
   k.integrator = p.integrator->name();
   k.loop = loop;
   k.integrator_state = std::move(integrator_state);

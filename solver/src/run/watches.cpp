@@ -2,6 +2,7 @@
 #include "run/watches.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "run/text.hpp"
 
@@ -34,6 +35,16 @@ std::string BlowUpWatch::non_finite_message(const std::string& where, std::int64
 }
 
 std::string BlowUpWatch::likely_cause(double h, double dt_exact, double dt_stable, bool explicit_step, bool contact) {
+  // A decomposed run whose ranks hold only their rows does not compute the exact limit (NaN): its
+  // step is eq. 2.5's × safety factor ≤ 1 (run/prepare whole_bonds_reason), below the exact limit.
+  if (std::isnan(dt_exact) && explicit_step)
+    return "dt = " + format("%.6g", h) + " s is within eq. 2.5's limit " + format("%.6g", dt_stable) +
+           " s, so within the linear limit, which large deformation lowers" +
+           (contact ? std::string(" and contact stiffness (contact.stiffness_factor) is not part of") : std::string()) +
+           "; use a smaller time.safety_factor (e.g. 0.8)" +
+           (contact ? std::string(" or a smaller contact.stiffness_factor") : std::string());
+  if (std::isnan(dt_exact))
+    return "dt = " + format("%.6g", h) + " s: look for contact stiffness, large deformation or a load that makes the state jump";
   const double ratio = h / dt_exact;
   std::string text = "dt = " + format("%.6g", h) + " s is " + format("%.3g", ratio) + " × the exact stability limit " +
                      format("%.6g", dt_exact) + " s (eq. 2.5: " + format("%.6g", dt_stable) + " s): ";
