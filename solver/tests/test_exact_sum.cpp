@@ -74,7 +74,7 @@ TEST(ExactSum, AnyPermutationGivesTheSameBits) {
   EXPECT_EQ(bits_of(c.value()), bits_of(first));
 }
 
-TEST(ExactSum, MatchesALongDoubleFreeReference) {
+TEST(ExactSum, MatchesTheNaiveLoopWhereThatIsExact) {
   // Terms that are integers times 2^−20 below 2^30: every partial sum is exact in a double, so the
   // naive loop is exact and must agree; more terms than kAddsBeforeCarry, so the carries run.
   std::mt19937_64 random(7);

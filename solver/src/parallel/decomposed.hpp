@@ -35,7 +35,7 @@ class Decomposed {
   virtual void update_ghosts(std::vector<double>& a) const = 0;
   // start + Σ over owned local nodes of per_node[l], summed exactly (core/exact_sum.hpp) and rounded
   // once, the same on every rank: the bits do not depend on the rank or thread count, and equal
-  // the serial sum_nodes (parallel/node_sum.hpp) of the whole model's terms. Entries of ghosts are
+  // the serial exact sum (parallel/node_sum.hpp) of the whole model's terms. Entries of ghosts are
   // ignored; a node that no term concerns may enter as 0.0, which adds nothing. Collective: every
   // rank calls it (one MPI_Allreduce of ExactSum::kLimbs int64).
   virtual double exact_sum(const std::vector<double>& per_node, double start = 0.0) const = 0;

@@ -12,13 +12,8 @@
 
 namespace pd {
 
-// start + Σ_i per_node[i] (the owned nodes' on a decomposed run), exactly, rounded once. Collective
-// on a decomposed run.
-inline double sum_nodes(const Decomposed* d, const std::vector<double>& per_node, double start = 0.0) {
-  return d ? d->exact_sum(per_node, start) : exact_sum(per_node, start);
-}
-
-// Σ_i term(i) over the n local nodes, as sum_nodes.
+// Σ_i term(i) over the n local nodes (the owned ones on a decomposed run), exactly, rounded once.
+// Collective on a decomposed run.
 template <class Term>
 double sum_over_nodes(const Decomposed* d, std::size_t n, Term term) {
   if (!d) {
