@@ -3,8 +3,8 @@ beside LAMMPS peri/pmb on 2 MPI ranks, on the same bricks in the same sitting.
 
 Runs build/solver/pd_mpi_halo (solver/bench/mpi_halo.cpp) under `mpiexec --oversubscribe
 --bind-to none -np R` with T OpenMP threads per rank: the velocity-Verlet loop of the `make bench`
-brick with the two ordered energy sums pdsolve's loop adds each step. Each rank reports, per
-step, the halo messages and bytes it sent, the ordered sums and the bytes they sent to rank 0,
+brick with the two exact energy sums pdsolve's loop adds each step. Each rank reports, per
+step, the halo messages and bytes it sent, the exact sums (MPI_Allreduce) and their bytes,
 its ghosts per owned node, the wall time in communication, and its peak memory. The codes
 alternate, `repeats` runs each, and the best run of each configuration counts (a busy neighbour
 slows a run, nothing speeds it up). Writes out/bench/mpi.csv (one row per rank and configuration,
@@ -84,7 +84,7 @@ def main():
                 r0 = run[0]
                 print(f"  {side}³ = {nodes} nodes, {ranks} rank(s) × {threads} thread(s): {rate[(ranks, threads)]:.3e} "
                       f"directed bond updates/s; per rank and step: {r0['halo_messages_per_step']} messages, "
-                      f"{r0['halo_bytes_per_step']} halo bytes, {r0['ordered_sum_bytes_per_step']} bytes of ordered sums, "
+                      f"{r0['halo_bytes_per_step']} halo bytes, {r0['reduction_bytes_per_step']} bytes of exact sums (MPI_Allreduce), "
                       f"{r0['ghosts_per_owned']} ghosts per owned node, {float(r0['communication_s_per_step']) * 1e3:.3f} ms "
                       f"in communication ({100 * float(r0['communication_share']):.1f} %), peak {r0['peak_rss_mb']} MB "
                       f"(load {load})", flush=True)
@@ -95,7 +95,7 @@ def main():
                       f"{rate[(2, 1)] / lammps_rate:.2f}× that (target ≥ 3.5×)", flush=True)
     fields = ["code", "rank", "side", "nodes", "ranks", "threads", "steps", "directed_bonds", "loop_s",
               "bond_updates_per_s", "owned", "ghosts", "ghosts_per_owned", "halo_messages_per_step",
-              "halo_bytes_per_step", "ordered_sums_per_step", "ordered_sum_bytes_per_step", "communication_s_per_step",
+              "halo_bytes_per_step", "reductions_per_step", "reduction_bytes_per_step", "communication_s_per_step",
               "communication_share", "peak_rss_mb", "load_average"]
     with open(args.out, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)

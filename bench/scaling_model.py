@@ -7,12 +7,12 @@ Per step and rank, with n owned nodes, g ghosts, R ranks, N = R·n nodes in all:
 - compute: b·n / r, with b directed bonds per node and r directed bond updates per second per core;
 - halo: one message to each of k neighbouring pieces (α each) and 24·g bytes (u, 3 doubles a
   ghost) at bandwidth β; not overlapped with the interior rows today;
-- ordered sums as built (parallel/ordered_sum): s sums a step, each gathers 8 bytes per node to
-  rank 0 (rank 0 receives 8·N bytes at β) and rank 0 adds N terms one by one (t_add each), then
-  a broadcast (log₂R·α);
-- ordered sums as an exact reduction would cost them (a fixed-size integer accumulator, A bytes,
-  reduced with MPI_Allreduce: log₂R·(α + A/β)); not built: it would change the serial run's
-  last bits (parallel/ordered_sum.hpp).
+- exact sums as built (core/exact_sum.hpp): s sums a step, each adds the rank's n terms into its
+  accumulator (t_exact each, measured by pd_bench BM_ExactSum) and reduces the A = 560-byte
+  accumulators with MPI_Allreduce (log₂R·(α + A/β));
+- the ordered sums they replaced, for comparison: each gathered 8 bytes per node to rank 0 (rank 0
+  receives 8·N bytes at β) and rank 0 added N terms one by one (t_add each), then a broadcast
+  (log₂R·α).
 Pieces are taken as cubes of side a = n^(1/3) node spacings (Morton pieces of R = 8^k ranks of a
 cube are cubes; others are unions of octree cells with up to ~1.5× the surface), an interior
 piece with ghosts g = (a + 2m)³ − a³ (m = 3 layers for δ = 3 dx) and k = 26 neighbours; a piece
@@ -27,7 +27,8 @@ LAYERS = 3                # ghost layers: δ/dx rounded up
 ALPHA = 2e-6              # network latency [s] (assumed)
 BETA = 10e9               # network bandwidth [bytes/s] (assumed)
 T_ADD = 1.0e-9            # rank 0's time per term of an ordered sum, one add in order [s] (a dependent add chain, ~4 cycles at ~4 GHz)
-ACCUMULATOR_BYTES = 600   # an exact accumulator over the double range (~2100 bits of fixed point, rounded up)
+ACCUMULATOR_BYTES = 560   # core/exact_sum.hpp: 70 int64 (67 digit limbs, 3 counts of ±∞/NaN); asserted by tests/bench/test_mpi_halo.py
+T_EXACT = 2.0e-9          # one term of an exact sum [s]: pd_bench BM_ExactSum (docs/performance.md §7), rounded up
 BYTES_PER_NODE = 723.0    # peak memory per node of a serial run (docs/performance.md §3: 723 MB at 10⁶ nodes)
 
 
@@ -42,18 +43,18 @@ def step_times(total, ranks, rate, sums):
     a, g = piece(n)
     compute = BONDS_PER_NODE * n / rate
     if ranks == 1:
-        return dict(n=n, a=a, ghosts=0.0, ratio=0.0, compute=compute, halo=0.0, sums_now=0.0, sums_exact=0.0)
+        return dict(n=n, a=a, ghosts=0.0, ratio=0.0, compute=compute, halo=0.0, sums_now=0.0, sums_exact=sums * n * T_EXACT)
     halo = 26 * ALPHA + 24 * g / BETA
     log_r = math.ceil(math.log2(ranks))
     sums_now = sums * (8 * total / BETA + total * T_ADD + log_r * ALPHA)
-    sums_exact = sums * log_r * (ALPHA + ACCUMULATOR_BYTES / BETA)
+    sums_exact = sums * (n * T_EXACT + log_r * (ALPHA + ACCUMULATOR_BYTES / BETA))
     return dict(n=n, a=a, ghosts=g, ratio=g / n, compute=compute, halo=halo, sums_now=sums_now, sums_exact=sums_exact)
 
 
 def table(title, rows, rate, sums, base_of):
     print(f"**{title}**\n")
     print("| ranks | nodes per rank | piece side a | ghosts per owned node | compute [ms] | halo [ms] | halo bytes per rank | "
-          "ordered sums as built [ms] | efficiency as built | with exact sums [ms] | efficiency with exact sums |")
+          "ordered sums before [ms] | efficiency before | exact sums as built [ms] | efficiency as built |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for total, ranks in rows:
         t = step_times(total, ranks, rate, sums)
@@ -61,7 +62,7 @@ def table(title, rows, rate, sums, base_of):
         exact = t["compute"] + t["halo"] + t["sums_exact"]
         base = base_of(total, ranks)
         print(f"| {ranks} | {t['n']:.3g} | {t['a']:.0f} | {t['ratio']:.3f} | {1e3 * t['compute']:.4g} | {1e3 * t['halo']:.3g} | "
-              f"{24 * t['ghosts'] / 1e6:.3g} MB | {1e3 * t['sums_now']:.3g} | {base / now:.2f} | {1e3 * exact:.4g} | "
+              f"{24 * t['ghosts'] / 1e6:.3g} MB | {1e3 * t['sums_now']:.3g} | {base / now:.2f} | {1e3 * t['sums_exact']:.3g} | "
               f"{base / exact:.2f} |")
     print()
 
@@ -70,11 +71,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--nodes", type=float, default=1e8)
     ap.add_argument("--rate", type=float, default=2.7e8, help="directed bond updates/s of one core")
-    ap.add_argument("--sums", type=int, default=2, help="ordered sums per step (2: the blow-up watch's energies)")
+    ap.add_argument("--sums", type=int, default=2, help="sums per step (2: the blow-up watch's energies)")
     args = ap.parse_args()
     ranks = [1, 8, 64, 128, 512, 1024]
     print(f"N = {args.nodes:.3g} nodes, {BONDS_PER_NODE} bonds per node, r = {args.rate:.3g} bond updates/s per core, "
-          f"α = {ALPHA * 1e6:g} µs, β = {BETA / 1e9:g} GB/s, {args.sums} ordered sums a step\n")
+          f"α = {ALPHA * 1e6:g} µs, β = {BETA / 1e9:g} GB/s, {args.sums} sums a step, exact sums {ACCUMULATOR_BYTES} B and {T_EXACT * 1e9:g} ns a term\n")
     serial = lambda total: BONDS_PER_NODE * total / args.rate  # noqa: E731
     table("Strong scaling (N fixed): efficiency = T(1) / (R·T(R))", [(args.nodes, r) for r in ranks], args.rate,
           args.sums, lambda total, r: serial(total) / r)

@@ -6,8 +6,8 @@
 // and strain energy as pdsolve's loop computes them for its blow-up watch, and prints, from rank 0, one
 // CSV row per rank: the loop's wall time (the slowest rank's) and directed bond updates per second
 // of the whole brick; the rank's owned nodes, ghosts and ghosts per owned node; per step the halo
-// messages and bytes it sent, the ordered sums/gathers and the bytes it sent in them to rank 0, the
-// wall time in communication (halo exchanges and ordered sums, MPI waits included); and its peak
+// messages and bytes it sent, the exact sums (MPI_Allreduce) and the bytes of their accumulators,
+// the wall time in communication (halo exchanges and sums, MPI waits included); and its peak
 // resident memory.
 //
 //   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T]
@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
   for (int k = 0; k < steps; ++k) {
     dt = dt0;
     integrator->step(s, t, dt);
-    energy += op.kinetic_energy(s) + op.strain_energy(s);  // pdsolve's blow-up watch: 2 ordered sums a step
+    energy += op.kinetic_energy(s) + op.strain_energy(s);  // pdsolve's blow-up watch: 2 exact sums a step
   }
   const double mine = std::chrono::duration<double>(Clock::now() - t0).count();
   double loop = mine;
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   if (rank == 0) {
     const double directed = static_cast<double>(global.bonds.offsets.back());  // held or only counted
     std::printf("rank,side,nodes,ranks,threads,steps,directed_bonds,loop_s,bond_updates_per_s,owned,ghosts,ghosts_per_owned,"
-                "halo_messages_per_step,halo_bytes_per_step,ordered_sums_per_step,ordered_sum_bytes_per_step,"
+                "halo_messages_per_step,halo_bytes_per_step,reductions_per_step,reduction_bytes_per_step,"
                 "communication_s_per_step,communication_share,peak_rss_mb\n");
     for (int r = 0; r < ranks; ++r) {
       const double* v = &all[static_cast<std::size_t>(kColumns * r)];

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <memory>
 
+#include "core/exact_sum.hpp"
+
 namespace pd {
 
 void BodyForceTerm::AddMult(double t, Vec3Array& f) const {
@@ -19,7 +21,9 @@ double BodyForceTerm::power(double t, const Vec3Array& v) const {
   for (const auto& b : model_.conditions.body_forces) {
     const double value = b.table.value(t);
     const auto& vc = v[static_cast<std::size_t>(b.component)];
-    for (std::int32_t i : b.nodes) p += model_.nodes.volume[static_cast<std::size_t>(i)] * value * vc[static_cast<std::size_t>(i)];
+    ExactSum sum(p);  // one exact sum per condition, continuing the last (as the decomposed power below)
+    for (std::int32_t i : b.nodes) sum.add(model_.nodes.volume[static_cast<std::size_t>(i)] * value * vc[static_cast<std::size_t>(i)]);
+    p = sum.value();
   }
   return p;
 }
@@ -30,10 +34,10 @@ double BodyForceTerm::power(double t, const Vec3Array& v, const Decomposed& d) c
   for (const auto& b : model_.conditions.body_forces) {
     const double value = b.table.value(t);
     const auto& vc = v[static_cast<std::size_t>(b.component)];
-    std::fill(term.begin(), term.end(), 0.0);  // a node outside the set adds +0.0: the bits of skipping it
+    std::fill(term.begin(), term.end(), 0.0);  // a node outside the set adds 0: nothing
     for (std::int32_t i : b.nodes)
       term[static_cast<std::size_t>(i)] = model_.nodes.volume[static_cast<std::size_t>(i)] * value * vc[static_cast<std::size_t>(i)];
-    p = d.ordered_sum(term, p);
+    p = d.exact_sum(term, p);
   }
   return p;
 }

@@ -2,6 +2,7 @@
 #include "forces/contact.hpp"
 
 #include "core/error.hpp"
+#include "core/exact_sum.hpp"
 #include "forces/contact_on_piece.hpp"
 
 #include <algorithm>
@@ -66,9 +67,9 @@ double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, V
   a.stiffness_over_horizon = m.contact.stiffness_factor / m.horizon;
   std::vector<double> e(m.nodes.size());
   add_contact_force_density(a, f[0].data(), f[1].data(), f[2].data(), e.data());
-  double total = 0.0;
-  for (std::size_t i = 0; i < e.size(); ++i) total += e[i] * m.nodes.volume[i];
-  return total;
+  ExactSum total;  // exact (core/exact_sum.hpp): the bits of the decomposed run's sum (contact_on_piece)
+  for (std::size_t i = 0; i < e.size(); ++i) total.add(e[i] * m.nodes.volume[i]);
+  return total.value();
 }
 
 }  // namespace pd

@@ -164,7 +164,7 @@ double ContactOnPiece::add_force(const Vec3Array& u, Vec3Array& f) {
   a.stiffness_over_horizon = m.contact.stiffness_factor / m.horizon;
   add_contact_force_density(a, f_[0].data(), f_[1].data(), f_[2].data(), energy_.data());
   // Into the piece: 0 + s = s exactly (a row's sum s starts at +0 and so is never −0), so f_i gets
-  // the serial f_i += s. The energy: the serial Σ e_i V_i, in global node order.
+  // the serial f_i += s. The energy: the serial exact Σ e_i V_i.
   std::vector<double> per_node(f[0].size(), 0.0);
   for (std::int32_t k : owned_) {
     const auto c = static_cast<std::size_t>(k);
@@ -172,7 +172,7 @@ double ContactOnPiece::add_force(const Vec3Array& u, Vec3Array& f) {
     for (std::size_t d = 0; d < 3; ++d) f[d][l] += f_[d][c];
     per_node[l] = energy_[c] * volume_[c];
   }
-  return d_.ordered_sum(per_node);
+  return d_.exact_sum(per_node);
 }
 
 }  // namespace pd

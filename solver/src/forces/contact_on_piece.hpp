@@ -15,7 +15,7 @@
 //   serial row's nodes in the serial order. The nodes no owned row names are dropped again;
 // - in every force evaluation the kept ghosts that are not bond ghosts get their displacement
 //   from their owners (Decomposed::make_node_halo); the bond ghosts' come from the bonds' halo;
-// - the energy is the serial node-order sum (Decomposed::ordered_sum), and the build count is the
+// - the energy is the serial exact sum (Decomposed::exact_sum), and the build count is the
 //   same on every rank because every rank builds together.
 // The piece's NeighbourList (model.contact_list) records the builds (count, time, the piece's
 // displacement at the last one) for run.log, history.csv and the checkpoint; a restart restores

@@ -5,6 +5,7 @@
 // Eliminating v^{n+½}: (1 + αΔt/2)v^{n+1} = (1 − αΔt/2)v^n + Δt(f^n + f^{n+1})/(2ρ), i.e. the
 // damping term is Crank–Nicolson, whose amplification (1 − αΔt/2)/(1 + αΔt/2) has modulus < 1.
 #pragma once
+#include "core/exact_sum.hpp"
 #include <cstdint>
 #include <vector>
 
@@ -27,9 +28,12 @@ inline double damping_power(double alpha, const std::vector<double>& density, co
                             const Vec3Array& v, const std::array<std::vector<std::uint8_t>, 3>& fixed) {
   if (alpha == 0.0) return 0.0;
   double p = 0.0;
-  for (std::size_t d = 0; d < 3; ++d)
+  for (std::size_t d = 0; d < 3; ++d) {  // one exact sum per component, continuing the last (core/exact_sum.hpp)
+    ExactSum sum(p);
     for (std::size_t i = 0; i < volume.size(); ++i)
-      if (!fixed[d][i]) p += density[i] * volume[i] * v[d][i] * v[d][i];
+      if (!fixed[d][i]) sum.add(density[i] * volume[i] * v[d][i] * v[d][i]);
+    p = sum.value();
+  }
   return alpha * p;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "core/exact_sum.hpp"
 #include "parallel/local_model.hpp"
 
 namespace pd {
@@ -161,23 +162,27 @@ double indenter_stable_depth(const Model& m, const IndenterSettings& ind, double
   return depth;
 }
 
-double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
-                              std::vector<std::array<double, 3>>& force_on_body) const {
-  const Model& m = model_;
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
-  const std::int64_t chunks = (n + kChunk - 1) / kChunk;
-  force_on_body.assign(m.indenters.size(), {0.0, 0.0, 0.0});
-  double energy = 0.0;
-  for (std::size_t k = 0; k < m.indenters.size(); ++k) {
+namespace {
+
+// f_i += K h_i² n_i over the nodes listed (all of them when `nodes` is null), and each indenter's
+// force Σ V_i K h_i² n_i and the potential Σ V_i K h_i³/3 as exact sums (core/exact_sum.hpp):
+// sums[3k + d] indenter k's force component d, sums[3K] the potential of all indenters. Threads
+// sum their nodes apart and merge: exact, so the bits do not depend on the thread count.
+std::vector<ExactSum> indenter_sums(const Model& m, double t, const Vec3Array& u, Vec3Array& f,
+                                    const std::vector<std::int32_t>* nodes) {
+  const auto K = m.indenters.size();
+  std::vector<ExactSum> sums(3 * K + 1);
+  const auto n = static_cast<std::int64_t>(nodes ? nodes->size() : m.nodes.size());
+  for (std::size_t k = 0; k < K; ++k) {
     const IndenterSettings& ind = m.indenters[k];
     const IndenterShape shape = indenter_shape_registry().get(ind.shape);
     const std::array<double, 3> c = indenter_position(ind, t);
-    std::vector<double> sums(static_cast<std::size_t>(chunks) * 4, 0.0);  // Fx, Fy, Fz, energy
-#pragma omp parallel for schedule(static)
-    for (std::int64_t b = 0; b < chunks; ++b) {
-      double* s = &sums[static_cast<std::size_t>(b) * 4];
-      for (std::int64_t i = b * kChunk; i < std::min(n, (b + 1) * kChunk); ++i) {
-        const auto q = static_cast<std::size_t>(i);
+#pragma omp parallel
+    {
+      ExactSum mine[4];  // this thread's force components and potential
+#pragma omp for schedule(static)
+      for (std::int64_t e = 0; e < n; ++e) {
+        const auto q = nodes ? static_cast<std::size_t>((*nodes)[static_cast<std::size_t>(e)]) : static_cast<std::size_t>(e);
         const double y[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
         double dir[3];
         const double h = shape(ind, c.data(), y, dir);
@@ -186,70 +191,41 @@ double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
         const double vol = m.nodes.volume[q];
         for (std::size_t d = 0; d < 3; ++d) {
           f[d][q] += magnitude * dir[d];
-          s[d] += vol * magnitude * dir[d];
+          mine[d].add(vol * magnitude * dir[d]);
         }
-        s[3] += vol * ind.stiffness * h * h * h / 3.0;
+        mine[3].add(vol * ind.stiffness * h * h * h / 3.0);
+      }
+#pragma omp critical(pd_indenter_sums)
+      {
+        for (std::size_t d = 0; d < 3; ++d) sums[3 * k + d].add(mine[d]);
+        sums[3 * K].add(mine[3]);
       }
     }
-    for (std::int64_t b = 0; b < chunks; ++b) {
-      for (std::size_t d = 0; d < 3; ++d) force_on_body[k][d] += sums[static_cast<std::size_t>(b) * 4 + d];
-      energy += sums[static_cast<std::size_t>(b) * 4 + 3];
-    }
   }
-  return energy;
+  return sums;
+}
+
+double indenter_results(const std::vector<ExactSum>& sums, std::vector<std::array<double, 3>>& force_on_body) {
+  const std::size_t K = (sums.size() - 1) / 3;
+  force_on_body.assign(K, {0.0, 0.0, 0.0});
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t d = 0; d < 3; ++d) force_on_body[k][d] = sums[3 * k + d].value();
+  return sums[3 * K].value();
+}
+
+}  // namespace
+
+double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
+                              std::vector<std::array<double, 3>>& force_on_body) const {
+  return indenter_results(indenter_sums(model_, t, u, f, nullptr), force_on_body);
 }
 
 double IndenterForce::AddMult(double t, const Vec3Array& u, Vec3Array& f,
                               std::vector<std::array<double, 3>>& force_on_body, const Decomposed& dec) const {
-  const Model& m = model_;
-  const LocalPiece& piece = dec.piece();
-  const std::vector<std::int32_t>& owned = piece.owned_local;
-  const std::vector<std::int32_t>& global = piece.global;
-  const auto K = m.indenters.size();
-  // Rank 0 holds the whole body's chunk sums, as the serial AddMult: chunk b = global nodes
-  // [b·kChunk, (b+1)·kChunk), each summed in node order from 0, the chunks added in chunk order.
-  const std::int64_t chunks = (piece.global_nodes + kChunk - 1) / kChunk;
-  std::vector<double> totals(3 * K + 1, 0.0);  // force_on_body, then the energy
-  for (std::size_t k = 0; k < K; ++k) {
-    const IndenterSettings& ind = m.indenters[k];
-    const IndenterShape shape = indenter_shape_registry().get(ind.shape);
-    const std::array<double, 3> c = indenter_position(ind, t);
-    std::vector<std::int32_t> inside;  // global numbers of the owned nodes inside, ascending
-    std::vector<double> terms;         // their V·K h² n and V·K h³/3
-    for (std::int32_t l32 : owned) {
-      const auto q = static_cast<std::size_t>(l32);
-      const double y[3] = {m.nodes.x[0][q] + u[0][q], m.nodes.x[1][q] + u[1][q], m.nodes.x[2][q] + u[2][q]};
-      double dir[3];
-      const double h = shape(ind, c.data(), y, dir);
-      if (!(h > 0.0)) continue;
-      const double magnitude = ind.stiffness * h * h;
-      const double vol = m.nodes.volume[q];
-      inside.push_back(global[q]);
-      for (std::size_t d = 0; d < 3; ++d) {
-        f[d][q] += magnitude * dir[d];
-        terms.push_back(vol * magnitude * dir[d]);
-      }
-      terms.push_back(vol * ind.stiffness * h * h * h / 3.0);
-    }
-    std::vector<std::int32_t> nodes;
-    std::vector<double> values;
-    dec.gather_entries(inside, terms, 4, nodes, values);
-    if (dec.rank() != 0) continue;
-    std::vector<double> sums(static_cast<std::size_t>(chunks) * 4, 0.0);
-    for (std::size_t e = 0; e < nodes.size(); ++e) {
-      double* s = &sums[static_cast<std::size_t>(nodes[e] / kChunk) * 4];
-      for (std::size_t r = 0; r < 4; ++r) s[r] += values[4 * e + r];
-    }
-    for (std::int64_t b = 0; b < chunks; ++b) {
-      for (std::size_t d = 0; d < 3; ++d) totals[3 * k + d] += sums[static_cast<std::size_t>(b) * 4 + d];
-      totals[3 * K] += sums[static_cast<std::size_t>(b) * 4 + 3];
-    }
-  }
-  dec.broadcast(totals);
-  force_on_body.assign(K, {0.0, 0.0, 0.0});
-  for (std::size_t k = 0; k < K; ++k)
-    for (std::size_t d = 0; d < 3; ++d) force_on_body[k][d] = totals[3 * k + d];
-  return totals[3 * K];
+  // The owned nodes' exact sums, then every rank's added exactly (one MPI_Allreduce): the serial bits.
+  std::vector<ExactSum> sums = indenter_sums(model_, t, u, f, &dec.piece().owned_local);
+  dec.reduce(sums.data(), static_cast<int>(sums.size()));
+  return indenter_results(sums, force_on_body);
 }
 
 }  // namespace pd

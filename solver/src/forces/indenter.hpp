@@ -57,14 +57,13 @@ class IndenterForce {
  public:
   explicit IndenterForce(const Model& model) : model_(model) {}
   // f_i += K·h_i²·n_i for every node inside every indenter. force_on_body[k] = Σ_i V_i·K h_i² n_i
-  // [N], the force indenter k exerts on the body (its reaction is the negative), summed in fixed
-  // chunks of nodes so that it does not depend on the thread count. Returns the potential
-  // Σ_k Σ_i V_i·K h_i³/3 [J] (−d/dh of it is the force).
+  // [N], the force indenter k exerts on the body (its reaction is the negative), summed exactly
+  // (core/exact_sum.hpp) so that it does not depend on the thread count. Returns the potential
+  // Σ_k Σ_i V_i·K h_i³/3 [J] (−d/dh of it is the force), summed exactly over all indenters.
   double AddMult(double t, const Vec3Array& u, Vec3Array& f, std::vector<std::array<double, 3>>& force_on_body) const;
   // The same on a decomposed run (issue 15; the model a rank's piece): f of the owned nodes, and
-  // force_on_body and the potential of the whole body, the serial sums' bits on every rank — the
-  // owned nodes inside an indenter send their terms to rank 0 (Decomposed::gather_entries), which
-  // sums them in the serial chunks of global node numbers and broadcasts. Collective.
+  // force_on_body and the potential of the whole body, the serial sums' bits on every rank: each
+  // rank's exact sums over its owned nodes, added across the ranks (Decomposed::reduce). Collective.
   double AddMult(double t, const Vec3Array& u, Vec3Array& f, std::vector<std::array<double, 3>>& force_on_body,
                  const Decomposed& d) const;
   // y += ∂f/∂u·x at (u, t): the stiffness of the push, 2K·h along n, and for a curved surface the

@@ -133,9 +133,9 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
         correction_[static_cast<std::size_t>(i)] = std::sqrt(dc);
         motion_[static_cast<std::size_t>(i)] = std::sqrt(dm);
       }
-      // Two sums in node order (each independent of the other), through the one reduction over
-      // nodes: on a decomposed run the serial sums' bits on every rank (ghosts left out), so every
-      // rank accepts or rejects alike.
+      // Two exact sums (each independent of the other), through the one reduction over nodes: on
+      // a decomposed run the serial sums' bits on every rank (ghosts left out), so every rank
+      // accepts or rejects alike.
       const double c = sum_over_nodes(op_.decomposed(), correction_.size(), [&](std::size_t i) { return correction_[i]; });
       const double m = sum_over_nodes(op_.decomposed(), motion_.size(), [&](std::size_t i) { return motion_[i]; });
       if (!std::isfinite(c) || !std::isfinite(m)) {

@@ -149,8 +149,8 @@ bool Implicit::factorize_at(const State& s, double t1, double h, bool definite) 
 double Implicit::residual(const State& start, const State& s, double h, double& scale) {
   const auto& volume = op_.model().nodes.volume;
   const double alpha = op_.damping(), am = ga_.alpha_m, af = ga_.alpha_f, beta = ga_.beta, gamma = ga_.gamma;
-  // Σ r², Σ inertia², Σ force² one by one in dof order (over the ranks: parallel/dof_sums.hpp): the
-  // same for any thread and rank count.
+  // Σ r², Σ inertia², Σ force², exactly (over the ranks: parallel/dof_sums.hpp): the same for any
+  // thread and rank count.
   for (std::size_t q = 0; q < dofs_.size(); ++q) {
     const auto i = static_cast<std::size_t>(dofs_.node[q]);
     const std::size_t d = dofs_.component[q];

@@ -12,6 +12,7 @@
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
+#include "core/exact_sum.hpp"
 #include "integrators/messages.hpp"
 #include "integrators/newton_krylov.hpp"
 
@@ -234,8 +235,8 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
 
 double QuasiStatic::residual_norm(const State& s) const {
   const auto& volume = op_.model().nodes.volume;
-  // Σ r_k² one by one in dof order (over the ranks: parallel/dof_sums.hpp): the same bits for any
-  // thread and rank count.
+  // Σ r_k², exactly (over the ranks: parallel/dof_sums.hpp): the same bits for any thread and rank
+  // count.
   terms_.resize(dofs_.size());
   for (std::size_t k = 0; k < dofs_.size(); ++k) {
     const auto i = static_cast<std::size_t>(dofs_.node[k]);
@@ -251,15 +252,17 @@ double QuasiStatic::load_scale(const State& s, double t) const {
   const Model& m = op_.model();
   const Decomposed* d = op_.decomposed();
   double sum = 0.0;
-  // One condition's Σ r², continuing the sum: serially node by node in the condition's order, and
-  // decomposed as an ordered sum over the owned nodes (node order, as ForceOperator's powers).
+  // One condition's Σ r², continuing the sum: an exact sum (core/exact_sum.hpp) over the
+  // condition's nodes, serially, or over the owned ones and the ranks (as ForceOperator's powers).
   std::vector<double> term(d ? s.size() : 0);
   const auto add = [&](const std::vector<std::int32_t>& nodes, const auto& r_of) {
     if (!d) {
+      ExactSum exact(sum);
       for (std::int32_t i32 : nodes) {
         const double r = r_of(static_cast<std::size_t>(i32));
-        sum += r * r;
+        exact.add(r * r);
       }
+      sum = exact.value();
       return;
     }
     std::fill(term.begin(), term.end(), 0.0);
@@ -267,7 +270,7 @@ double QuasiStatic::load_scale(const State& s, double t) const {
       const double r = r_of(static_cast<std::size_t>(i32));
       term[static_cast<std::size_t>(i32)] = r * r;
     }
-    sum = d->ordered_sum(term, sum);
+    sum = d->exact_sum(term, sum);
   };
   for (const auto& p : m.conditions.prescribed)
     add(p.nodes, [&](std::size_t i) { return m.nodes.volume[i] * s.f[static_cast<std::size_t>(p.component)][i]; });
@@ -467,7 +470,7 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       }
       alpha *= 0.5;
     }
-    // Σ Δu² and Σ (u − u_n)² one by one in dof order (over the ranks: parallel/dof_sums.hpp).
+    // Σ Δu² and Σ (u − u_n)², exactly (over the ranks: parallel/dof_sums.hpp).
     terms_.resize(dofs_.size());
     motion_terms_.resize(dofs_.size());
     for (std::size_t q = 0; q < dofs_.size(); ++q) {

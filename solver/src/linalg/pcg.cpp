@@ -89,10 +89,6 @@ double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& 
   return chunked_sum(static_cast<std::int64_t>(a.size()), [&](std::size_t k) { return a[k] * b[k]; });
 }
 
-double fixed_order_sum(const std::vector<double>& terms) {
-  return chunked_sum(static_cast<std::int64_t>(terms.size()), [&](std::size_t k) { return terms[k]; });
-}
-
 void BlockJacobi::build(const std::vector<std::int64_t>& first, const std::vector<double>& blocks) {
   first_ = first;
   const auto groups = static_cast<std::int64_t>(first.empty() ? 0 : first.size() - 1);

@@ -22,10 +22,6 @@ using LinearOperator = std::function<void(const std::vector<double>& x, std::vec
 
 // Σ a_k b_k in the fixed order above (OpenMP over the chunks).
 double fixed_order_dot(const std::vector<double>& a, const std::vector<double>& b);
-// Σ t_k in the same order: fixed_order_dot(a, b) == fixed_order_sum(a ⊙ b) bit for bit (the products
-// are rounded alike: no FMA contraction in the baseline x86-64 build). A decomposed run sums its
-// gathered products with it (parallel/dof_sums.hpp).
-double fixed_order_sum(const std::vector<double>& terms);
 
 // M⁻¹ for M = blockdiag(M_1, …, M_n): block g covers the unknowns first[g] … first[g+1]−1 (1 to 3 of
 // them: a node's free components, numbered together by FreeDofs). Each block is inverted once, by

@@ -58,8 +58,8 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
     std::vector<double> lost(s.size(), 0.0);
     report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost.data());
     report.broken = decomposed_->total(report.broken);
-    // The energy the broken bonds held, summed per node in node order as the serial path sums it.
-    if (report.broken > 0) report.energy = decomposed_->ordered_sum(lost);
+    // The energy the broken bonds held, summed exactly over the nodes as the serial path sums it.
+    if (report.broken > 0) report.energy = decomposed_->exact_sum(lost);
   }
   s.contact_energy = 0.0;
   s.indenter_energy = 0.0;
@@ -70,13 +70,13 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
 BreakReport ForceOperator::break_bonds(State& s) {
   if (!decomposed_) return model_.bond_model->break_bonds(model_, s.u, true);
   // The breaking of break_bonds_and_evaluate into scratch force arrays: the same flags as the law's
-  // break_bonds (bond_model.hpp), with each node's share of the lost energy kept for the ordered sum.
+  // break_bonds (bond_model.hpp), with each node's share of the lost energy kept for the exact sum.
   decomposed_->update_ghosts(s.u);
   Vec3Array f = make_vec3(s.size());
   std::vector<double> w(s.size(), 0.0), lost(s.size(), 0.0);
   BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, f, w.data(), true, lost.data());
   report.broken = decomposed_->total(report.broken);
-  report.energy = report.broken > 0 ? decomposed_->ordered_sum(lost) : 0.0;
+  report.energy = report.broken > 0 ? decomposed_->exact_sum(lost) : 0.0;
   return report;
 }
 
@@ -318,17 +318,19 @@ double ForceOperator::external_power(const State& s, double t) const {
   for (const auto& bc : model_.conditions.prescribed) {
     const auto c = static_cast<std::size_t>(bc.component);
     const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;
+    ExactSum sum(p);  // one exact sum per condition, continuing the last (as decomposed_external_power)
     for (std::int32_t i32 : bc.nodes) {
       const auto i = static_cast<std::size_t>(i32);
       const double reaction = model_.density[i] * a - s.f[c][i];  // force density the support applies
-      p += model_.nodes.volume[i] * reaction * s.v[c][i];
+      sum.add(model_.nodes.volume[i] * reaction * s.v[c][i]);
     }
+    p = sum.value();
   }
   return p;
 }
 
-// The serial loops of external_power and damping_power, one ordered sum per loop, each continuing
-// the last (parallel/decomposed.hpp): the same additions in the same order, so the same bits.
+// The serial loops of external_power and damping_power, one exact sum per loop, each continuing
+// the last (parallel/decomposed.hpp): the same exact sums rounded at the same places, so the same bits.
 double ForceOperator::decomposed_external_power(const State& s, double t) const {
   // The force terms' powers first, in power order, each reduced by the term itself (it knows the
   // decomposition: ForceTerm::set_decomposed), then the supports' loops.
@@ -344,7 +346,7 @@ double ForceOperator::decomposed_external_power(const State& s, double t) const 
       const double reaction = model_.density[i] * a - s.f[c][i];
       term[i] = model_.nodes.volume[i] * reaction * s.v[c][i];
     }
-    p = decomposed_->ordered_sum(term, p);
+    p = decomposed_->exact_sum(term, p);
   }
   return p;
 }
@@ -357,7 +359,7 @@ double ForceOperator::decomposed_damping_power(const State& s) const {
   for (std::size_t d = 0; d < 3; ++d) {
     for (std::size_t i = 0; i < term.size(); ++i)
       term[i] = m.conditions.fixed[d][i] ? 0.0 : m.density[i] * m.nodes.volume[i] * s.v[d][i] * s.v[d][i];
-    p = decomposed_->ordered_sum(term, p);
+    p = decomposed_->exact_sum(term, p);
   }
   return model_.damping * p;
 }

@@ -1,7 +1,7 @@
 // What the operator asks of a decomposed run (issue 15), without naming MPI: fill the ghosts of a
-// per-node array before a sweep, and sum per-node values in an order that does not depend on the
+// per-node array before a sweep, and sum per-node values exactly, so the sum does not depend on the
 // decomposition. parallel/mpi_decomposed implements it with MPI; a serial run has none (null), and
-// parallel/node_sum.hpp then sums in node order exactly as before.
+// parallel/node_sum.hpp then sums the same terms with the same exact sum.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/bonds.hpp"
+#include "core/exact_sum.hpp"
 #include "core/nodes.hpp"
 
 namespace pd {
@@ -32,13 +33,15 @@ class Decomposed {
   virtual void update_ghosts(Vec3Array& a) const = 0;
   // The same for a scalar per node (LPS's P_i between its two sweeps).
   virtual void update_ghosts(std::vector<double>& a) const = 0;
-  // start + Σ over owned local nodes of per_node[l], added one by one in global node order (the
-  // serial sum's order), the same on every rank: bitwise the serial result for any rank count.
-  // Entries of ghosts are ignored. start lets a serial sum that runs through several loops (over
-  // components, over conditions) be continued loop by loop. A node the serial loop skips may enter
-  // as +0.0: a sum that starts at +0.0 never becomes −0.0, and x + (+0.0) = x for any other x, so
-  // the bits are those of skipping it. Collective: every rank calls it.
-  virtual double ordered_sum(const std::vector<double>& per_node, double start = 0.0) const = 0;
+  // start + Σ over owned local nodes of per_node[l], summed exactly (core/exact_sum.hpp) and rounded
+  // once, the same on every rank: the bits do not depend on the rank or thread count, and equal
+  // the serial exact sum (parallel/node_sum.hpp) of the whole model's terms. Entries of ghosts are
+  // ignored; a node that no term concerns may enter as 0.0, which adds nothing. Collective: every
+  // rank calls it (one MPI_Allreduce of ExactSum::kLimbs int64).
+  virtual double exact_sum(const std::vector<double>& per_node, double start = 0.0) const = 0;
+  // sums[0 … count) = the sums over all ranks of every rank's sums[0 … count), exactly (one
+  // MPI_Allreduce). Collective.
+  virtual void reduce(ExactSum* sums, int count) const = 0;
   // Σ over ranks of an integer (exact, so the order does not matter). Collective.
   virtual std::int64_t total(std::int64_t local) const = 0;
   // The least of the ranks' values (exact, so the order does not matter). Collective.
@@ -57,12 +60,6 @@ class Decomposed {
   // The same for `width` values per node (local node l's at width·l …), in one message per rank:
   // on rank 0 width × (global nodes) values, node g's at width·g … (empty elsewhere). Collective.
   virtual std::vector<double> gather(const std::vector<double>& per_node, int width) const = 0;
-  // Entries of owned nodes from every rank — entry e is node global_node[e] with the `width` values
-  // values[width·e …] — merged on rank 0 in ascending global node order (empty elsewhere): for a sum
-  // over a few nodes (those inside an indenter) that rank 0 then takes in the serial loop's order.
-  // A node is given by its owner only, so it appears once. Collective.
-  virtual void gather_entries(const std::vector<std::int32_t>& global_node, const std::vector<double>& values,
-                              int width, std::vector<std::int32_t>& all_nodes, std::vector<double>& all_values) const = 0;
   // values = rank 0's values on every rank (the same size everywhere). Collective.
   virtual void broadcast(std::vector<double>& values) const = 0;
   // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
@@ -97,12 +94,13 @@ class Decomposed {
   // step of `steps`, like traffic_report. Collective; the lines on rank 0 (empty elsewhere).
   virtual std::vector<std::string> contact_traffic_report(std::int64_t steps) const = 0;
 
-  // What this rank's communication has cost so far (issue 15's per-step measures): halo exchanges
-  // and ordered sums/gathers, with their wall time.
+  // What this rank's communication has cost so far (issue 15's per-step measures): halo exchanges,
+  // exact sums and gathers, with their wall time.
   struct Traffic {
     std::int64_t halo_exchanges = 0, halo_messages = 0, halo_bytes = 0;  // sent by this rank
-    std::int64_t reductions = 0, reduction_bytes = 0;                    // ordered sums and gathers, sent to rank 0
-    double halo_seconds = 0.0, reduction_seconds = 0.0;                  // wall time inside MPI calls and packing
+    std::int64_t reductions = 0, reduction_bytes = 0;  // exact sums: MPI_Allreduce calls and the bytes of their accumulators
+    std::int64_t gathers = 0, gather_bytes = 0;        // gathers to rank 0 (frames, history, setup): calls and bytes sent
+    double halo_seconds = 0.0, reduction_seconds = 0.0;  // wall time inside MPI calls and packing (reductions: sums and gathers)
   };
   virtual Traffic traffic() const = 0;
   // run.log's lines on the decomposed run's communication: per rank, per step of `steps`, the

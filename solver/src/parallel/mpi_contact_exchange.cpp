@@ -108,19 +108,15 @@ std::vector<std::string> MpiDecomposed::contact_traffic_report(std::int64_t step
                                 static_cast<double>(t.box_bytes) * per, static_cast<double>(t.halo_exchanges) * per,
                                 static_cast<double>(t.halo_messages) * per, static_cast<double>(t.halo_bytes) * per,
                                 t.seconds * per};
-  const std::vector<double> all = rows_on_rank_0(row, kColumns);
-  std::vector<std::string> lines;
-  for (int r = 0; r < ranks() && rank_ == 0; ++r) {
-    const double* v = &all[static_cast<std::size_t>(kColumns * r)];
+  return lines_on_rank_0(row, kColumns, [](int r, const double* v) {
     char line[512];
     std::snprintf(line, sizeof line,
                   "rank %d contact: %.0f contact ghosts not among the bond ghosts (last list); per step: %.3g box "
                   "exchanges sending %.4g bytes, %.3g contact halo exchanges, %.3g messages and %.4g bytes sent, "
                   "%.4g ms in communication",
                   r, v[0], v[1], v[2], v[3], v[4], v[5], 1e3 * v[6]);
-    lines.emplace_back(line);
-  }
-  return lines;
+    return std::string(line);
+  });
 }
 
 }  // namespace pd

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
+#include <string>
 
 #include "core/cracks.hpp"
 
@@ -51,6 +53,33 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
   }
 }
 
+double MpiDecomposed::exact_sum(const std::vector<double>& per_node, double start) const {
+  ExactSum sum;
+  for (std::int32_t l : piece_.owned_local) sum.add(per_node[static_cast<std::size_t>(l)]);
+  reduce(&sum, 1);
+  sum.add(start);  // once, after the ranks' sums: start is the same on every rank
+  return sum.value();
+}
+
+void MpiDecomposed::reduce(ExactSum* sums, int count) const {
+  const double start = MPI_Wtime();
+  const auto limbs = static_cast<std::size_t>(ExactSum::kLimbs);
+  limbs_.resize(limbs * static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    sums[k].normalise();  // digits in [0, 2^32): the ranks' limbs add without overflow (core/exact_sum.hpp)
+    std::copy(sums[k].limbs(), sums[k].limbs() + limbs, limbs_.begin() + static_cast<std::ptrdiff_t>(limbs * static_cast<std::size_t>(k)));
+  }
+  MPI_Allreduce(MPI_IN_PLACE, limbs_.data(), static_cast<int>(limbs_.size()), MPI_INT64_T, MPI_SUM, comm_);
+  for (int k = 0; k < count; ++k) {
+    std::copy(limbs_.begin() + static_cast<std::ptrdiff_t>(limbs * static_cast<std::size_t>(k)),
+              limbs_.begin() + static_cast<std::ptrdiff_t>(limbs * static_cast<std::size_t>(k + 1)), sums[k].limbs());
+    sums[k].normalise();
+  }
+  ++reductions_;
+  reduction_bytes_ += static_cast<std::int64_t>(8 * limbs_.size());
+  reduction_seconds_ += MPI_Wtime() - start;
+}
+
 std::int64_t MpiDecomposed::total(std::int64_t local) const {
   std::int64_t sum = 0;
   MPI_Allreduce(&local, &sum, 1, MPI_INT64_T, MPI_SUM, comm_);
@@ -80,16 +109,21 @@ Decomposed::Traffic MpiDecomposed::traffic() const {
   t.halo_messages = halo_->exchanges() * halo_->messages_sent();
   t.halo_bytes = halo_->exchanges() * halo_->bytes_sent();
   t.halo_seconds = halo_->seconds();
-  t.reductions = sum_->calls();
-  t.reduction_bytes = sum_->bytes_sent();
-  t.reduction_seconds = sum_->seconds();
+  t.reductions = reductions_;
+  t.reduction_bytes = reduction_bytes_;
+  t.gathers = sum_->calls();
+  t.gather_bytes = sum_->bytes_sent();
+  t.reduction_seconds = reduction_seconds_ + sum_->seconds();
   return t;
 }
 
-std::vector<double> MpiDecomposed::rows_on_rank_0(const double* row, int columns) const {
+std::vector<std::string> MpiDecomposed::lines_on_rank_0(const double* row, int columns,
+                                                        const std::function<std::string(int, const double*)>& line) const {
   std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(columns * ranks()) : 0);
   MPI_Gather(row, columns, MPI_DOUBLE, all.data(), columns, MPI_DOUBLE, 0, comm_);
-  return all;
+  std::vector<std::string> lines;
+  for (int r = 0; r < ranks() && rank_ == 0; ++r) lines.push_back(line(r, &all[static_cast<std::size_t>(columns * r)]));
+  return lines;
 }
 
 std::vector<std::string> MpiDecomposed::traffic_report(std::int64_t steps) const {
@@ -97,56 +131,24 @@ std::vector<std::string> MpiDecomposed::traffic_report(std::int64_t steps) const
   getrusage(RUSAGE_SELF, &usage);  // ru_maxrss: this process's (this rank's) peak resident set, in KiB on Linux
   const Traffic t = traffic();
   const double per = 1.0 / static_cast<double>(std::max<std::int64_t>(steps, 1));
-  constexpr int kColumns = 10;
+  constexpr int kColumns = 12;
   const double row[kColumns] = {static_cast<double>(piece_.owned_local.size()), static_cast<double>(piece_.ghost_local.size()),
                                 static_cast<double>(t.halo_exchanges) * per, static_cast<double>(t.halo_messages) * per,
                                 static_cast<double>(t.halo_bytes) * per, static_cast<double>(t.reductions) * per,
-                                static_cast<double>(t.reduction_bytes) * per, t.halo_seconds * per, t.reduction_seconds * per,
+                                static_cast<double>(t.reduction_bytes) * per, static_cast<double>(t.gathers) * per,
+                                static_cast<double>(t.gather_bytes) * per, t.halo_seconds * per, t.reduction_seconds * per,
                                 static_cast<double>(usage.ru_maxrss) / 1024.0};
-  const std::vector<double> all = rows_on_rank_0(row, kColumns);
-  std::vector<std::string> lines;
-  for (int r = 0; r < ranks() && rank_ == 0; ++r) {
-    const double* v = &all[static_cast<std::size_t>(kColumns * r)];
-    char line[512];
+  return lines_on_rank_0(row, kColumns, [](int r, const double* v) {
+    char line[640];
     std::snprintf(line, sizeof line,
                   "rank %d: %.0f owned nodes, %.0f ghosts (%.3f per owned node); per step: %.2g halo exchanges, "
-                  "%.3g messages and %.4g bytes sent, %.3g ordered sums/gathers sending %.4g bytes to rank 0, "
-                  "%.4g ms in communication (halo %.4g ms, sums %.4g ms); peak memory %.1f MB",
-                  r, v[0], v[1], v[1] / std::max(v[0], 1.0), v[2], v[3], v[4], v[5], v[6], 1e3 * (v[7] + v[8]), 1e3 * v[7],
-                  1e3 * v[8], v[9]);
-    lines.emplace_back(line);
-  }
-  return lines;
-}
-
-void MpiDecomposed::gather_entries(const std::vector<std::int32_t>& global_node, const std::vector<double>& values,
-                                   int width, std::vector<std::int32_t>& all_nodes, std::vector<double>& all_values) const {
-  const int ranks = this->ranks();
-  const int mine = static_cast<int>(global_node.size());
-  std::vector<int> counts(static_cast<std::size_t>(ranks), 0), starts(static_cast<std::size_t>(ranks) + 1, 0);
-  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
-  for (int r = 0; r < ranks; ++r) starts[static_cast<std::size_t>(r) + 1] = starts[static_cast<std::size_t>(r)] + counts[static_cast<std::size_t>(r)];
-  std::vector<std::int32_t> nodes(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
-  MPI_Gatherv(global_node.data(), mine, MPI_INT32_T, nodes.data(), counts.data(), starts.data(), MPI_INT32_T, 0, comm_);
-  std::vector<int> value_counts(counts.size()), value_starts(starts.size());
-  for (std::size_t r = 0; r < counts.size(); ++r) value_counts[r] = width * counts[r];
-  for (std::size_t r = 0; r < starts.size(); ++r) value_starts[r] = width * starts[r];
-  std::vector<double> gathered(rank_ == 0 ? static_cast<std::size_t>(value_starts.back()) : 0);
-  MPI_Gatherv(values.data(), width * mine, MPI_DOUBLE, gathered.data(), value_counts.data(), value_starts.data(),
-              MPI_DOUBLE, 0, comm_);
-  all_nodes.clear();
-  all_values.clear();
-  if (rank_ != 0) return;
-  // Each rank's entries ascend; sorting the entry numbers by node merges them (nodes are distinct).
-  std::vector<std::size_t> order(nodes.size());
-  for (std::size_t e = 0; e < order.size(); ++e) order[e] = e;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return nodes[a] < nodes[b]; });
-  const auto w = static_cast<std::size_t>(width);
-  for (std::size_t e : order) {
-    all_nodes.push_back(nodes[e]);
-    all_values.insert(all_values.end(), gathered.begin() + static_cast<std::ptrdiff_t>(w * e),
-                      gathered.begin() + static_cast<std::ptrdiff_t>(w * (e + 1)));
-  }
+                  "%.3g messages and %.4g bytes sent, %.3g exact sums (MPI_Allreduce of %.4g bytes), %.3g gathers "
+                  "sending %.4g bytes to rank 0, %.4g ms in communication (halo %.4g ms, sums and gathers %.4g ms); "
+                  "peak memory %.1f MB",
+                  r, v[0], v[1], v[1] / std::max(v[0], 1.0), v[2], v[3], v[4], v[5], v[6], v[7], v[8],
+                  1e3 * (v[9] + v[10]), 1e3 * v[9], 1e3 * v[10], v[11]);
+    return std::string(line);
+  });
 }
 
 void MpiDecomposed::broadcast(std::vector<double>& values) const {

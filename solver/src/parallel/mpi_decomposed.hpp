@@ -1,9 +1,11 @@
 // A decomposed run on MPI's ranks (issue 15): the decomposition, this rank's piece, its halo
-// exchange and the ordered sums, behind the Decomposed interface the operator calls.
+// exchange, the exact sums and the gathers, behind the Decomposed interface the operator calls.
 #pragma once
 #include <mpi.h>
 
+#include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/model.hpp"
@@ -36,9 +38,8 @@ class MpiDecomposed : public Decomposed {
 
   void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
   void update_ghosts(std::vector<double>& a) const override { halo_->exchange(a); }
-  double ordered_sum(const std::vector<double>& per_node, double start = 0.0) const override {
-    return sum_->sum(per_node, start);
-  }
+  double exact_sum(const std::vector<double>& per_node, double start = 0.0) const override;
+  void reduce(ExactSum* sums, int count) const override;
   std::int64_t total(std::int64_t local) const override;
   double minimum(double local) const override;
 
@@ -47,8 +48,6 @@ class MpiDecomposed : public Decomposed {
   std::vector<double> gather(const std::vector<double>& per_node, int width) const override {
     return sum_->gather(per_node, width);
   }
-  void gather_entries(const std::vector<std::int32_t>& global_node, const std::vector<double>& values, int width,
-                      std::vector<std::int32_t>& all_nodes, std::vector<double>& all_values) const override;
   void broadcast(std::vector<double>& values) const override;
   void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
   std::string broadcast(const std::string& bytes_on_rank_0) const override;
@@ -74,14 +73,19 @@ class MpiDecomposed : public Decomposed {
   const ContactTraffic& contact_traffic() const { return *contact_traffic_; }
 
  private:
-  // Every rank's `columns` values, rank after rank, on rank 0 (empty elsewhere): run.log's lines. Collective.
-  std::vector<double> rows_on_rank_0(const double* row, int columns) const;
+  // run.log's per-rank lines: every rank's `columns` values gathered on rank 0 and written there by
+  // line(rank, its values), rank after rank (empty elsewhere). Collective.
+  std::vector<std::string> lines_on_rank_0(const double* row, int columns,
+                                           const std::function<std::string(int, const double*)>& line) const;
   MPI_Comm comm_;
   int rank_ = 0;
   Decomposition decomposition_;
   LocalPiece piece_;
   std::unique_ptr<HaloExchange> halo_;
-  std::unique_ptr<OrderedSum> sum_;
+  std::unique_ptr<OrderedSum> sum_;  // the gathers to rank 0
+  mutable std::vector<std::int64_t> limbs_;  // reduce's buffer
+  mutable std::int64_t reductions_ = 0, reduction_bytes_ = 0;
+  mutable double reduction_seconds_ = 0.0;
   std::unique_ptr<ContactTraffic> contact_traffic_ = std::make_unique<ContactTraffic>();  // shared with the halos made
 };
 

@@ -1,26 +1,29 @@
 // The one reduction over nodes (design.md "next shape"): every sum over nodes that the operator
-// reports (energies, powers) goes through here, so its order never depends on threads or ranks.
-// Serial (d == null): term(i) summed in node order, one by one — the code every such sum had
-// before, so serial results keep their bits. Decomposed: the terms of the owned nodes are summed in
-// global node order by Decomposed::ordered_sum — the same bits as the serial sum.
+// reports (energies, powers, norms) goes through here, so its bits never depend on threads or
+// ranks. The terms are summed exactly (core/exact_sum.hpp) and rounded once: serially (d == null)
+// over all nodes, decomposed over each rank's owned nodes and then across the ranks
+// (Decomposed::exact_sum) — the same exact value, so the same bits, for any rank and thread count.
 #pragma once
 #include <cstddef>
 #include <vector>
 
+#include "core/exact_sum.hpp"
 #include "parallel/decomposed.hpp"
 
 namespace pd {
 
+// Σ_i term(i) over the n local nodes (the owned ones on a decomposed run), exactly, rounded once.
+// Collective on a decomposed run.
 template <class Term>
 double sum_over_nodes(const Decomposed* d, std::size_t n, Term term) {
   if (!d) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < n; ++i) sum += term(i);
-    return sum;
+    ExactSum sum;
+    for (std::size_t i = 0; i < n; ++i) sum.add(term(i));
+    return sum.value();
   }
   std::vector<double> per_node(n);
   for (std::size_t i = 0; i < n; ++i) per_node[i] = term(i);
-  return d->ordered_sum(per_node);
+  return d->exact_sum(per_node);
 }
 
 }  // namespace pd

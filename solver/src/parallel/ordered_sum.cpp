@@ -1,4 +1,4 @@
-// Rank-count-independent sums and gathers over nodes (parallel/ordered_sum.hpp).
+// Gathers of per-node values to rank 0 in global node order (parallel/ordered_sum.hpp).
 #include "parallel/ordered_sum.hpp"
 
 namespace pd {
@@ -136,17 +136,6 @@ void OrderedSum::gather_lines(const BondList& local, const std::vector<std::int3
     const auto g = static_cast<std::size_t>(g32);
     for (std::int64_t k = lines.offsets[g]; k < lines.offsets[g + 1]; ++k) lines.neighbour[static_cast<std::size_t>(k)] = all[at++];
   }
-}
-
-double OrderedSum::sum(const std::vector<double>& per_node, double start) const {
-  double total = start;
-  const std::vector<double> ordered = gather(per_node);
-  if (rank_ == 0)
-    for (double term : ordered) total += term;  // one by one in node order: the serial loop's bits
-  const double bcast_start = MPI_Wtime();
-  MPI_Bcast(&total, 1, MPI_DOUBLE, 0, comm_);
-  seconds_ += MPI_Wtime() - bcast_start;
-  return total;
 }
 
 }  // namespace pd

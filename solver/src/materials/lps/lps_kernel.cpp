@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/exact_sum.hpp"
 #include "materials/lps/lps_kernel.hpp"
 #include "parallel/decomposed.hpp"
 
@@ -266,7 +267,7 @@ BreakReport LpsModel::break_bonds_and_add_force(Model& model, const Vec3Array& u
     return r;
   }
   if (r.broken > 0)
-    for (double e : lost) r.energy += e;  // serially in node order: the same for any thread count
+    r.energy += exact_sum(lost);  // exact (core/exact_sum.hpp): the same for any thread and rank count
   return r;
 }
 
@@ -278,7 +279,7 @@ BreakReport LpsModel::break_bonds(Model& model, const Vec3Array& u, bool want_en
   const Breaking br = breaking_of(model, want_energy ? lost.data() : nullptr);
   r.broken = dilatation_sweep(k, &br, theta, p);
   if (r.broken > 0)
-    for (double e : lost) r.energy += e;
+    r.energy += exact_sum(lost);
   return r;
 }
 

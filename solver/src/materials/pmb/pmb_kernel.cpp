@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/exact_sum.hpp"
+
 namespace pd {
 
 PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
@@ -227,7 +229,7 @@ std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
 #pragma omp parallel for schedule(static) reduction(+ : newly)
   for (std::int64_t i = 0; i < a.nodes; ++i) break_row(a, br, i, newly);
   if (energy && newly > 0)
-    for (double e : lost) *energy += e;
+    *energy += exact_sum(lost);  // exact (core/exact_sum.hpp): the decomposed run's bits too
   return newly;
 }
 
@@ -246,7 +248,7 @@ std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Arr
   const PmbBreaking br = pmb_breaking(m, broken_energy ? lost.data() : nullptr);
   const std::int64_t newly = add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br);
   if (broken_energy && newly > 0)
-    for (double e : lost) *broken_energy += e;  // serially in node order, as update_broken_bonds
+    *broken_energy += exact_sum(lost);  // exact, as update_broken_bonds
   return newly;
 }
 
@@ -320,7 +322,7 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
   }
   if (node_rule) m.node_critical_stretch.swap(s0_next);  // every row read the previous s0 above
   if (broken_energy && !lost_per_node && newly > 0)
-    for (double e : lost) *broken_energy += e;  // serially in node order, as update_broken_bonds
+    *broken_energy += exact_sum(lost);  // exact, as update_broken_bonds
   return newly;
 }
 
