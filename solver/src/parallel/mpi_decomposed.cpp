@@ -155,7 +155,11 @@ void MpiDecomposed::broadcast(std::vector<double>& values) const {
   MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, 0, comm_);
 }
 
-std::vector<double> MpiDecomposed::per_rank(double value) const { return rows_on_rank_0(&value, 1); }
+std::vector<double> MpiDecomposed::per_rank(double value) const {
+  std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(ranks()) : 0);
+  MPI_Gather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, 0, comm_);
+  return all;
+}
 
 void MpiDecomposed::gather_broken_lines(const BondList& local, BondList& lines) const {
   sum_->gather_lines(local, piece_.global, lines);
