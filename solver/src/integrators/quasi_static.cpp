@@ -435,10 +435,8 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     if (k > 1 && omega <= settings_.tol && (residual <= settings_.residual_tol * load || residual >= 0.5 * previous))
       return true;
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
-    // Reuse the factorisation while it keeps the residual falling fast; else assemble anew. (Also
-    // when the residual is already within its tolerance and only ω is above TOL: an old factor then
-    // reduces ω only linearly, and skipping the refactorisation there made traction/quasi_static.yaml
-    // fail at 1.374 ms, after the snap.)
+    // Reuse the factorisation while it keeps the residual falling fast; else assemble anew (also
+    // when only ω is above TOL: an old factor then reduces ω only linearly).
     if (!use_cg_ && (!have_factor_ || residual > 0.25 * previous)) {
       // Once bonds have broken, a node or a fragment may hang by nothing: its rows are zero and K
       // is singular although the residual does not drive it. A shift of the diagonal by
