@@ -149,7 +149,7 @@ void QuasiStatic::set_up_amg(const State& s, double t1) {
   const auto start = std::chrono::steady_clock::now();
   // The definite variant, shifted: positive definite even with compressed bonds and loose nodes.
   SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, true);
-  shift_diagonal(K);
+  amg_shift_ = shift_diagonal(K);
   amg_.set_up(K, op_.model().nodes.dimension, dofs_.component);
   ++amg_setups_;
   amg_u_ = s.u;
@@ -175,13 +175,16 @@ void QuasiStatic::initialize(State& state, double t) {
   }
   trial_ = State(state.size());
   report_ = StepReport{};
+  carried_load_ = 0.0;
+  started_cold_ = false;
   if (use_cg_) {
     cg_x_ = make_vec3(state.size());
     cg_y_ = make_vec3(state.size());
   }
 }
 
-bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
+// Block-Jacobi of K's 3×3 node blocks at (s, t1), shifted after bonds have broken; returns the shift.
+double QuasiStatic::build_block_jacobi(const State& s, double t1) {
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
     // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG.
     block_first_.clear();
@@ -202,12 +205,22 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
     for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
       for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a) blocks_[9 * g + static_cast<std::size_t>(4 * a)] += shift;
   }
+  preconditioner_.build(block_first_, blocks_);
+  return shift;
+}
+
+bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
+  double shift = 0.0;
   const Preconditioner* M = &preconditioner_;
   if (use_amg_) {
+    // AMG never reads block-Jacobi's 3×3 blocks: they are not assembled. After bonds have broken
+    // the operator's shift is the one the hierarchy was set up with (kDiagonalShift × the largest
+    // diagonal entry of its K): a regularisation, which any fixed one of that size serves.
     if (!amg_.ready()) set_up_amg(s, t1);
     M = &amg_;
+    if (broken_since_start_) shift = amg_shift_;
   } else {
-    preconditioner_.build(block_first_, blocks_);
+    shift = build_block_jacobi(s, t1);
   }
   PcgSettings settings;
   settings.relative_tol = eta;
@@ -281,7 +294,7 @@ double QuasiStatic::load_scale(const State& s, double t) const {
   return std::sqrt(sum);
 }
 
-void QuasiStatic::shift_diagonal(SparseMatrix& K) const {
+double QuasiStatic::shift_diagonal(SparseMatrix& K) const {
   double largest = 0.0;
   for (std::int64_t r = 0; r < K.rows; ++r)
     for (std::int64_t q = K.row_start[static_cast<std::size_t>(r)]; q < K.row_start[static_cast<std::size_t>(r) + 1]; ++q)
@@ -289,6 +302,7 @@ void QuasiStatic::shift_diagonal(SparseMatrix& K) const {
   for (std::int64_t r = 0; r < K.rows; ++r)
     for (std::int64_t q = K.row_start[static_cast<std::size_t>(r)]; q < K.row_start[static_cast<std::size_t>(r) + 1]; ++q)
       if (K.column[static_cast<std::size_t>(q)] == r) K.value[static_cast<std::size_t>(q)] += kDiagonalShift * largest;
+  return kDiagonalShift * largest;
 }
 
 bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool shifted) {
@@ -338,6 +352,9 @@ std::vector<char> QuasiStatic::save_state() const {
         bytes.insert(bytes.end(), reinterpret_cast<const char*>(component.data()),
                      reinterpret_cast<const char*>(component.data() + component.size()));
   }
+  // Last: a checkpoint of a solver without them reads (carried_load_ = 0, started_cold_ = false).
+  const std::uint8_t cold = started_cold_ ? 1 : 0;
+  put(carried_load_), put(cold);
   return bytes;
 }
 
@@ -352,7 +369,15 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   const bool amg = use_cg_ && use_amg_;
   const bool have_amg = amg && bytes.size() > kReportBytes + extra && bytes[kReportBytes + extra] != 0;
   const std::size_t amg_extra = amg ? amg_part + (have_amg ? 3 * n * sizeof(double) : 0) : 0;
-  if (bytes.size() != kReportBytes + extra + amg_extra) throw std::runtime_error("integrator state of the wrong size");
+  const std::size_t known = kReportBytes + extra + amg_extra;
+  if (bytes.size() != known && bytes.size() != known + sizeof(double) + 1)
+    throw std::runtime_error("integrator state of the wrong size");
+  carried_load_ = 0.0;
+  started_cold_ = false;
+  if (bytes.size() > known) {
+    std::memcpy(&carried_load_, bytes.data() + known, sizeof carried_load_);
+    started_cold_ = bytes[known + sizeof(double)] != 0;
+  }
   const char* at = bytes.data() + kReportBytes + 1;
   const bool definite = *at++ != 0, shifted = *at++ != 0;
   double t = 0.0;
@@ -396,14 +421,25 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     evaluated = false;
     const double residual = residual_norm(s);
     if (!std::isfinite(residual)) return false;
-    const double load = load_scale(s, t1);
+    // The force scale of the residual test: the load now, but never less than the largest load an
+    // accepted load step has carried. Once a crack has cut the body (or it is unloaded past its
+    // peak) the reactions fall to ~0 while the unloaded pieces' residual sits at the round-off of
+    // their stretches, which scales with the forces the bonds have carried, not with today's
+    // reactions: residual_tol × the reactions is then out of reach, Newton ends only on stagnation
+    // (4–8 iterations, measured on traction after the cut) and refactorises on the way. Peridigm's
+    // quasi-static solver measures its residual against the reactions the same way and has an
+    // absolute tolerance for when that fails (Peridigm.cpp, executeQuasiStatic: "Relative
+    // Tolerance" × ‖reactions‖ or "Absolute Tolerance"); the largest load carried is that absolute
+    // scale, taken from the run itself. While the load grows it is the load now: unchanged.
+    const double load = force_scale(s, t1);
     // Equilibrium: the residual below its tolerance and the last correction below TOL. Or the
     // correction below TOL and the residual no longer falling: it is at the round-off floor of the
     // stretches (about 1e-16/strain of the load), and no further iteration changes u.
     if (k > 1 && omega <= settings_.tol && (residual <= settings_.residual_tol * load || residual >= 0.5 * previous))
       return true;
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
-    // Reuse the factorisation while it keeps the residual falling fast; else assemble anew.
+    // Reuse the factorisation while it keeps the residual falling fast; else assemble anew (also
+    // when only ω is above TOL: an old factor then reduces ω only linearly).
     if (!use_cg_ && (!have_factor_ || residual > 0.25 * previous)) {
       // Once bonds have broken, a node or a fragment may hang by nothing: its rows are zero and K
       // is singular although the residual does not drive it. A shift of the diagonal by
@@ -494,7 +530,7 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
     op_.evaluate(s, t1);
     ++report_.force_evaluations;
   }
-  return residual_norm(s) <= settings_.residual_tol * load_scale(s, t1) && omega <= settings_.tol;
+  return residual_norm(s) <= settings_.residual_tol * force_scale(s, t1) && omega <= settings_.tol;
 }
 
 void QuasiStatic::step(State& state, double& t, double& dt) {
@@ -511,7 +547,10 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     const double t1 = t + h;
     State s = state;
     op_.advance_prescribed_motion(state.u, s.u, s.v, t, t1, h, false);
-    if (guess_from_velocity_)  // the predictor (see quasi_static.hpp); v_n = 0 at the start
+    // The predictor (see quasi_static.hpp); v_n = 0 at the start. Not after a step that started from
+    // an explicit step's state either: its mean velocity is the jump from the ringing state to the
+    // equilibrium, not the rate of the load path, and extrapolating it puts the ringing back.
+    if (guess_from_velocity_ && !started_cold_)
       for (std::size_t d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < s.size(); ++i)
           if (!op_.fixed()[d][i]) s.u[d][i] = state.u[d][i] + h * state.v[d][i];
@@ -547,6 +586,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       // s.f is already the force at the equilibrium with these bonds: solve_equilibrium returns true
       // only just after evaluating it, and a breaking round that broke nothing changed no bond.
       op_.update_work(s, t1, h);
+      carried_load_ = std::max(carried_load_, load_scale(s, t1));
+      started_cold_ = !guess_from_velocity_;
       state = std::move(s);
       report_.iterations = std::max(total, 1);
       report_.broken_now = broke_total.broken;

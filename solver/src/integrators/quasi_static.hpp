@@ -43,6 +43,7 @@
 // are checkpointed, and load_state sets the hierarchy up again there: hypre's serial set-up is
 // deterministic, so a restarted run continues bitwise.
 #pragma once
+#include <algorithm>
 #include <memory>
 
 #include "integrators/integrator.hpp"
@@ -114,11 +115,16 @@ class QuasiStatic : public Integrator {
   // iterations, the last ω_K and the evaluations are added to the report.
   bool solve_equilibrium(State& trial, double t1, const Vec3Array& u_start, int& iterations, double& omega);
   double load_scale(const State& s, double t) const;
+  // The force the residual test measures against: the load now, or the largest load an accepted
+  // load step has carried when that is larger (see solve_equilibrium).
+  double force_scale(const State& s, double t) const { return std::max(load_scale(s, t), carried_load_); }
+  double carried_load_ = 0.0;  // the largest load_scale of an accepted equilibrium (checkpointed)
   double residual_norm(const State& s) const;  // ‖V f‖ over free dofs
-  void shift_diagonal(SparseMatrix& K) const;
+  double shift_diagonal(SparseMatrix& K) const;  // returns the shift added
   static constexpr double kDiagonalShift = 1e-8;
   bool broken_since_start_ = false;  // a bond has broken in this run (then K is shifted, see .cpp)
   bool guess_from_velocity_ = true;
+  bool started_cold_ = false;  // the last accepted step started without the predictor (checkpointed)
   int try_once_iterations_ = 0;  // the cap of try_once (0: none)
   int iteration_cap_ = 0;        // the step in progress's (0: none)
 
@@ -147,6 +153,7 @@ class QuasiStatic : public Integrator {
   std::string solver_reason_;
   static constexpr double kEtaMax = 0.1;
   bool solve_krylov(const State& s, double t1, double eta, double floor);
+  double build_block_jacobi(const State& s, double t1);
   void choose_linear_solver(const Case& c);
   std::string cg_failure_;
   BlockJacobi preconditioner_;
@@ -159,6 +166,7 @@ class QuasiStatic : public Integrator {
   AmgPreconditioner amg_;
   Vec3Array amg_u_;
   double amg_t_ = 0.0, amg_rate_ = 0.0;
+  double amg_shift_ = 0.0;  // the diagonal shift of the K the hierarchy was set up on
   int amg_setups_ = 0;
   double amg_seconds_ = 0.0;
   std::vector<std::int64_t> block_first_;
