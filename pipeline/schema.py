@@ -154,11 +154,12 @@ CASE = {
                            "none (full volumes), lammps (ν = (δ − |ξ|)/dx + ½ for δ − dx/2 ≤ |ξ| ≤ δ), "
                            "hhb (family |ξ| − dx/2 ≤ δ, ν = (δ − |ξ| + dx/2)/dx on the outer shell)",
                            default="none", choices=("none", "lammps", "hhb")),
-        surface_correction=Key("choice", "surface correction (Le & Bobaru 2018): none, or energy (per-bond "
+        surface_correction=Key("choice", "surface correction (Le & Bobaru 2018): none; energy (per-bond "
                                "factors from each node's strain energy under a uniaxial stress along each "
                                "axis against the continuum's, combined over the two ends and the bond's "
-                               "direction, refined in 3 passes with the factors applied; any node cloud)",
-                               default="none", choices=("none", "energy")),
+                               "direction, refined in 3 passes with the factors applied; any node cloud); or volume (g = 2V0/(V_i + V_j), "
+                               "V_i a node's family volume, V0 the continuum's)",
+                               default="none", choices=("none", "energy", "volume")),
     ),
     "materials": Key("named", "one entry per block, named after a gmsh physical group of the "
                      "top dimension (surface in 2D, volume in 3D)", default=REQUIRED, fields=MATERIAL),

@@ -96,7 +96,7 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
                      c_pair: np.ndarray, horizon: float, tree: cKDTree | None = None, *,
                      dx: float | None = None, partial_volume: str = "none", contact: float | None = None,
                      sample: int | None = SAMPLE, lps: tuple | None = None,
-                     surface: np.ndarray | None = None) -> tuple[float, int]:
+                     surface: np.ndarray | tuple | None = None) -> tuple[float, int]:
     """min over nodes of √(2ρ_i / Σ_j V_j ν_ij c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the
     node where it is reached, as solver/src/core/model.cpp stable_time_step computes it: ν of the
     `partial_volume` rule (needs the grid spacing dx unless "none"), and with contact (c_s/c given
@@ -106,8 +106,9 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
     blocks' c). (inf, -1) when no sampled node has a bond. lps = (q, kind): an LPS case, whose bond
     term is V_j ν ω(|ξ|)(q_i + q_j) with q = (d²κ + α)/m per node (LpsModel::bond_stiffness).
     surface: the per-node direction factors of the energy surface correction (n × 3,
-    surface_correction.direction_factors): each bond's term times its g (core/model.cpp
-    node_stiffness; LPS's q is unchanged by the correction: its κ, α and m all scale by ḡ_i).
+    surface_correction.direction_factors or split_factors), or (family volumes V_i, V0) of the
+    volume method: each bond's term times its g (core/model.cpp node_stiffness; LPS's q is unchanged
+    by either: its κ, α and m all scale by ḡ_i).
     tests/pipeline/test_stability_solver.py
     holds it equal to `pdsolve --stable-dt` on every shipped case."""
     n = len(points)
@@ -128,7 +129,10 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
     else:
         q, kind = lps
         stiffness = volume[cols] * nu * influence(kind, dist, horizon) * (q[i] + q[cols])
-    if surface is not None:
+    if isinstance(surface, tuple):  # the volume method: g = 2 V0/(V_i + V_j)
+        family, bulk = surface
+        stiffness = stiffness * (2.0 * bulk / (family[i] + family[cols]))
+    elif surface is not None:
         stiffness = stiffness * surface_correction.bond_factors(surface, i, cols, (points[cols] - points[i]) / dist[:, None])
     if contact is not None:
         stiffness = stiffness + np.where(dist <= CONTACT_DISTANCE * dx, volume[cols] * contact * c / horizon, 0.0)
@@ -161,10 +165,13 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
     c_pair = 0.5 * (c[:, None] + c[None, :])
     density = np.array([m["density"] for m in materials], dtype=np.float64)
     surface = None
-    if resolved.get("surface_correction", "none") == "energy":
+    method = resolved.get("surface_correction", "none")
+    if method != "none":
         law = {"model": "pmb", "c": c, "c_pair": c_pair} if lps is None else \
             {"model": "lps", "moduli": moduli, "kind": lps[1]}
-        surface = surface_factors(case, resolved, cloud, block, law, tree)
+        surface, q = surface_factors(case, resolved, cloud, block, law, tree, method)
+        if q is not None:
+            lps = (q, lps[1])
     return stable_time_step(np.asarray(cloud.points), np.asarray(cloud.volume), block, density, c_pair,
                             horizon, tree, dx=float(resolved["grid_spacing"]),
                             partial_volume=resolved["partial_volume"],
@@ -173,10 +180,11 @@ def case_stable_time_step(case: dict, resolved: dict, cloud, tree: cKDTree | Non
 
 
 def surface_factors(case: dict, resolved: dict, cloud, block: np.ndarray, law: dict,
-                    tree: cKDTree | None = None) -> np.ndarray:
-    """The direction factors of `surface_correction: energy` (n × 3) on the whole cloud, over the
-    bonds the solver makes (the partial-volume rule's cutoff and ν; bonds across a pre-crack count
-    for g but hold no energy). Holds every bond in memory: a correction asked for on a large cloud
+                    tree: cKDTree | None = None, method: str = "energy") -> tuple:
+    """The factors of `surface_correction` on the whole cloud, over the bonds the solver makes (the
+    partial-volume rule's cutoff and ν; bonds across a pre-crack count for g but hold no energy), and
+    LPS's corrected q per node (None: q is unchanged, as with both methods today, since LPS scales
+    κ, α and m by the same ḡ_i). energy: the direction factors (n × 3); volume: (V_i per node, V0). Holds every bond in memory: a correction asked for on a large cloud
     costs here what it costs the solver's set-up."""
     points, volume = np.asarray(cloud.points, dtype=np.float64), np.asarray(cloud.volume)
     tree = tree if tree is not None else cKDTree(points)
@@ -188,11 +196,16 @@ def surface_factors(case: dict, resolved: dict, cloud, block: np.ndarray, law: d
     i, j, dist = pairs.row[keep].astype(np.int64), pairs.col[keep].astype(np.int64), pairs.data[keep]
     nu = np.clip((horizon + 0.5 * dx - dist) * (1.0 / dx), 0.0, 1.0) if shell else 1.0
     intact = ~crosses_cracks(points, i, j, resolved.get("cracks") or [])
+    dims = 3 if case["analysis"] == "3d" else 2
+    n, weight = len(points), volume[j] * nu
+    if method == "volume":
+        family = np.bincount(i, weights=weight * intact, minlength=n)
+        bulk = math.pi * horizon * horizon * case["thickness"] if dims == 2 else 4.0 / 3.0 * math.pi * horizon ** 3
+        return (family, bulk), None
     if law["model"] == "lps":
         law = dict(law, influence=influence(law["kind"], dist, horizon))
-    dims = 3 if case["analysis"] == "3d" else 2
-    return surface_correction.direction_factors(law, len(points), dims, horizon, case["thickness"], block - 1, i, j,
-                                                dist, (points[j] - points[i]) / dist[:, None], volume[j] * nu, intact)
+    return surface_correction.direction_factors(law, n, dims, horizon, case["thickness"], block - 1, i, j, dist,
+                                                (points[j] - points[i]) / dist[:, None], weight, intact), None
 
 
 def _orientation(o, a, b):

@@ -6,6 +6,7 @@
 // bar's uniaxial stress along x has the compliances below (validation.md C3; the static tension of
 // test_lps.cpp and test_lps_tension.cpp measure them).
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -13,17 +14,23 @@
 
 namespace pdtest {
 
-// r_A for a horizon of horizon_factor spacings with influence `w` (full volumes: every node within
-// the horizon counts whole, as pd::build_model with partial_volume none).
-inline double axis_shear_factor(int dimension, double horizon_factor, const std::string& w) {
-  const int r = static_cast<int>(horizon_factor) + 1, rz = dimension == 3 ? r : 0;
+// r_A for a horizon of horizon_factor spacings with influence `w` and the partial-volume rule
+// `partial_volume` (core/partial_volume.cpp): none, every node within the horizon counts whole;
+// lammps, the same family with the outer shell weighted by ν = clamp(m + ½ − |ξ|/dx, 0, 1); hhb,
+// that weight on the family |ξ| − dx/2 ≤ δ.
+inline double axis_shear_factor(int dimension, double horizon_factor, const std::string& w,
+                                const std::string& partial_volume = "none") {
+  const int r = static_cast<int>(horizon_factor) + 2, rz = dimension == 3 ? r : 0;
+  const bool shell = partial_volume != "none";
+  const double reach = horizon_factor + (partial_volume == "hhb" ? 0.5 : 0.0);
   double a = 0.0, m = 0.0;
   for (int p = -r; p <= r; ++p)
     for (int q = -r; q <= r; ++q)
       for (int s = -rz; s <= rz; ++s) {
         const double l2 = p * p + q * q + s * s, l = std::sqrt(l2);
-        if (l2 == 0 || l > horizon_factor) continue;
-        const double wt = pd::influence(pd::influence_named(w), l, horizon_factor) * l2;
+        if (l2 == 0 || l > reach) continue;
+        const double nu = shell ? std::min(1.0, std::max(0.0, horizon_factor + 0.5 - l)) : 1.0;
+        const double wt = pd::influence(pd::influence_named(w), l, horizon_factor) * l2 * nu;
         const double c = (p * p - q * q) / l2;
         a += wt * c * c;
         m += wt;
@@ -40,9 +47,13 @@ struct BulkStrains {
   double axial = 0.0;    // ε_xx E'/σ
   double lateral = 0.0;  // −ε_yy/ε_xx
 };
-inline BulkStrains lps_bulk_tension(double youngs_modulus, double nu, const std::string& analysis, double r_a) {
-  const pd::LpsModuli k = pd::lps_moduli(youngs_modulus, nu, analysis);
-  const double shear = k.mu * r_a;
+// bulk_factor, shear_factor: a surface correction's factors of κ and μ on the bulk node (the split
+// method's β, γ; core/surface_correction.hpp).
+inline BulkStrains lps_bulk_tension(double youngs_modulus, double nu, const std::string& analysis, double r_a,
+                                    double bulk_factor = 1.0, double shear_factor = 1.0) {
+  pd::LpsModuli k = pd::lps_moduli(youngs_modulus, nu, analysis);
+  k.kappa *= bulk_factor;
+  const double shear = k.mu * r_a * shear_factor;
   const double e_prime = analysis == "plane_strain" ? youngs_modulus / (1.0 - nu * nu) : youngs_modulus;
   BulkStrains out;
   if (analysis == "3d") {  // S11 = 1/(9κ) + 1/(3μ r_A), S12 = 1/(9κ) − 1/(6μ r_A)

@@ -2,7 +2,7 @@
 eq. 2.5 by its correction factor g; pipeline/stability.py (via pipeline/surface_correction.py, the
 solver's energy method with the stretch linearised) gives the same stable step as
 `pdsolve --stable-dt` to 1e-8 relative, for PMB and LPS, 2D and 3D, and with a pre-crack; and the
-correction does move the step (so the comparison could fail)."""
+correction does move the step (so the comparison could fail); the same for `surface_correction: volume`."""
 import json
 import os
 import subprocess
@@ -67,3 +67,15 @@ def test_python_stable_step_is_the_solvers_with_the_energy_correction(name, tmp_
           f"{ours / solver - 1.0:.2e}")
     assert ours == pytest.approx(solver, rel=1e-8, abs=0)
     assert abs(solver / plain - 1.0) > 1e-3  # the factors do change the step
+
+
+@pytest.mark.parametrize("name", ["membrane-pmb", "plate_3d-lps", "branching-pmb"])
+def test_python_stable_step_is_the_solvers_with_the_volume_correction(name, tmp_path, pdsolve):
+    """`surface_correction: volume`: g = 2V0/(V_i + V_j) per bond (volume_factors), the same in
+    stability.py's eq. 2.5 as in the solver's; LPS's q unchanged (κ, α and m all times ḡ)."""
+    ours, solver = steps(name, tmp_path, pdsolve, "volume")
+    plain, _ = steps(name, tmp_path, pdsolve, "none")
+    print(f"{name}: stable step {solver:.6e} s with the volume correction, {plain:.6e} s without; "
+          f"python/solver - 1 = {ours / solver - 1.0:.2e}")
+    assert ours == pytest.approx(solver, rel=1e-8, abs=0)
+    assert abs(solver / plain - 1.0) > 1e-3

@@ -46,6 +46,11 @@ struct BondList {
   // 2018), the same for both copies of a bond; empty without a correction (then g = 1, and no
   // kernel reads it: results are bitwise those of a build without it). 8 bytes per directed bond.
   std::vector<double> surface_factor;
+  // The split surface correction's per-node factors of LPS's two moduli (core/surface_correction.hpp,
+  // measured there; no case-file method sets them): surface_moduli[2i] multiplies node i's bulk
+  // modulus, surface_moduli[2i + 1] its shear modulus. Empty otherwise (then LPS scales both by the
+  // mean of its g, lps.hpp).
+  std::vector<double> surface_moduli;
 
   bool corrected() const { return !surface_factor.empty(); }
   double factor(std::size_t k) const { return surface_factor.empty() ? 1.0 : surface_factor[k]; }

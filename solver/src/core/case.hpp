@@ -147,8 +147,9 @@ struct Case {
   double grid_spacing = 0.0;
   double horizon = 0.0;
   std::string partial_volume = "none";  // validation.md F3: none | lammps | hhb
-  // none | energy (Le & Bobaru 2018, core/surface_correction): per-bond factors from the energy of
-  // a uniaxial stress along each axis on each node's family against the continuum's.
+  // none | energy | volume (Le & Bobaru 2018, core/surface_correction): energy, per-bond factors
+  // from the energy of a uniaxial stress along each axis on each node's family against the
+  // continuum's; volume, from the family volumes.
   std::string surface_correction = "none";
   std::vector<BlockMaterial> blocks;
   // thesis: a bond over its critical stretch breaks before the force at the new state (§2.2);

@@ -12,7 +12,7 @@ namespace pd {
 
 struct Model;
 
-// none | energy. A registry so that the reader's error and --describe list the same names.
+// none | energy | volume. A registry so that the reader's error and --describe list the same names.
 const Registry<bool>& surface_correction_registry();
 
 // The probe of direction d on node i: the uniaxial stress along axis d of i's material, ε along d
@@ -46,6 +46,53 @@ constexpr int kSurfacePasses = 3;
 //   2018; as Peridynamics.jl combines them). Symmetric in a and b and in ±n, so both
 //   stored copies of a bond get bitwise the same g.
 double bond_surface_factor(const double* a, const double* b, double n0, double n1, double n2);
+
+// The split method, for a law whose energy is a dilatational part (κ/2)θ² plus a deviatoric one
+// (bond_model->dilatation not empty: LPS). Built to test whether correcting the two parts apart
+// brings LPS's lateral strain in C3 within 2 % where the energy method misses it; it does not
+// (validation/README.md, "Split surface correction and lattice anisotropy": the 3D bar's lateral
+// error stays +11.7, +8.3 % at ν = 0.2, 0.3 and grows to +4.6 % at 0.45), so no case-file method
+// uses it: apply_surface_correction's `energy` is the method above for every law. As the ordinary
+// state-based surface corrections of Madenci & Oterkus 2014 ("Peridynamic Theory and Its
+// Applications", Springer, §5.4: one set of factors for the dilatation from a uniform extension,
+// another for the distortional term from its own probe) and the OSB code of Dorduncu, Ren, Zhuang,
+// Silling, Madenci & Rabczuk 2024 (Comput. Struct. 299:107395, §5.1), the two parts get their own:
+//   1. the dilatation: direction factors f_d,i (bond g = bond_surface_factor of the ends' f, which
+//      weights the bond in every sum of the law) such that θ_i of a uniaxial strain along each axis
+//      d is 1 (exact): f_d,i ← f_d,i / θ_d,i(g), `passes` times. A bulk node's θ is exact already
+//      (θ is a weighted mean of n·ε·n over the family, exact where the family's second moment is
+//      isotropic: the lattice's cubic symmetry), so its f stays 1; a node within δ of a face loses a
+//      cap of its family and overweights the directions along the face, which f takes out.
+//   2. the moduli, per node, from the probes of `shear_probes` with those g: the bulk factor
+//      β_i = Σ W_bulk^cont / Σ ½κ θ_i² (1 where step 1 made θ exact) and the shear factor
+//      γ_i = Σ W_dev^cont / Σ W_dev,i, W_dev,i = W_i − ½κ θ_i² the law's deviatoric energy.
+//      A node's energy depends on its own moduli only, so one pass fits them exactly.
+// Probes of the shear factor: `axes` the uniaxial stresses of surface_probe_strain (the state of a
+// bar in tension, as the method above), or `isotropic` an orthonormal basis of deviatoric strains
+// (ε^d:ε^d = 1 each: xx − yy, xx + yy − 2zz, xy, yz, zx; in 2D xx − yy, xy), whose sum weighs every
+// direction alike. On a bulk node the `axes` probes give γ = 1/r_A (the lattice's shear along the
+// axes, tests/lps_lattice.hpp: the correction then takes the cubic lattice's anisotropy out for
+// loads along the axes, and leaves it in the diagonal shear), the `isotropic` ones give γ = 1 exactly
+// wherever θ is exact (Σ over the basis of (n·E_k·n)² = 1 − 1/d for every unit n).
+enum class ShearProbes { axes, isotropic };
+struct SplitFactors {
+  std::vector<double> direction;  // f_d,i, row-major [3 i + d]
+  std::vector<double> moduli;     // β_i, γ_i: [2 i], [2 i + 1]
+};
+SplitFactors split_surface_factors(Model& model, int passes, ShearProbes shear_probes);
+constexpr int kDilatationPasses = 6;
+
+// g of every directed bond from per-node direction factors f (bond_surface_factor).
+std::vector<double> bond_factors(const Model& model, const std::vector<double>& f);
+
+// The volume method (Le & Bobaru 2018, "Surface corrections for peridynamic models in elasticity
+// and fracture", Comput. Mech. 61:499–518, §3; PeriLab's "volume correction"): bond i–j's factor
+//   g = 2 V0 / (V_i + V_j),  V_i = Σ_j V_j ν_j over i's intact family,
+// V0 the continuum's family volume 4πδ³/3 (3D) or πδ²h (2D, h the thickness), so that a truncated
+// family's bonds are stiffened by what it lacks. No probe: g comes from the geometry only (and
+// includes the bulk lattice's own V_i/V0, as PeriLab's does). LPS takes g without moduli factors
+// (both moduli times ḡ, lps.hpp).
+std::vector<double> volume_factors(const Model& model);
 
 // Sets model.bonds.surface_factor for `method` (none: leaves it empty). Needs model.bond_model.
 void apply_surface_correction(const std::string& method, Model& model);

@@ -110,6 +110,13 @@ class BondModel {
   // reference of the energy surface correction (core/surface_correction), which probes each node
   // with a uniaxial stress built from it.
   virtual double continuum_energy_density(const Model& model, std::size_t i, const StrainTensor& strain) const = 0;
+  // The dilatation θ_i per node at u, for a law whose energy is (κ/2)θ² plus a deviatoric part (LPS);
+  // empty for a law without one (PMB). The surface correction corrects such a law's two parts
+  // separately (core/surface_correction.hpp, the split method).
+  virtual std::vector<double> dilatation(const Model& model, const Vec3Array& u) const {
+    (void)model, (void)u;
+    return {};
+  }
   // y = M^{-1/2} K M^{-1/2} x with K the stiffness linearised about the reference configuration
   // and M the lumped masses ρ_i V_i (core/stability: its largest eigenvalue is ω_max²). period[d] > 0
   // makes axis d periodic for the bond direction (the tests' infinite lattice).

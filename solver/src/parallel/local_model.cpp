@@ -78,6 +78,11 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
   // Owned rows in the global order of their neighbours (local_of is increasing, so a row stays
   // ascending); a ghost's row is empty.
   m.bonds.volume_weight = g.bonds.volume_weight;
+  // The split correction's moduli factors, per node (the piece's LPS law copies its moduli from the
+  // whole model's anyway: LpsModel::for_piece).
+  for (std::size_t l = 0; l < nl && !g.bonds.surface_moduli.empty(); ++l)
+    for (std::size_t q = 0; q < 2; ++q)
+      m.bonds.surface_moduli.push_back(g.bonds.surface_moduli[2 * static_cast<std::size_t>(p.global[l]) + q]);
   m.bonds.offsets.assign(nl + 1, 0);
   if (take) {
     // The owned rows, ascending by node, are in local order too (a ghost's row between them is

@@ -28,16 +28,20 @@ constexpr double kSigma = 1e6;
 struct Bar {
   std::string analysis = "plane_strain";
   double nu = 0.3;
-  std::string correction = "energy";
+  std::string correction = "energy";  // none, energy, volume, or split (test only: split_surface_factors)
   double horizon_factor = 4.015;  // m = δ/dx
   int load_layers = 4;            // the traction σ spread over this many end layers
   int nx = 36, width = 25;        // width: ny (and nz in 3D) nodes
+  std::string partial_volume = "none";
+  std::string influence = "one";
+  pd::ShearProbes shear = pd::ShearProbes::axes;  // the split correction's shear probes
+  int passes = pd::kDilatationPasses;             // and its dilatation passes (0: moduli factors only)
 };
 
 struct Strains {
   double axial = 0.0;    // interior ε_xx E'/σ (1 in the continuum)
   double lateral = 0.0;  // interior −ε_yy/ε_xx / ν' (1 in the continuum)
-  double bulk_factor = 1.0;  // the correction's factor ḡ on a bulk node (1 uncorrected)
+  double bulk_factor = 1.0, shear_factor = 1.0;  // the correction's β, γ on a bulk node (1 uncorrected)
   int iterations = 0;
   bool converged = false;
 };
@@ -50,22 +54,33 @@ Strains tension(const Bar& b) {
   pd::Case c = pdtest::lattice_case(dim, b.analysis, kDx, b.horizon_factor * kDx, kE, 1000.0, -1.0, 1e-3);
   c.blocks[0].model = "lps";
   c.blocks[0].parameters["poisson_ratio"] = b.nu;
-  c.blocks[0].choices["influence"] = "one";
-  c.surface_correction = b.correction;
-  const pd::Model m = pd::build_model(c, pdtest::cubic_lattice(b.nx, b.width, nz, kDx, dim, 1e-3));
+  c.blocks[0].choices["influence"] = b.influence;
+  const bool split = b.correction == "split";
+  c.surface_correction = split ? "none" : b.correction;
+  c.partial_volume = b.partial_volume;
+  pd::Model m = pd::build_model(c, pdtest::cubic_lattice(b.nx, b.width, nz, kDx, dim, 1e-3));
+  if (split) {  // the split method (core/surface_correction.hpp), set as build_model sets a correction
+    pd::SplitFactors f = pd::split_surface_factors(m, b.passes, b.shear);
+    m.bonds.surface_factor = pd::bond_factors(m, f.direction);
+    m.bonds.surface_moduli = std::move(f.moduli);
+    m.bond_model = pd::material_registry().get("lps").make(m);
+  }
   // The interior: 2δ (rounded down to whole spacings) from every lateral face, but at least the three
   // middle rows (a fit of ε_yy needs more than one).
   const int inner = std::min(static_cast<int>(2.0 * b.horizon_factor), (b.width - 3) / 2);
   const pdtest::Tension t = pdtest::static_tension(m, b.nx, b.width, nz, kDx, kSigma, inner, b.load_layers);
   Strains s;
-  // The correction multiplies a bulk node's κ and α, and every bond of it, by the same factor ḡ
-  // (lps_model.cpp: m_i/m0; a bond's g is the ellipsoid of its ends' direction factors, and a bulk
-  // node's are equal): its direction factor, found on the uncorrected model. The middle node's
-  // family is whole for W ≥ 2m + 1, so its factor is the bulk's even when its neighbours' are not.
-  if (m.bonds.corrected()) {
+  // The correction's factors of both moduli on the middle node (a bulk node for W ≥ 2m + 1): the
+  // split method's β, γ; the energy method's ḡ = its direction factor there (lps.hpp), found on the
+  // uncorrected model.
+  const std::size_t mid = pdtest::node_index(b.nx / 2, b.width / 2, nz / 2, b.nx, b.width);
+  if (split) {
+    s.bulk_factor = m.bonds.surface_moduli[2 * mid];
+    s.shear_factor = m.bonds.surface_moduli[2 * mid + 1];
+  } else if (m.bonds.corrected() && b.correction == "energy") {
     c.surface_correction = "none";
     pd::Model bare = pd::build_model(c, pdtest::cubic_lattice(b.nx, b.width, nz, kDx, dim, 1e-3));
-    s.bulk_factor = pd::surface_direction_factors(bare, pd::kSurfacePasses)[3 * pdtest::node_index(b.nx / 2, b.width / 2, nz / 2, b.nx, b.width)];
+    s.bulk_factor = s.shear_factor = pd::surface_direction_factors(bare, pd::kSurfacePasses)[3 * mid];
   }
   s.axial = t.interior_xx * modulus(b) / kSigma;
   s.lateral = -t.interior_yy / t.interior_xx / ratio(b);
@@ -75,9 +90,11 @@ Strains tension(const Bar& b) {
 }
 
 void print(const char* what, const Bar& b, const Strains& s) {
-  std::printf("[ c3 lps   ] %-22s %-12s nu=%.2f m=%.3f load=%d L=%d W=%2d corr=%-6s cg=%5d%s: axial %+.2f %%, "
-              "lateral %+.2f %%\n",
-              what, b.analysis.c_str(), b.nu, b.horizon_factor, b.load_layers, b.nx, b.width, b.correction.c_str(),
+  std::printf("[ c3 lps   ] %-22s %-12s nu=%.2f m=%.3f w=%s pv=%s load=%d L=%d W=%2d corr=%-6s%s cg=%5d%s: "
+              "axial %+.2f %%, lateral %+.2f %%\n",
+              what, b.analysis.c_str(), b.nu, b.horizon_factor, b.influence.c_str(), b.partial_volume.c_str(),
+              b.load_layers, b.nx, b.width, b.correction.c_str(),
+              b.correction != "split" ? "" : (b.shear == pd::ShearProbes::axes ? " (axes)" : " (isotropic)"),
               s.iterations, s.converged ? "" : " (not converged)", 100.0 * (s.axial - 1.0),
               100.0 * (s.lateral - 1.0));
   std::fflush(stdout);
@@ -99,10 +116,23 @@ TEST(LpsTension, MeasureTable) {
   for (const Row& r : rows) {
     if (only && std::string(only) != r.analysis) continue;
     const bool solid = std::string(r.analysis) == "3d";
+    const char* nu_only = std::getenv("PD_LPS_TENSION_NU");
+    if (nu_only && std::fabs(std::atof(nu_only) - r.nu) > 1e-9) continue;
+    const char* m_only = std::getenv("PD_LPS_TENSION_M");
+    const char* layers_only = std::getenv("PD_LPS_TENSION_LAYERS");  // 1, or 0: m layers
+    const char* corr_only = std::getenv("PD_LPS_TENSION_CORR");
     for (const double m : {3.015, 4.015})
       for (const int layers : {1, 0})
-        for (const char* corr : {"none", "energy"}) {
+        for (const char* corr : {"none", "energy", "split"}) {
+          if ((m_only && std::fabs(std::atof(m_only) - m) > 1e-9) || (layers_only && std::atoi(layers_only) != layers) ||
+              (corr_only && std::string(corr_only) != corr))
+            continue;
           Bar b{r.analysis, r.nu, corr, m, layers == 0 ? static_cast<int>(m) : 1};
+          if (const char* pv = std::getenv("PD_LPS_TENSION_PV")) b.partial_volume = pv;
+          if (const char* w = std::getenv("PD_LPS_TENSION_INFLUENCE")) b.influence = w;
+          if (const char* sp = std::getenv("PD_LPS_TENSION_SHEAR"))
+            b.shear = std::string(sp) == "isotropic" ? pd::ShearProbes::isotropic : pd::ShearProbes::axes;
+          if (const char* p = std::getenv("PD_LPS_TENSION_PASSES")) b.passes = std::atoi(p);
           if (solid) b.width = 15;
           if (const char* w = std::getenv(solid ? "PD_LPS_TENSION_W3" : "PD_LPS_TENSION_W2")) b.width = std::atoi(w);
           if (const char* l = std::getenv("PD_LPS_TENSION_NX")) b.nx = std::atoi(l);
@@ -116,12 +146,13 @@ namespace {
 // The bulk lattice's interior strains for bar b (lps_lattice.hpp), scaled by the correction's ḡ:
 // both moduli times ḡ divide the axial strain by ḡ and leave −ε_yy/ε_xx alone. Relative to σ/E'
 // and ν' as Strains.
-Strains bulk_lattice(const Bar& b, double bulk_factor) {
+Strains bulk_lattice(const Bar& b, const Strains& corrected) {
   const int dim = b.analysis == "3d" ? 3 : 2;
-  const pdtest::BulkStrains k =
-      pdtest::lps_bulk_tension(kE, b.nu, b.analysis, pdtest::axis_shear_factor(dim, b.horizon_factor, "one"));
+  const pdtest::BulkStrains k = pdtest::lps_bulk_tension(
+      kE, b.nu, b.analysis, pdtest::axis_shear_factor(dim, b.horizon_factor, b.influence, b.partial_volume),
+      corrected.bulk_factor, corrected.shear_factor);
   Strains s;
-  s.axial = k.axial / bulk_factor;
+  s.axial = k.axial;
   s.lateral = k.lateral / ratio(b);
   return s;
 }
@@ -135,13 +166,14 @@ Row c3_row(const Bar& corrected) {
   Bar uncorrected = corrected;
   uncorrected.correction = "none";
   Row r{tension(corrected), tension(uncorrected), {}};
-  r.lattice = bulk_lattice(corrected, r.with.bulk_factor);
+  r.lattice = bulk_lattice(corrected, r.with);
   EXPECT_TRUE(r.with.converged && r.without.converged) << corrected.analysis << " ν=" << corrected.nu;
   print("corrected", corrected, r.with);
   print("uncorrected", uncorrected, r.without);
-  std::printf("[ c3 lps   ] %-22s %-12s nu=%.2f m=%.3f g=%.4f: axial %+.2f %%, lateral %+.2f %%; C3 (2 %%) with "
-              "the correction: axial %s, lateral %s\n",
+  std::printf("[ c3 lps   ] %-22s %-12s nu=%.2f m=%.3f beta=%.4f gamma=%.4f: axial %+.2f %%, lateral %+.2f %%; C3 "
+              "(2 %%) with the correction: axial %s, lateral %s\n",
               "bulk lattice", corrected.analysis.c_str(), corrected.nu, corrected.horizon_factor, r.with.bulk_factor,
+              r.with.shear_factor,
               100.0 * (r.lattice.axial - 1.0), 100.0 * (r.lattice.lateral - 1.0),
               std::fabs(r.with.axial - 1.0) <= 0.02 ? "met" : "NOT met",
               std::fabs(r.with.lateral - 1.0) <= 0.02 ? "met" : "NOT met");
@@ -181,7 +213,9 @@ TEST(LpsTension, BarInteriorAxialStrainMeetsC3WithTheCorrectionItsLateralStrainD
   // The lateral half is not: the direction factors, fitted to the axial energy of each face layer,
   // make the section's shear stiffness uneven, and the interior lateral strain is off by +12.1,
   // +8.6, +1.2 % (the earlier uniaxial-strain probe: +3.6, +2.5, −1.6 %; the bulk lattice +3.5,
-  // +1.7, +0.3 %). Asserted as measured, so that a change of the correction shows here.
+  // +1.7, +0.3 %). Asserted as measured, so that a change of the correction shows here. Neither hhb
+  // partial volumes (+4.0, +3.2, −3.1 %) nor the split method (+11.7, +8.3, +4.6 %) meets 2 % here
+  // (validation/README.md, "Split surface correction and lattice anisotropy").
   const pdtest::OneThread one;
   const Row rows[] = {c3_row(Bar{"3d", 0.2, "energy", 4.015, 4, 36, 13}),
                       c3_row(Bar{"3d", 0.3, "energy", 4.015, 4, 36, 13}),
@@ -193,4 +227,100 @@ TEST(LpsTension, BarInteriorAxialStrainMeetsC3WithTheCorrectionItsLateralStrainD
   EXPECT_GT(rows[0].with.lateral - 1.0, 0.10);  // ν = 0.2: lateral +12.1 %, C3 not met
   EXPECT_GT(rows[1].with.lateral - 1.0, 0.07);  // ν = 0.3: +8.6 %
   EXPECT_LT(std::fabs(rows[2].with.lateral - 1.0), 0.02);  // ν = 0.45: +1.2 %, met
+}
+
+namespace {
+
+// r_A of the solver's LPS on the middle node of a lattice block: its strain energy under the axis
+// shear ε_xx = −ε_yy = ε (θ = 0) over the continuum's 2με² (the mean of ±ε cancels the odd
+// finite-strain terms).
+double solver_axis_shear_factor(int dim, double horizon_factor, const std::string& w, const std::string& pv) {
+  const int half = static_cast<int>(horizon_factor + 0.5) + 1, n = 2 * half + 1, nz = dim == 3 ? n : 1;
+  pd::Case c = pdtest::lattice_case(dim, dim == 3 ? "3d" : "plane_strain", kDx, horizon_factor * kDx, kE, 1000.0, -1.0,
+                                    1e-3);
+  c.blocks[0].model = "lps";
+  c.blocks[0].parameters["poisson_ratio"] = 0.3;
+  c.blocks[0].choices["influence"] = w;
+  c.partial_volume = pv;
+  const pd::Model m = pd::build_model(c, pdtest::cubic_lattice(n, n, nz, kDx, dim, 1e-3));
+  const std::size_t mid = pdtest::node_index(half, half, nz / 2, n, n);
+  const double eps = 1e-5;
+  double w_mid = 0.0;
+  for (const double e : {eps, -eps}) {
+    pd::Vec3Array u = pd::make_vec3(m.nodes.size());
+    for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+      u[0][i] = e * m.nodes.x[0][i];
+      u[1][i] = -e * m.nodes.x[1][i];
+    }
+    w_mid += 0.5 * m.bond_model->strain_energy_density(m, u)[mid];
+  }
+  pd::StrainTensor shear{};
+  shear[0] = eps;
+  shear[4] = -eps;
+  return w_mid / m.bond_model->continuum_energy_density(m, mid, shear);
+}
+
+}  // namespace
+
+TEST(LpsTension, BulkLatticeLateralStrainByInfluencePartialVolumeAndHorizon) {
+  // The square and cubic lattices' shear along the axes is μ·r_A, not μ (lps_lattice.hpp): a
+  // discretisation property that no surface correction should hide. Which settings make it small?
+  // r_A from the solver's energy on a bulk node (checked against the lattice sum of lps_lattice.hpp
+  // to 1e-9), and from it the bulk lattice's lateral strain in C3's uniaxial stress, for ω = 1,
+  // 1/|ξ|, Gaussian, partial volumes none, lammps, hhb, m = 3, 4, 5 (m + 0.015). Measured: only
+  // hhb at m = 4 and 5 keeps every row (plane strain ν = 0.2, 0.3, 0.45, plane stress 0.3, 3D 0.2,
+  // 0.3, 0.45) within 2 % of ν', for every ω (worst: ω = 1/|ξ| m = 4, −1.39 %); full volumes and
+  // lammps miss it at every m (3D ν = 0.2: +2.6 to +20.5 %), and hhb at m = 3 (2D ν = 0.2: −7.1 %).
+  const pdtest::OneThread one;
+  struct Analysis {
+    const char* name;
+    double nu;
+  };
+  const Analysis rows[] = {{"plane_strain", 0.2}, {"plane_strain", 0.3}, {"plane_strain", 0.45}, {"plane_stress", 0.3},
+                           {"3d", 0.2},           {"3d", 0.3},           {"3d", 0.45}};
+  int meeting = 0;
+  for (const char* w : {"one", "inverse_length", "gaussian"})
+    for (const char* pv : {"none", "lammps", "hhb"})
+      for (const double m : {3.015, 4.015, 5.015}) {
+        const double r2 = pdtest::axis_shear_factor(2, m, w, pv), r3 = pdtest::axis_shear_factor(3, m, w, pv);
+        if (m < 5.0) {  // the solver's r_A on the bulk node (m = 5 in 3D: a 13³ block, left to the sum)
+          EXPECT_NEAR(solver_axis_shear_factor(2, m, w, pv), r2, 1e-9) << w << " " << pv << " m=" << m;
+          EXPECT_NEAR(solver_axis_shear_factor(3, m, w, pv), r3, 1e-9) << w << " " << pv << " m=" << m;
+        }
+        double worst = 0.0;
+        std::string line;
+        for (const Analysis& a : rows) {
+          const double err = bulk_lattice(Bar{a.name, a.nu, "none", m, 1, 36, 25, pv, w}, Strains{}).lateral - 1.0;
+          worst = std::max(worst, std::fabs(err));
+          char cell[16];
+          std::snprintf(cell, sizeof cell, " %+6.2f", 100.0 * err);
+          line += cell;
+        }
+        std::printf("[ c3 lps   ] bulk lattice w=%-14s pv=%-6s m=%.3f r_A 2D %.4f 3D %.4f lateral %%:%s%s\n", w, pv, m, r2,
+                    r3, line.c_str(), worst <= 0.02 ? "  (all within 2 %)" : "");
+        const bool hhb = std::string(pv) == "hhb";
+        EXPECT_EQ(worst <= 0.02, hhb && m > 4.0) << w << " " << pv << " m=" << m;
+        meeting += worst <= 0.02;
+      }
+  EXPECT_EQ(meeting, 6);  // hhb × m = 4, 5 × three ω
+}
+
+TEST(LpsTension, PlatesMeetC3WithHhbPartialVolumesAndTheEnergyCorrection) {
+  // The plates of PlaneInterior… with partial_volume hhb, whose shell weight makes the square
+  // lattice's shear nearly isotropic (r_A = 1.0041 at m = 4, against 1.0468 with full volumes:
+  // BulkLatticeLateralStrain…): with the energy correction the interior meets C3 on both halves.
+  // Measured (validation/README.md, "Split surface correction and lattice anisotropy"): axial
+  // +0.32, +0.59, +1.38, +0.40 %, lateral +0.01, +0.37, +0.51, +0.16 % (plane strain ν = 0.2,
+  // 0.3, 0.45; plane stress 0.3); uncorrected axial −2.90 to −3.44 %. 4 static solves, 3.5 s each at load ≈ 8.
+  const pdtest::OneThread one;
+  for (const auto& [analysis, nu] : {std::pair<const char*, double>{"plane_strain", 0.2}, {"plane_strain", 0.3},
+                                     {"plane_strain", 0.45}, {"plane_stress", 0.3}}) {
+    Bar b{analysis, nu, "energy", 4.015, 4, 72, 41};
+    b.partial_volume = "hhb";
+    const Strains s = tension(b);
+    print("hhb, corrected", b, s);
+    EXPECT_TRUE(s.converged) << analysis << " ν=" << nu;
+    EXPECT_NEAR(s.axial, 1.0, 0.02) << analysis << " ν=" << nu;
+    EXPECT_NEAR(s.lateral, 1.0, 0.02) << analysis << " ν=" << nu;
+  }
 }

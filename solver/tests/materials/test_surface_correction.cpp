@@ -16,6 +16,7 @@
 #include "core/stability.hpp"
 #include "core/surface_correction.hpp"
 #include "lattice.hpp"
+#include "lps_lattice.hpp"
 #include "materials/bond_model.hpp"
 #include "static_tension.hpp"
 
@@ -246,12 +247,12 @@ TEST(SurfaceCorrection, EllipsoidCombinationOfTheEndsFactors) {
 TEST(SurfaceCorrection, NoneLeavesNoFactorsAndUnknownMethodsAreListed) {
   const pd::Model m = build(Config{"lps", "3d"}, 8, 8, 8);
   EXPECT_FALSE(m.bonds.corrected());
-  EXPECT_EQ(pd::surface_correction_registry().keys(), (std::vector<std::string>{"energy", "none"}));
+  EXPECT_EQ(pd::surface_correction_registry().keys(), (std::vector<std::string>{"energy", "none", "volume"}));
   try {
-    pd::surface_correction_registry().get("volume");
+    pd::surface_correction_registry().get("area");
     FAIL() << "no error";
   } catch (const pd::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown surface_correction method 'volume'; known: energy, none"),
+    EXPECT_NE(std::string(e.what()).find("unknown surface_correction method 'area'; known: energy, none, volume"),
               std::string::npos);
   }
 }
@@ -329,13 +330,14 @@ TEST(SurfaceCorrection, ForceIsTheGradientOfTheCorrectedEnergyAndJacobianItsDeri
 TEST(SurfaceCorrection, FactorsForceAndEnergyAreBitwiseTheSameForOneAndTwoThreads) {
   for (const Config& s : {Config{"pmb", "3d", 0.25, "energy"}, Config{"lps", "3d", 0.3, "energy"}}) {
     const int saved = omp_get_max_threads();
-    std::vector<double> g[2], w[2];
+    std::vector<double> g[2], w[2], moduli[2];
     pd::Vec3Array f[2], y[2];
     for (int t = 0; t < 2; ++t) {
       omp_set_num_threads(t + 1);
       const pd::Model m = build(s, 9, 8, 7);
       const pd::Vec3Array u = smooth_state(m);
       g[t] = m.bonds.surface_factor;
+      moduli[t] = m.bonds.surface_moduli;
       f[t] = pd::make_vec3(m.nodes.size());
       y[t] = pd::make_vec3(m.nodes.size());
       w[t].assign(m.nodes.size(), 0.0);
@@ -344,6 +346,7 @@ TEST(SurfaceCorrection, FactorsForceAndEnergyAreBitwiseTheSameForOneAndTwoThread
     }
     omp_set_num_threads(saved);
     EXPECT_EQ(g[0], g[1]) << s.model;
+    EXPECT_TRUE(moduli[0].empty() && moduli[1].empty()) << s.model;  // only the split method sets them
     EXPECT_EQ(w[0], w[1]) << s.model;
     for (int d = 0; d < 3; ++d) {
       EXPECT_EQ(f[0][d], f[1][d]) << s.model;
@@ -457,5 +460,94 @@ TEST(SurfaceCorrection, StaticTensionOfLpsInteriorStrains) {
     EXPECT_NEAR(axial, 1.0, row.axial_tol) << row.s.analysis;
     EXPECT_NEAR(ratio, 1.0, row.ratio_tol) << row.s.analysis;
     EXPECT_GT(std::fabs(axial0 - 1.0), 0.06) << row.s.analysis;  // the correction is what brings it in
+  }
+}
+
+TEST(SurfaceCorrection, SplitMethodMakesLpsDilatationNearlyExactAndFitsItsTwoModuli) {
+  // The split method (core/surface_correction.hpp; not a case-file choice): with its bond factors
+  // θ of a uniaxial strain along each axis comes much closer to 1 on every node (not to round-off:
+  // the mean of the two ends' factors and a corner's off-diagonal second moment leave a residue);
+  // the moduli factors: β ≈ 1 where θ is right, γ on the middle node near the lattice's 1/r_A (the
+  // axes probes compare with the continuum; lps_lattice.hpp), not equal to it: its neighbours'
+  // factors reach into its bonds on a 13-node block at m = 3. Measured: max |θ − 1| 0.238 → 0.077
+  // (3D), 0.196 → 0.017 (plane strain); max |β − 1| 0.030, 0.0018; γ 1.2074 (1/r_A 1.1980), 0.9779
+  // (0.9659). 4.7 s with one thread at load ≈ 9.
+  for (const char* analysis : {"3d", "plane_strain"}) {
+    const Config s{"lps", analysis, 0.3, "none"};
+    const bool plane = std::string(analysis) != "3d";
+    const int n = 13, nz = plane ? 1 : n;
+    const pd::Model bare = build(s, n, n, nz);
+    pd::Model m = build(s, n, n, nz);
+    const pd::SplitFactors f = pd::split_surface_factors(m, pd::kDilatationPasses, pd::ShearProbes::axes);
+    EXPECT_FALSE(m.bonds.corrected());  // left as it was
+    m.bonds.surface_factor = pd::bond_factors(m, f.direction);
+    m.bonds.surface_moduli = f.moduli;
+    m.bond_model = pd::material_registry().get("lps").make(m);
+    double worst[2] = {0.0, 0.0};  // |θ − 1| without and with the factors
+    for (int d = 0; d < (plane ? 2 : 3); ++d) {
+      pd::Vec3Array u = pd::make_vec3(m.nodes.size());
+      const double eps = 1e-6;
+      for (std::size_t i = 0; i < m.nodes.size(); ++i)
+        u[static_cast<std::size_t>(d)][i] = eps * m.nodes.x[static_cast<std::size_t>(d)][i];
+      const std::vector<double> t0 = bare.bond_model->dilatation(bare, u), t1 = m.bond_model->dilatation(m, u);
+      for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+        worst[0] = std::max(worst[0], std::fabs(t0[i] / eps - 1.0));
+        worst[1] = std::max(worst[1], std::fabs(t1[i] / eps - 1.0));
+      }
+    }
+    const std::size_t centre = pdtest::node_index(n / 2, n / 2, nz / 2, n, n);
+    double beta_worst = 0.0;
+    for (std::size_t i = 0; i < m.nodes.size(); ++i) beta_worst = std::max(beta_worst, std::fabs(f.moduli[2 * i] - 1.0));
+    const double r_a = pdtest::axis_shear_factor(plane ? 2 : 3, s.horizon_factor, "one");
+    std::printf("[ surface  ] LPS %s split: max |θ − 1| of a uniaxial strain %.4f without, %.4f with; max |β − 1| "
+                "%.4f; middle node's γ %.4f (1/r_A = %.4f)\n", analysis, worst[0], worst[1], beta_worst,
+                f.moduli[2 * centre + 1], 1.0 / r_a);
+    EXPECT_GT(worst[0], 0.15) << analysis;
+    EXPECT_LT(worst[1], 0.4 * worst[0]) << analysis;
+    EXPECT_LT(beta_worst, 0.035) << analysis;
+    EXPECT_NEAR(f.moduli[2 * centre + 1], 1.0 / r_a, 0.015) << analysis;
+  }
+}
+
+TEST(SurfaceCorrection, VolumeMethodFactorsAndTheStiffnessTheyGive) {
+  // The volume method (core/surface_correction.hpp volume_factors; Le & Bobaru 2018, PeriLab's
+  // volume correction): g = 2 V0/(V_i + V_j). On the middle node of a block every bond's g is
+  // V0/V_bulk (the continuum's family volume over the lattice's, 4πδ³/3 against 122 dx³ at m = 3 in
+  // 3D), both copies of a bond carry the same g; and the apparent stiffness of the thin bar and the
+  // plate of expect_stiffness_of_the_material, asserted as measured (the method has no probe: it does
+  // not aim at E and is not held to 2 %). Measured E_app/E with it: PMB 3D 1.1188, LPS 3D (ν = 0.3)
+  // 1.7395, PMB plane stress 1.1761, LPS plane stress 1.4188 (without: 0.7650, 1.1175, 0.9893,
+  // 1.1534): it overcorrects PMB's 3D bar and stiffens further the LPS surfaces, which are stiff
+  // already (LPS's discrete m keeps a truncated family's energy whole; the factor's volume deficit
+  // then multiplies it again through ḡ). 12 s with one thread at load ≈ 9.
+  {
+    const pd::Model m = build(Config{"pmb", "3d", 0.25, "volume"}, 13, 13, 13);
+    ASSERT_TRUE(m.bonds.corrected());
+    const std::size_t centre = pdtest::node_index(6, 6, 6, 13, 13);
+    const double expected = 4.0 / 3.0 * kPi * std::pow(3.015 * kDx, 3) / (122.0 * kDx * kDx * kDx);
+    ASSERT_EQ(m.bonds.offsets[centre + 1] - m.bonds.offsets[centre], 122);
+    for (std::int64_t k = m.bonds.offsets[centre]; k < m.bonds.offsets[centre + 1]; ++k)
+      EXPECT_NEAR(m.bonds.surface_factor[static_cast<std::size_t>(k)], expected, 1e-12);
+    for (std::size_t i = 0; i < m.nodes.size(); ++i)
+      for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
+        const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
+        const std::int32_t* row = m.bonds.neighbour.data();
+        const auto back = std::lower_bound(row + m.bonds.offsets[j], row + m.bonds.offsets[j + 1], static_cast<std::int32_t>(i));
+        ASSERT_EQ(m.bonds.surface_factor[static_cast<std::size_t>(k)],
+                  m.bonds.surface_factor[static_cast<std::size_t>(back - row)]);
+      }
+  }
+  const struct {
+    Config s;
+    double measured;
+  } rows[] = {{{"pmb", "3d", 0.25, "volume"}, 1.1188},
+              {{"lps", "3d", 0.3, "volume"}, 1.7395},
+              {{"pmb", "plane_stress", 0.0, "volume"}, 1.1761},
+              {{"lps", "plane_stress", 0.3, "volume"}, 1.4188}};
+  for (const auto& row : rows) {
+    const double with = apparent_stiffness(row.s);
+    std::printf("[ surface  ] %s %s thin %s: E_apparent/E = %.4f with the volume correction\n", row.s.model.c_str(),
+                row.s.analysis.c_str(), row.s.analysis == "3d" ? "bar" : "plate", with);
+    EXPECT_NEAR(with, row.measured, 1e-3) << row.s.model << " " << row.s.analysis;
   }
 }

@@ -28,7 +28,9 @@
 // Surface correction (core/surface_correction, discretization.surface_correction: energy): bond q's
 // factor g_q multiplies its weight V_j ν_j in every sum of the law — m_i, θ_i, the deviatoric sum and
 // the force — and node i's moduli κ_i, α_i are multiplied by ḡ_i = m_i(g)/m_i(1), the factors' mean
-// over i's family. So a node whose bonds all carry one g has its energy W_i times g exactly (θ and
+// over i's family (the energy and volume methods). The split method (core/surface_correction.hpp,
+// measured there, not a case-file choice) sets per-node factors of κ_i and α_i instead
+// (BondList::surface_moduli). So a node whose bonds all carry one g has its energy W_i times g exactly (θ and
 // the deviatoric shape do not change, the moduli do): the energy method's premise, and ν stays the
 // material's; unequal factors reweight the family by direction (a truncated family's θ and
 // deviatoric sum see the missing directions again). One symmetric weighting (g_ij = g_ji), so the
@@ -116,7 +118,7 @@ class LpsModel : public BondModel {
   void set_decomposed(const Decomposed* d) const override { decomposed_ = d; }
 
   // The dilatation θ_i at u over the intact bonds (for tests and output).
-  std::vector<double> dilatation(const Model& model, const Vec3Array& u) const;
+  std::vector<double> dilatation(const Model& model, const Vec3Array& u) const override;
   const std::vector<double>& weighted_volume() const { return m_; }
 
  private:

@@ -52,9 +52,12 @@ LpsModel::LpsModel(const Model& model) {
     const LpsModuli& mod = per_block.empty() ? LpsModuli{} : per_block[static_cast<std::size_t>(model.block_index[i])];
     kappa0_[i] = mod.kappa;
     mu0_[i] = mod.mu;
+    // The split correction gives the two moduli their own factors (core/surface_correction.hpp);
+    // bond factors alone (set by hand) scale both by ḡ.
+    const bool split = model.bonds.corrected() && !model.bonds.surface_moduli.empty();
     const double gbar = model.bonds.corrected() && m0 > 0.0 ? m / m0 : 1.0;
-    kappa_[i] = mod.kappa * gbar;
-    alpha_[i] = alpha_factor * mod.mu * gbar;
+    kappa_[i] = mod.kappa * (split ? model.bonds.surface_moduli[2 * i] : gbar);
+    alpha_[i] = alpha_factor * mod.mu * (split ? model.bonds.surface_moduli[2 * i + 1] : gbar);
     if (m > 0.0) {
       a_[i] = alpha_[i] / m;
       b_[i] = d_ * kappa_[i] / m;
