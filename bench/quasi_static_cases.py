@@ -367,6 +367,11 @@ def runs(args, rows: list[dict], name: str) -> str:
         for speed, *_ in family:
             case, run_dir, r = explicit(speed, alpha)
             mine.append(row(f"verlet-alpha{alpha:g}", speed, case, run_dir, r))
+    if args.explicit_only:
+        rows.extend(mine)
+        if source.summary():
+            print(f"  {name}: {source.summary()}", flush=True)
+        return f"{name}: explicit rows only (--explicit-only): no mixed run, no speedup"
     cases = {}
     for scheme in ("quasi_static", "mixed"):
         case = implicit_case(base, scheme)
@@ -415,6 +420,9 @@ def add_arguments(parser) -> None:
                              "later than s0 ∝ δ^(-1/2) says, and 1.2/sqrt(8) ended the plate's runs at its peak)")
     parser.add_argument("--pairs", type=int, default=None,
                         help="paired reruns of mixed and its explicit rival (default 2, --quick 1)")
+    parser.add_argument("--explicit-only", action="store_true",
+                        help="traction, plate_with_hole: the explicit rows alone (no quasi_static, mixed or speedup): "
+                             "a folder for a later --reuse-explicit / --explicit-from")
     reuse = parser.add_mutually_exclusive_group()
     reuse.add_argument("--reuse-explicit", metavar="DIR", default=None,
                        help="traction, plate_with_hole: take each explicit run from DIR (an earlier --out) when its "

@@ -142,3 +142,12 @@ def test_quick_traction_runs_end_to_end_and_its_speedup_line_matches_the_rows(tm
     assert (again / "traction" / f"verlet-alpha{found.group(3)[len('verlet-alpha'):]}-v{found.group(4)}"
             / "run.log").exists()                                            # the rival's paired reruns
     assert re.match(r"^speedup traction: mixed [0-9.]+ s against explicit", second.stdout.splitlines()[-1])
+
+    # --explicit-only: the explicit rows alone (here all reused again), no mixed, no speedup line.
+    only = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+                           "--solver", solver, "--out", str(tmp_path / "only"), "--reuse-explicit", str(tmp_path),
+                           "--explicit-only"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert only.returncode == 0, only.stdout + only.stderr
+    with open(tmp_path / "only" / "accuracy.csv", newline="", encoding="utf-8") as stream:
+        assert sorted(r["scheme"] for r in csv.DictReader(stream)) == sorted(r["scheme"] for r in explicit)
+    assert only.stdout.splitlines()[-1] == "traction: explicit rows only (--explicit-only): no mixed run, no speedup"
