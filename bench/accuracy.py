@@ -27,6 +27,7 @@ wall time and against force evaluations).
     /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 1] [--repeat 3] [--quick]
                                        [--problems wave,fracture,tension,traction,plate_with_hole]
                                        [--coarsen 4 | --full-resolution] [--halvings 7] [--pairs 2]
+                                       [--reuse-explicit DIR | --explicit-from DIR] [--explicit-only]
 """
 from __future__ import annotations
 

@@ -2,7 +2,8 @@
 made-up data: where the reference search stops, which explicit run is mixed's rival, the speedup
 line, the crack position of two symmetric cracks, and the count of where a mixed run's time goes.
 One quick end-to-end run of traction at dx × 8 (about 10 s), and again reusing its explicit rows
-(--reuse-explicit, a few s); the full benchmark takes minutes."""
+(--reuse-explicit) and its explicit rows alone (--explicit-only): some 25 s in all at load ~7; the
+full benchmark takes minutes."""
 import math
 import os
 import re
