@@ -7,7 +7,7 @@ them again; mixed, quasi_static and the paired reruns of mixed and its rival alw
 a speedup is a ratio measured side by side:
 
 - `--reuse-explicit DIR`: a run is reused only when nothing that makes it differs: its case.json
-  byte for byte as this run writes it, the lattice (nodes.vtu) byte for byte, the same number of
+  byte for byte as this run writes it (but its "source" line: see case_sha256), the lattice (nodes.vtu) byte for byte, the same number of
   threads, and a solver file with the same SHA-256 (recorded in DIR/<problem>/<run>/bench_run.json
   when that run was made). Anything else runs here again, and the output says why.
 - `--explicit-from DIR`: the user names the run whose explicit rows to take, made by another solver
@@ -28,6 +28,7 @@ import csv
 import hashlib
 import json
 import os
+import re
 
 from bench.result_hashes import history_without_wall_time
 
@@ -48,10 +49,19 @@ def file_sha256(path: str) -> str:
     return _SHA_CACHE[key]
 
 
+def case_sha256(path: str) -> str:
+    """SHA-256 of case.json's bytes but its `"source": ...` line: the path of the mixed.yaml it
+    came from, which differs between checkouts and which the solver reads but never uses
+    (solver/src/io/describe.cpp only lists it)."""
+    with open(path, "rb") as stream:
+        data = stream.read()
+    return hashlib.sha256(re.sub(rb'(?m)^ *"source": "[^"\n]*",?\n', b"", data)).hexdigest()
+
+
 def write_record(run_dir: str, solver: str, threads: int, r: dict) -> None:
     """bench_run.json of a run made here (see the module docstring)."""
     record = {"solver": os.path.abspath(solver), "solver_sha256": file_sha256(solver), "threads": threads,
-              "case_sha256": file_sha256(os.path.join(run_dir, "case.json")),
+              "case_sha256": case_sha256(os.path.join(run_dir, "case.json")),
               "nodes_sha256": file_sha256(os.path.join(os.path.dirname(run_dir), "nodes.vtu")),
               **{key: r[key] for key in ("status", "steps", "wall", "cpu", "evaluations", "broken_bonds")}}
     with open(os.path.join(run_dir, RECORD), "w", encoding="utf-8") as stream:
@@ -125,8 +135,8 @@ class ExplicitSource:
         old_case = os.path.join(old_dir, "case.json")
         if not os.path.isfile(old_case):
             return None, "not in it"
-        if file_sha256(old_case) != file_sha256(case_path):
-            return None, "its case.json differs"
+        if case_sha256(old_case) != case_sha256(case_path):
+            return None, "its case.json differs (other than in its source line)"
         if file_sha256(os.path.join(self.directory, problem, "nodes.vtu")) != \
                 file_sha256(os.path.join(os.path.dirname(run_dir), "nodes.vtu")):
             return None, "its nodes.vtu differs"

@@ -151,3 +151,13 @@ def test_the_reuse_options_refuse_a_missing_folder_and_the_output_folder(tmp_pat
             qs.settle_arguments(args)
     with pytest.raises(SystemExit):
         parser.parse_args(["--reuse-explicit", "a", "--explicit-from", "b"])
+
+
+def test_case_json_compared_byte_for_byte_but_its_source_line(tmp_path):
+    from bench.explicit_reuse import case_sha256
+    cases = []
+    for name, source, speed in (("a", "/work/one/cases/traction/mixed.yaml", 0.5),
+                                ("b", "/work/two/cases/traction/mixed.yaml", 0.5), ("c", "/work/one/x.yaml", 0.25)):
+        cases.append(qs.write(str(tmp_path / name), "run", {"source": source, "speed": speed}))
+    assert case_sha256(cases[0]) == case_sha256(cases[1])      # another checkout: the same case
+    assert case_sha256(cases[0]) != case_sha256(cases[2])      # another speed
