@@ -27,6 +27,7 @@ wall time and against force evaluations).
     /usr/bin/python3 -m bench.accuracy [--solver build/solver/pdsolve] [--threads 1] [--repeat 3] [--quick]
                                        [--problems wave,fracture,tension,traction,plate_with_hole]
                                        [--coarsen 4 | --full-resolution] [--halvings 7] [--pairs 2]
+                                       [--reuse-explicit DIR | --explicit-from DIR] [--explicit-only]
 """
 from __future__ import annotations
 
@@ -140,14 +141,23 @@ def run_once(solver: str, case_path: str, threads: int) -> dict:
             log = stream.read()
     except OSError:
         log = ""
-    done = re.search(r"(\d+) steps to t = \S+ s in ([0-9.]+) s wall.*?(\d+) force evaluations", log)
-    broken = re.search(r"(\d+) broken bonds", log)
-    if result.returncode != 0 or not done:
+    counts = log_counts(log)
+    if result.returncode != 0 or counts is None:
         last = (result.stderr.strip().splitlines() or ["no message"])[-1]
         return {"status": f"failed ({result.returncode}: {last[:80]})", "steps": 0, "wall": float("nan"),
                 "evaluations": 0, "broken_bonds": -1, "log": log}
-    return {"status": "ok", "steps": int(done.group(1)), "wall": float(done.group(2)),
-            "evaluations": int(done.group(3)), "broken_bonds": int(broken.group(1)) if broken else -1, "log": log}
+    return dict(counts, status="ok", log=log)
+
+
+def log_counts(log: str) -> dict | None:
+    """steps, wall (the time loop's), evaluations and broken_bonds from run.log's `done:` line;
+    None when it has none."""
+    done = re.search(r"(\d+) steps to t = \S+ s in ([0-9.]+) s wall.*?(\d+) force evaluations", log)
+    if not done:
+        return None
+    broken = re.search(r"(\d+) broken bonds", log)
+    return {"steps": int(done.group(1)), "wall": float(done.group(2)), "evaluations": int(done.group(3)),
+            "broken_bonds": int(broken.group(1)) if broken else -1}
 
 
 def run(solver: str, case_path: str, threads: int, repeat: int = 1) -> dict:

@@ -22,6 +22,10 @@ dx × 8, uses 0.6: there the peak comes later than that rule says).
 The speedup line: mixed against the cheapest explicit run as accurate (peak within 2 % of the
 reference's, the same crack position), rerun in pairs side by side (mixed, explicit, mixed,
 explicit, ...; the fastest of each counts) so that the ratio is measured in one sitting.
+
+`--reuse-explicit DIR` / `--explicit-from DIR`: the explicit rows of an earlier run's --out folder,
+when their inputs are byte-identical (bench/explicit_reuse.py says when exactly); mixed,
+quasi_static and the paired reruns run here always.
 """
 from __future__ import annotations
 
@@ -36,6 +40,7 @@ import sys
 import numpy as np
 
 from bench import tension
+from bench.explicit_reuse import ExplicitSource
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -286,16 +291,22 @@ def runs(args, rows: list[dict], name: str) -> str:
     ref_alpha = axial_alpha(base, REFERENCE_ZETA)
     speed0 = CASES[name]["explicit_speed"]
     dt_guess = [None]
+    source = ExplicitSource(args.reuse_explicit or args.explicit_from,
+                            "reuse" if args.reuse_explicit else "from", args.solver, args.threads)
+    print(f"  {name}: {source.describe()}", flush=True)
+    notes = {}
 
     def explicit(speed: float, alpha: float):
         every = 1 if dt_guess[0] is None else max(1, int(explicit_end(base, speed) / dt_guess[0] / 3000))
         case = explicit_case(base, speed, alpha, every)
         path = write(directory, f"verlet-alpha{alpha:g}-v{speed:g}", case)
-        r = timed_run(args.solver, path, args.threads)
+        r, run_dir, notes[run_dir] = source.run(name, path, timed_run)
+        if notes[run_dir]:
+            print(f"    {os.path.basename(run_dir)}: {notes[run_dir]}", flush=True)
         if r["status"] == "ok" and dt_guess[0] is None:
             from bench.accuracy import stable_dt
             dt_guess[0] = 0.8 * stable_dt(r["log"])
-        return case, os.path.dirname(path), r
+        return case, run_dir, r
 
     family = []
     speed = speed0
@@ -334,7 +345,9 @@ def runs(args, rows: list[dict], name: str) -> str:
                "crack_left": m.get("cracks", (float("nan"),) * 2)[0],
                "crack_right": m.get("cracks", (float("nan"),) * 2)[1],
                "same_crack": m.get("same_crack", False), "reference": run_dir == ref_dir,
-               "nodes": base["_nodes"], "grid_spacing": base["grid_spacing"], "run_dir": run_dir}
+               "nodes": base["_nodes"], "grid_spacing": base["grid_spacing"], "run_dir": run_dir,
+               "case_path": os.path.join(directory, os.path.basename(run_dir), "case.json"),
+               "explicit_source": notes.get(run_dir, "")}
         if ok and scheme in ("mixed", "quasi_static"):
             out.update(where_time_goes(m["history"]))
         print(f"  {scheme:18s} {parameter:<8g} {r['status'][:6]:6s} steps {r['steps']:7d} evals {r['evaluations']:7d} "
@@ -354,6 +367,11 @@ def runs(args, rows: list[dict], name: str) -> str:
         for speed, *_ in family:
             case, run_dir, r = explicit(speed, alpha)
             mine.append(row(f"verlet-alpha{alpha:g}", speed, case, run_dir, r))
+    if args.explicit_only:
+        rows.extend(mine)
+        if source.summary():
+            print(f"  {name}: {source.summary()}", flush=True)
+        return f"{name}: explicit rows only (--explicit-only): no mixed run, no speedup"
     cases = {}
     for scheme in ("quasi_static", "mixed"):
         case = implicit_case(base, scheme)
@@ -362,6 +380,8 @@ def runs(args, rows: list[dict], name: str) -> str:
         mine.append(row(scheme, 0.0 if scheme == "quasi_static" else grip_tables(base)[1][-1] / grip_tables(base)[0][-1],
                         case, os.path.dirname(path), timed_run(args.solver, path, args.threads)))
     rows.extend(mine)
+    if source.summary():
+        print(f"  {name}: {source.summary()}", flush=True)
     mixed = next(r for r in mine if r["scheme"] == "mixed")
     if mixed["status"] != "ok":
         return f"speedup {name}: mixed failed ({mixed['status']})"
@@ -369,7 +389,7 @@ def runs(args, rows: list[dict], name: str) -> str:
     mixed_wall, explicit_wall = mixed["wall_time"], best["wall_time"] if best else float("nan")
     if best is not None and args.pairs > 0:
         # Side by side: mixed and its rival alternately, the fastest of each.
-        rival_path = os.path.join(best["run_dir"], "case.json")
+        rival_path = best["case_path"]   # in this run's folder, also when its row was reused
         def walls(group):
             return ", ".join(f"{r['wall']:.2f}" for r in group)
 
@@ -400,6 +420,18 @@ def add_arguments(parser) -> None:
                              "later than s0 ∝ δ^(-1/2) says, and 1.2/sqrt(8) ended the plate's runs at its peak)")
     parser.add_argument("--pairs", type=int, default=None,
                         help="paired reruns of mixed and its explicit rival (default 2, --quick 1)")
+    parser.add_argument("--explicit-only", action="store_true",
+                        help="traction, plate_with_hole: the explicit rows alone (no quasi_static, mixed or speedup): "
+                             "a folder for a later --reuse-explicit / --explicit-from")
+    reuse = parser.add_mutually_exclusive_group()
+    reuse.add_argument("--reuse-explicit", metavar="DIR", default=None,
+                       help="traction, plate_with_hole: take each explicit run from DIR (an earlier --out) when its "
+                            "case.json and nodes.vtu are byte-identical and the same solver file (SHA-256) made it "
+                            "on as many threads; mixed, quasi_static and the paired reruns run here")
+    reuse.add_argument("--explicit-from", metavar="DIR", default=None,
+                       help="traction, plate_with_hole: take the explicit runs of DIR (an earlier --out) whose inputs "
+                            "are byte-identical, whatever solver made them; the first of each problem is rerun and "
+                            "its results compared (any difference stops the benchmark); their times are DIR's")
 
 
 def settle_arguments(args) -> None:
@@ -415,3 +447,11 @@ def settle_arguments(args) -> None:
     args.halvings = (3 if args.quick else 7) if args.halvings is None else args.halvings
     args.pairs = (1 if args.quick else 2) if args.pairs is None else args.pairs
     args.zetas = (0.0,) if args.quick else (0.0, CASE_ZETA)
+    for option, value in (("--reuse-explicit", args.reuse_explicit), ("--explicit-from", args.explicit_from)):
+        if value is None:
+            continue
+        if not os.path.isdir(value):
+            sys.exit(f"{option} {value}: no such folder (give the --out folder of an earlier run)")
+        if os.path.realpath(value) == os.path.realpath(args.out):
+            # This run rewrites case.json and nodes.vtu before comparing them with DIR's.
+            sys.exit(f"{option} {value}: the same folder as --out; write this run elsewhere")

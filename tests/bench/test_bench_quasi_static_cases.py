@@ -1,7 +1,9 @@
 """The logic of bench/quasi_static_cases.py (traction and plate_with_hole in make bench-accuracy) on
 made-up data: where the reference search stops, which explicit run is mixed's rival, the speedup
 line, the crack position of two symmetric cracks, and the count of where a mixed run's time goes.
-One quick end-to-end run of traction at dx × 8 (about 10 s); the full benchmark takes minutes."""
+One quick end-to-end run of traction at dx × 8 (about 10 s), and again reusing its explicit rows
+(--reuse-explicit) and its explicit rows alone (--explicit-only): some 25 s in all at load ~7; the
+full benchmark takes minutes."""
 import math
 import os
 import re
@@ -120,3 +122,33 @@ def test_quick_traction_runs_end_to_end_and_its_speedup_line_matches_the_rows(tm
     assert float(found.group(5)) == pytest.approx(float(found.group(2)) / float(found.group(1)), rel=3e-2)
     assert any(r["scheme"] == found.group(3) and float(r["parameter"]) == float(found.group(4))
                and float(r["peak_error"]) <= 0.02 and r["same_crack"] == "True" for r in rows)
+
+    # --reuse-explicit the folder just written: every explicit row taken (same inputs, same solver),
+    # mixed, quasi_static and the paired reruns run again, the rival rerun in the new folder.
+    again = tmp_path / "again"
+    second = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+                             "--solver", solver, "--out", str(again), "--reuse-explicit", str(tmp_path)], cwd=ROOT,
+                            capture_output=True, text=True, timeout=600)
+    assert second.returncode == 0, second.stdout + second.stderr
+    with open(again / "accuracy.csv", newline="", encoding="utf-8") as stream:
+        rows2 = list(csv.DictReader(stream))
+    explicit = [r for r in rows if r["scheme"].startswith("verlet")]
+    explicit2 = [r for r in rows2 if r["scheme"].startswith("verlet")]
+    assert [(r["scheme"], r["parameter"], r["steps"], r["cpu_time"], r["peak_force"], r["run_dir"]) for r in explicit] \
+        == [(r["scheme"], r["parameter"], r["steps"], r["cpu_time"], r["peak_force"], r["run_dir"]) for r in explicit2]
+    assert all(r["explicit_source"] == f"reused from {r['run_dir']}" for r in explicit2)
+    assert f"explicit runs: {len(explicit2)} taken from {tmp_path} (same solver file), 0 run here" in second.stdout
+    mixed2 = next(r for r in rows2 if r["scheme"] == "mixed")
+    assert mixed2["run_dir"] == str(again / "traction" / "mixed") and mixed2["steps"] == mixed["steps"]
+    assert (again / "traction" / f"verlet-alpha{found.group(3)[len('verlet-alpha'):]}-v{found.group(4)}"
+            / "run.log").exists()                                            # the rival's paired reruns
+    assert re.match(r"^speedup traction: mixed [0-9.]+ s against explicit", second.stdout.splitlines()[-1])
+
+    # --explicit-only: the explicit rows alone (here all reused again), no mixed, no speedup line.
+    only = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+                           "--solver", solver, "--out", str(tmp_path / "only"), "--reuse-explicit", str(tmp_path),
+                           "--explicit-only"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert only.returncode == 0, only.stdout + only.stderr
+    with open(tmp_path / "only" / "accuracy.csv", newline="", encoding="utf-8") as stream:
+        assert sorted(r["scheme"] for r in csv.DictReader(stream)) == sorted(r["scheme"] for r in explicit)
+    assert only.stdout.splitlines()[-1] == "traction: explicit rows only (--explicit-only): no mixed run, no speedup"
