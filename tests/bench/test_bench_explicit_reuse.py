@@ -161,3 +161,20 @@ def test_case_json_compared_byte_for_byte_but_its_source_line(tmp_path):
         cases.append(qs.write(str(tmp_path / name), "run", {"source": source, "speed": speed}))
     assert case_sha256(cases[0]) == case_sha256(cases[1])      # another checkout: the same case
     assert case_sha256(cases[0]) != case_sha256(cases[2])      # another speed
+
+
+def test_results_compare_without_the_energy_sums_but_with_every_column_the_benchmark_reads(tmp_path):
+    # Two runs whose histories differ only in an energy sum's last digit (as after the exact sums
+    # of 3 Dec 2026) have the same digests; a reaction that differs does not.
+    header = "step,time,kinetic_energy,strain_energy,wall_time,broken_bonds,reaction_right_fx\n"
+    rows = {"a": "1,0.1,1.0000000000000002,3.0,0.5,0,12.5\n",
+            "b": "1,0.1,1.0000000000000004,3.0,0.7,0,12.5\n",
+            "c": "1,0.1,1.0000000000000002,3.0,0.5,0,12.500000000000002\n"}
+    digests = {}
+    for name, row in rows.items():
+        run = tmp_path / name
+        run.mkdir()
+        (run / "history.csv").write_text(header + row)
+        digests[name] = result_digests(str(run))
+    assert digests["a"] == digests["b"]
+    assert digests["a"] != digests["c"]
