@@ -5,7 +5,8 @@ On the coarse cracking plate of test_mpi_ranks.py (1234 nodes, 300 steps), each 
   built without the order and ran the thesis order: a silently different run),
 - `critical_stretch_alpha: 0.25` with the LAMMPS order (s0_i = s00 − α·min_j s_ij: a bond's threshold
   min(s0_i, s0_j) reads the s0 of its ghost end, refreshed from its owner before each breaking pass),
-- `surface_correction: energy` (the factors computed on the whole model before the decomposition)
+- `surface_correction: energy` and `volume` (the factors computed on the whole model before the
+  decomposition)
 writes on 2 and 3 ranks (and on 1 for α) frames, frames.pvd and history.csv
 byte for byte as the serial run. A checkpoint of the α run holds the owners' s0 in global node
 order: written on 2 ranks it continues on 3 and on 1, written serially it continues on 2, each
@@ -35,8 +36,12 @@ def surface_corrected(case):
     case["surface_correction"] = "energy"
 
 
+def volume_corrected(case):
+    case["surface_correction"] = "volume"
+
+
 VARIANTS = {"lammps": (lammps_order, (2, 3)), "alpha": (alpha_rule, (1, 2, 3)),
-            "surface": (surface_corrected, (2, 3))}
+            "surface": (surface_corrected, (2, 3)), "volume": (volume_corrected, (2, 3))}
 
 
 def broken_bonds(folder):
@@ -67,8 +72,9 @@ def test_decomposed_runs_equal_the_serial_run_byte_for_byte(prepared, thesis_ser
         result = solve(folder, ranks)
         assert result.returncode == 0, f"{kind} np{ranks}: {result.stderr}"
         assert_same_run(serial, folder)
-        if kind == "surface":  # run.log's factor range: over every rank's rows, as the serial run's
-            factors = re.search(r"work: surface correction energy .*", serial_log).group(0)
+        if kind in ("surface", "volume"):  # run.log's factor range: over every rank's rows, as the serial run's
+            method = "energy" if kind == "surface" else "volume"
+            factors = re.search(rf"work: surface correction {method} .*", serial_log).group(0)
             assert "factors g from" in factors
             assert factors in (folder / "run.log").read_text()
 
