@@ -15,8 +15,8 @@ class BodyForceTerm {
   // Σ_i V_i b_i(t)·v_i [W], summed condition by condition, each over its nodes in node order.
   double power(double t, const Vec3Array& v) const;
   // The same on a decomposed run (the model a rank's piece, whose conditions hold its owned nodes):
-  // one ordered sum per condition, each continuing the last (parallel/decomposed.hpp), so the
-  // serial loop's additions in its order: the same bits on every rank. Collective.
+  // one exact sum per condition, each continuing the last (parallel/decomposed.hpp), so the
+  // serial run's exact sums: the same bits on every rank. Collective.
   double power(double t, const Vec3Array& v, const Decomposed& d) const;
 
  private:

@@ -3,7 +3,7 @@
 // preconditioned CG (linalg/pcg.hpp) with K x = −V ∂f/∂u·x + D x, the products from
 // ForceOperator::apply_jacobian (force evaluations with ghosts on a decomposed run), D a diagonal
 // the integrator adds (quasi_static's shift after damage, implicit's mass term c m), and every dot
-// product summed in global dof order (parallel/dof_sums.hpp): the same bits for any rank count.
+// product an exact sum (parallel/dof_sums.hpp): the same bits for any rank count.
 #pragma once
 #include <string>
 #include <vector>

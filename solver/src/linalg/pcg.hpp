@@ -52,7 +52,7 @@ struct PcgSettings {
   double absolute_tol = 0.0;
   int max_iterations = 1000;
   // Every dot product and norm of the iteration; empty: fixed_order_dot. A decomposed run passes
-  // one summed in global dof order over the ranks, so every rank takes the same α and β as a
+  // one an exact sum over the ranks (core/exact_sum.hpp), so every rank takes the same α and β as a
   // serial solve would, bit for bit (the vector updates are element by element).
   DotProduct dot;
 };

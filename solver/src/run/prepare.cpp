@@ -87,8 +87,8 @@ void check_decomposable(const Prepared& p) {
   // Decomposed: LAMMPS's α rule (the ghosts' s0 refreshed before each breaking pass), breaking_order:
   // lammps, surface_correction (its factors computed on the whole model, copied into the pieces'
   // rows), contact (forces/contact_on_piece) with the explicit integrators, and every integrator:
-  // verlet, adaptive (its norms of eq. 2.6 are ordered sums), and quasi_static, implicit and mixed on
-  // their matrix-free path (their norms and CG's dot products summed in global dof order:
+  // verlet, adaptive (its norms of eq. 2.6 are exact sums: core/exact_sum.hpp), and quasi_static,
+  // implicit and mixed on their matrix-free path (their norms and CG's dot products exact sums:
   // parallel/dof_sums.hpp; linear_solver: direct is refused by the integrator). dt: exact is
   // decomposed too: choose_dt ran on the whole model on every rank, before the decomposition.
   // Not yet: the contact's linearised force (forces/contact.cpp) inside a Newton solve.

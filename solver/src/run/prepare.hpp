@@ -26,7 +26,7 @@ struct Prepared {
   bool whole_bonds = true;
   // Directed bonds of the whole model (each bond twice), held or not.
   std::int64_t directed_bonds() const { return model.bonds.offsets.empty() ? 0 : model.bonds.offsets.back(); }
-  // A run on several MPI ranks (issue 15): this rank's piece, its ghosts and the ordered sums; the
+  // A run on several MPI ranks (issue 15): this rank's piece, its ghosts and the exact sums; the
   // operator then works on the piece's model. Null on one rank: the serial path.
   std::unique_ptr<Decomposed> decomposed;
   bool writes_output() const { return !decomposed || decomposed->rank() == 0; }
