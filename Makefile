@@ -166,15 +166,18 @@ test: $(SOLVER) | $(DEPS)
 	@$(MAKE) --no-print-directory test-asan
 
 # The solver and its tests under AddressSanitizer + UBSan (+ libstdc++ assertions): any report fails
-# the test that caused it (UBSan halts instead of printing and going on). -O2 without NDEBUG: at -O0
-# the physics tests run 10-50 times slower under ASan (one took 11 min), asserts stay on.
+# the test that caused it (UBSan halts instead of printing and going on). -O1 without NDEBUG: at -O0
+# the physics tests run 10-50 times slower under ASan (one took 11 min); -O2 compiled 2.4× slower
+# than -O1 (31.6 against 13.0 CPU s for test_quasi_static.cpp), and its build was most of make
+# test's time. Asserts stay on. LpsTension's C3 lattices (138 s of the 247 s under ASan at -O1, 2
+# threads) run in the Release ctest only: their kernels are the LPS tests' here too.
 ASAN_DIR := build/solver-asan
 test-asan: | $(DEPS)
 	cmake -S solver -B $(ASAN_DIR) -DPD_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g"
+	    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g"
 	cmake --build $(ASAN_DIR) -j$(JOBS) --target pdsolve pd_tests
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-	    ctest --test-dir $(ASAN_DIR) --output-on-failure -j$(JOBS)
+	    ctest --test-dir $(ASAN_DIR) --output-on-failure -j$(JOBS) -E '^LpsTension\.'
 
 # libFuzzer (clang) on the solver's readers, FUZZ_SECONDS each; a crash leaves its input in
 # $(FUZZ_DIR)/artifacts/: fix the reader and add the input to solver/fuzz/regressions/<target>/.

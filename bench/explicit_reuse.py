@@ -76,13 +76,18 @@ SUM_COLUMNS = (b"kinetic_energy", b"strain_energy", b"external_work", b"damping_
                b"indenter_energy", b"broken_bond_energy")
 
 
+def is_sum_column(name: bytes) -> bool:
+    """SUM_COLUMNS, and each indenter's reaction indenter_<name>_f{x,y,z} (an exact sum too)."""
+    return name in SUM_COLUMNS or (name.startswith(b"indenter_") and name[-3:] in (b"_fx", b"_fy", b"_fz"))
+
+
 def history_without_sums(data: bytes) -> bytes:
-    """history.csv (wall_time already removed) without the SUM_COLUMNS; all else byte for byte."""
+    """history.csv (wall_time already removed) without the sum columns; all else byte for byte."""
     lines = data.splitlines(keepends=True)
     if not lines:
         return data
     header = lines[0].rstrip(b"\r\n").split(b",")
-    keep = [k for k, name in enumerate(header) if name not in SUM_COLUMNS]
+    keep = [k for k, name in enumerate(header) if not is_sum_column(name)]
     out = []
     for line in lines:
         body = line.rstrip(b"\r\n")

@@ -6,7 +6,8 @@
 // multiple of 2^−1074 below 2^1024: a fixed-point number of 2098 bits. The accumulator holds it as
 // kDigits signed 64-bit limbs, limb k weighing 2^(32k − 1074) (the Kulisch accumulator, with
 // 32-bit digits in 64-bit limbs). A term adds its mantissa, shifted to its exponent, into two
-// adjacent limbs (< 2^32 into the lower, < 2^53 into the upper), so 2^10 terms fit before a limb
+// adjacent limbs (< 2^32 into the lower, < 2^52 into the upper: a mantissa below 2^53 shifted by at
+// most 31 bits, less the 32 bits of the lower), so 2^10 terms fit before a limb
 // could overflow; then the carries are propagated (normalise): limbs 0 … kDigits−2 back into
 // [0, 2^32), the top limb signed. That normal form is unique for each value, so two accumulators
 // of the same exact sum hold the same limbs, and adding normal forms limb by limb (MPI_SUM on
@@ -30,7 +31,7 @@ class ExactSum {
  public:
   static constexpr int kDigits = 67;             // 32-bit digits: 2144 bits from 2^−1074
   static constexpr int kLimbs = kDigits + 3;     // + counts of +∞, −∞ and NaN terms
-  static constexpr int kAddsBeforeCarry = 1024;  // a limb gains < 2^53 + 2^32 a term: 2^10 terms fit in 2^63
+  static constexpr int kAddsBeforeCarry = 1024;  // a limb gains < 2^52 + 2^32 a term: 2^10 terms stay below 2^63
 
   ExactSum() = default;
   explicit ExactSum(double start) { add(start); }

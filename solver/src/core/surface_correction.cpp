@@ -259,7 +259,10 @@ std::vector<double> volume_factors(const Model& m) {
   for (std::size_t i = 0; i < n; ++i)
     for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-      g[static_cast<std::size_t>(k)] = 2.0 * bulk / (family[i] + family[j]);  // the same for both copies
+      // The same for both copies; 1 when neither end has an intact family left (two nodes cut off
+      // by pre-cracks), where 2·bulk/0 would be infinite and eq. 2.5's step zero.
+      const double both = family[i] + family[j];
+      g[static_cast<std::size_t>(k)] = both > 0.0 ? 2.0 * bulk / both : 1.0;
     }
   return g;
 }

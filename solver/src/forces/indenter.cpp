@@ -43,8 +43,9 @@ double plane(const IndenterSettings& ind, const double c[3], const double y[3], 
   return -s;
 }
 
-// Chunks of this many nodes are summed in node order and the chunk sums added in chunk order: the
-// reaction is the same for any thread count.
+// Chunks of this many nodes share the stable-depth bound's work between the threads, combined in
+// chunk order (the node it names is the same for any thread count); the reaction and energy are
+// exact sums, the same in any order.
 constexpr std::int64_t kChunk = 4096;
 
 }  // namespace

@@ -1,7 +1,25 @@
 // Gathers of per-node values to rank 0 in global node order (parallel/ordered_sum.hpp).
 #include "parallel/ordered_sum.hpp"
 
+#include <climits>
+#include <string>
+
+#include "core/error.hpp"
+
 namespace pd {
+
+namespace {
+
+// MPI-3's counts and displacements are int: a gather of more than INT_MAX entries to rank 0 would
+// overflow them. Called with the same total on every rank, so every rank refuses alike (no hang).
+void check_gather_size(std::int64_t total, const char* what) {
+  if (total > INT_MAX)
+    throw Error(std::to_string(total) + " " + what + " to gather on rank 0 (a checkpoint or a gathered frame): more "
+                "than MPI's int counts allow (2^31 - 1); runs this large need output.parallel_frames: pieces and "
+                "no checkpoint for now (issue 15)");
+}
+
+}  // namespace
 
 OrderedSum::OrderedSum(MPI_Comm comm, const LocalPiece& piece)
     : comm_(comm), global_nodes_(piece.global_nodes), owned_local_(piece.owned_local) {
@@ -67,6 +85,7 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node, int 
 }
 
 void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
+  check_gather_size(global.offsets.back(), "directed bonds' broken flags");  // every rank holds the offsets
   const double start = MPI_Wtime();
   std::vector<std::uint8_t> flags;
   for (std::int32_t l : owned_local_)
@@ -112,6 +131,9 @@ void OrderedSum::gather_lines(const BondList& local, const std::vector<std::int3
       }
     }
   }
+  std::int64_t total = static_cast<std::int64_t>(ends.size());
+  MPI_Allreduce(MPI_IN_PLACE, &total, 1, MPI_INT64_T, MPI_SUM, comm_);
+  check_gather_size(total, "broken bonds");
   const std::vector<double> count = gather(per_node);  // rank 0: per node, in global order (exact integers)
   const double start = MPI_Wtime();
   const int mine = static_cast<int>(ends.size());

@@ -1,5 +1,5 @@
 // Gathers of per-node values of a decomposed run to rank 0, in global node order (issue 15): the
-// frames, history's whole-model columns, checkpoints and the dof masks read them there. Each costs
+// frames, history's whole-model columns and checkpoints read them there. Each costs
 // 8 bytes per owned node (per value) to rank 0. The per-step sums over nodes do not gather: they are
 // exact sums over each rank's own nodes, added across ranks with one MPI_Allreduce
 // (core/exact_sum.hpp, MpiDecomposed::exact_sum).

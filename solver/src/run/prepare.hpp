@@ -20,7 +20,7 @@ struct Prepared {
   Case c;
   int threads = 0;  // OpenMP's, after --threads
   // The whole model. On a decomposed run every rank holds its per-node data (output and run.log
-  // read it); its bond list only when whole_bonds (rows_per_rank_reason() says why), else just the
+  // read it); its bond list only when whole_bonds (whole_bonds_reason() in prepare.cpp says why), else just the
   // rows' offsets — each rank built only its owned rows, in decomposed->piece() (issue 15).
   Model model;
   bool whole_bonds = true;

@@ -255,7 +255,7 @@ TEST_P(DecomposedTerms, LpsWithBreakingGivesTheSerialRunBitwise) {
 }
 
 // The adaptive integrator (thesis §2.2) on a PMB lattice torn open and pulled: its eq. 2.6 norms are
-// ordered sums over the ranks, so every rank iterates, accepts and rejects as the serial run does.
+// exact sums over the ranks, so every rank iterates, accepts and rejects as the serial run does.
 TEST_P(DecomposedTerms, AdaptiveStepsGiveTheSerialRunBitwise) {
   omp_set_num_threads(GetParam());
   const int nx = 14, ny = 10, nz = 8;
