@@ -2,6 +2,7 @@
 #include "integrators/adaptive.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -135,9 +136,11 @@ void AdaptiveStep::step(State& state, double& t, double& dt) {
       }
       // Two exact sums (each independent of the other), through the one reduction over nodes: on
       // a decomposed run the serial sums' bits on every rank (ghosts left out), so every rank
-      // accepts or rejects alike.
-      const double c = sum_over_nodes(op_.decomposed(), correction_.size(), [&](std::size_t i) { return correction_[i]; });
-      const double m = sum_over_nodes(op_.decomposed(), motion_.size(), [&](std::size_t i) { return motion_[i]; });
+      // accepts or rejects alike; both in one MPI_Allreduce.
+      const std::array<double, 2> cm = sums_over_nodes<2>(op_.decomposed(), correction_.size(), [&](std::size_t i) {
+        return std::array<double, 2>{correction_[i], motion_[i]};
+      });
+      const double c = cm[0], m = cm[1];
       if (!std::isfinite(c) || !std::isfinite(m)) {
         phi_k = 0.01;
         diverged = true;

@@ -2,6 +2,7 @@
 #include "operator/force_operator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -55,11 +56,9 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
     // LAMMPS's α rule: a bond's threshold min(s0_i, s0_j) reads its ghost end's s0, which the
     // previous pass updated on the owner only (a ghost's empty row leaves +inf).
     if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
-    std::vector<double> lost(s.size(), 0.0);
-    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost.data());
-    report.broken = decomposed_->total(report.broken);
-    // The energy the broken bonds held, summed exactly over the nodes as the serial path sums it.
-    if (report.broken > 0) report.energy = decomposed_->exact_sum(lost);
+    lost_.assign(s.size(), 0.0);
+    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost_.data());
+    reduce_break_report(report);
   }
   s.contact_energy = 0.0;
   s.indenter_energy = 0.0;
@@ -73,11 +72,23 @@ BreakReport ForceOperator::break_bonds(State& s) {
   // break_bonds (bond_model.hpp), with each node's share of the lost energy kept for the exact sum.
   decomposed_->update_ghosts(s.u);
   Vec3Array f = make_vec3(s.size());
-  std::vector<double> w(s.size(), 0.0), lost(s.size(), 0.0);
-  BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, f, w.data(), true, lost.data());
-  report.broken = decomposed_->total(report.broken);
-  report.energy = report.broken > 0 ? decomposed_->exact_sum(lost) : 0.0;
+  std::vector<double> w(s.size(), 0.0);
+  lost_.assign(s.size(), 0.0);
+  BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, f, w.data(), true, lost_.data());
+  reduce_break_report(report);
   return report;
+}
+
+void ForceOperator::reduce_break_report(BreakReport& report) {
+  // Both ends of a bond that crosses ranks break it in the same pass; the i < j copy counts it and
+  // holds its energy, on one rank only. The count and the energy the broken bonds held, summed
+  // exactly over the owned nodes as the serial path sums it, go in one reduction.
+  ExactSum energy;
+  for (std::int32_t l : decomposed_->piece().owned_local) energy.add(lost_[static_cast<std::size_t>(l)]);
+  std::int64_t broken = report.broken;
+  decomposed_->reduce(&energy, 1, &broken, 1);
+  report.broken = broken;
+  report.energy = broken > 0 ? energy.value() : 0.0;
 }
 
 bool ForceOperator::any_broken() const {
@@ -300,15 +311,30 @@ void ForceOperator::impose_prescribed_velocity(Vec3Array& v, double t1) const {
     }
 }
 
+namespace {
+
+// Node i's terms of the kinetic energy ½ ρ V |v|² and of the strain energy W_i V_i [J].
+double kinetic_term(const Model& m, const State& s, std::size_t i) {
+  return 0.5 * m.density[i] * m.nodes.volume[i] * (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
+}
+double strain_term(const Model& m, const State& s, std::size_t i) { return s.w[i] * m.nodes.volume[i]; }
+
+}  // namespace
+
 double ForceOperator::kinetic_energy(const State& s) const {
-  const Model& m = model_;
-  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) {
-    return 0.5 * m.density[i] * m.nodes.volume[i] * (s.v[0][i] * s.v[0][i] + s.v[1][i] * s.v[1][i] + s.v[2][i] * s.v[2][i]);
-  });
+  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) { return kinetic_term(model_, s, i); });
 }
 
 double ForceOperator::strain_energy(const State& s) const {
-  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) { return s.w[i] * model_.nodes.volume[i]; });
+  return sum_over_nodes(decomposed_, s.size(), [&](std::size_t i) { return strain_term(model_, s, i); });
+}
+
+ForceOperator::KineticAndStrain ForceOperator::kinetic_and_strain_energy(const State& s) const {
+  // The terms of kinetic_energy and strain_energy, each summed exactly: the same two values, bit for bit.
+  const std::array<double, 2> e = sums_over_nodes<2>(decomposed_, s.size(), [&](std::size_t i) {
+    return std::array<double, 2>{kinetic_term(model_, s, i), strain_term(model_, s, i)};
+  });
+  return KineticAndStrain{e[0], e[1]};
 }
 
 double ForceOperator::external_power(const State& s, double t) const {
@@ -354,12 +380,19 @@ double ForceOperator::decomposed_external_power(const State& s, double t) const 
 double ForceOperator::decomposed_damping_power(const State& s) const {
   if (model_.damping == 0.0) return 0.0;
   const Model& m = model_;
+  // The three components' exact sums in one reduction; then each continues the last as the serial
+  // loop does (exact_sum(term, p) adds p after the ranks' sums): the same bits.
+  std::array<ExactSum, 3> sum;
+  for (std::int32_t l : decomposed_->piece().owned_local)
+    for (std::size_t d = 0; d < 3; ++d) {
+      const auto i = static_cast<std::size_t>(l);
+      if (!m.conditions.fixed[d][i]) sum[d].add(m.density[i] * m.nodes.volume[i] * s.v[d][i] * s.v[d][i]);
+    }
+  decomposed_->reduce(sum.data(), 3);
   double p = 0.0;
-  std::vector<double> term(s.size());
   for (std::size_t d = 0; d < 3; ++d) {
-    for (std::size_t i = 0; i < term.size(); ++i)
-      term[i] = m.conditions.fixed[d][i] ? 0.0 : m.density[i] * m.nodes.volume[i] * s.v[d][i] * s.v[d][i];
-    p = decomposed_->exact_sum(term, p);
+    sum[d].add(p);
+    p = sum[d].value();
   }
   return model_.damping * p;
 }

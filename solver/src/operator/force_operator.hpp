@@ -100,6 +100,12 @@ class ForceOperator {
   // Energies [J], summed in node order by parallel/node_sum.hpp (the same for any thread and rank count).
   double kinetic_energy(const State& s) const;
   double strain_energy(const State& s) const;  // Σ W_i V_i from the last force evaluation
+  // Both, the same bits as the two calls, in one reduction on a decomposed run (the run loop's
+  // blow-up watch asks every step: one wait for the slowest rank instead of two).
+  struct KineticAndStrain {
+    double kinetic = 0.0, strain = 0.0;
+  };
+  KineticAndStrain kinetic_and_strain_energy(const State& s) const;
   // Body-force and moving-indenter power plus the power of the reactions at prescribed components,
   // Σ V (ρa − f)·v with a the prescribed acceleration (the slope of a velocity table; 0 for a
   // piecewise-linear displacement — the impulses at its kinks are not counted) [W].
@@ -122,6 +128,10 @@ class ForceOperator {
   std::vector<const ForceTerm*> built_;                  // per registry entry: its term, or null
   const Decomposed* decomposed_ = nullptr;
   mutable Vec3Array ghosted_x_;  // apply_jacobian's x with its ghosts filled (decomposed only)
+  std::vector<double> lost_;     // the breaking pass's energy lost per node (decomposed only; kept, not allocated per step)
+  // report.broken and report.energy summed over the ranks from this rank's count and lost_, in one
+  // reduction (decomposed only).
+  void reduce_break_report(BreakReport& report);
   double decomposed_external_power(const State& s, double t) const;
   double decomposed_damping_power(const State& s) const;
 };

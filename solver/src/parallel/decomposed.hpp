@@ -39,9 +39,11 @@ class Decomposed {
   // ignored; a node that no term concerns may enter as 0.0, which adds nothing. Collective: every
   // rank calls it (one MPI_Allreduce of ExactSum::kLimbs int64).
   virtual double exact_sum(const std::vector<double>& per_node, double start = 0.0) const = 0;
-  // sums[0 … count) = the sums over all ranks of every rank's sums[0 … count), exactly (one
-  // MPI_Allreduce). Collective.
-  virtual void reduce(ExactSum* sums, int count) const = 0;
+  // sums[0 … count) = the sums over all ranks of every rank's sums[0 … count), exactly, and
+  // integers[0 … integer_count) the same for integers, in the same one MPI_Allreduce: every
+  // reduction a step needs at one point goes in one message, since each collective is a point where
+  // every rank waits for the slowest (docs/performance.md, MPI). Collective.
+  virtual void reduce(ExactSum* sums, int count, std::int64_t* integers = nullptr, int integer_count = 0) const = 0;
   // Σ over ranks of an integer (exact, so the order does not matter). Collective.
   virtual std::int64_t total(std::int64_t local) const = 0;
   // The least of the ranks' values (exact, so the order does not matter). Collective.
@@ -98,9 +100,11 @@ class Decomposed {
   // exact sums and gathers, with their wall time.
   struct Traffic {
     std::int64_t halo_exchanges = 0, halo_messages = 0, halo_bytes = 0;  // sent by this rank
-    std::int64_t reductions = 0, reduction_bytes = 0;  // exact sums: MPI_Allreduce calls and the bytes of their accumulators
+    std::int64_t reductions = 0, reduction_bytes = 0;  // MPI_Allreduce calls (exact sums, totals, minima) and their bytes
     std::int64_t gathers = 0, gather_bytes = 0;        // gathers to rank 0 (frames, history, setup): calls and bytes sent
-    double halo_seconds = 0.0, reduction_seconds = 0.0;  // wall time inside MPI calls and packing (reductions: sums and gathers)
+    // Wall time inside MPI calls and packing (reductions: every Allreduce and the gathers), waits
+    // for the other ranks included: a collective returns when the slowest rank has entered it.
+    double halo_seconds = 0.0, reduction_seconds = 0.0;
   };
   virtual Traffic traffic() const = 0;
   // run.log's lines on the decomposed run's communication: per rank, per step of `steps`, the

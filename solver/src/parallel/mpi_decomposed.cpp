@@ -61,34 +61,41 @@ double MpiDecomposed::exact_sum(const std::vector<double>& per_node, double star
   return sum.value();
 }
 
-void MpiDecomposed::reduce(ExactSum* sums, int count) const {
+void MpiDecomposed::reduce(ExactSum* sums, int count, std::int64_t* integers, int integer_count) const {
   const double start = MPI_Wtime();
   const auto limbs = static_cast<std::size_t>(ExactSum::kLimbs);
-  limbs_.resize(limbs * static_cast<std::size_t>(count));
+  const std::size_t exact = limbs * static_cast<std::size_t>(count);
+  limbs_.resize(exact + static_cast<std::size_t>(integer_count));
   for (int k = 0; k < count; ++k) {
     sums[k].normalise();  // digits in [0, 2^32): the ranks' limbs add without overflow (core/exact_sum.hpp)
     std::copy(sums[k].limbs(), sums[k].limbs() + limbs, limbs_.begin() + static_cast<std::ptrdiff_t>(limbs * static_cast<std::size_t>(k)));
   }
+  if (integer_count > 0) std::copy(integers, integers + integer_count, limbs_.begin() + static_cast<std::ptrdiff_t>(exact));
   MPI_Allreduce(MPI_IN_PLACE, limbs_.data(), static_cast<int>(limbs_.size()), MPI_INT64_T, MPI_SUM, comm_);
   for (int k = 0; k < count; ++k) {
     std::copy(limbs_.begin() + static_cast<std::ptrdiff_t>(limbs * static_cast<std::size_t>(k)),
               limbs_.begin() + static_cast<std::ptrdiff_t>(limbs * static_cast<std::size_t>(k + 1)), sums[k].limbs());
     sums[k].normalise();
   }
+  if (integer_count > 0) std::copy(limbs_.begin() + static_cast<std::ptrdiff_t>(exact), limbs_.end(), integers);
   ++reductions_;
   reduction_bytes_ += static_cast<std::int64_t>(8 * limbs_.size());
   reduction_seconds_ += MPI_Wtime() - start;
 }
 
 std::int64_t MpiDecomposed::total(std::int64_t local) const {
-  std::int64_t sum = 0;
-  MPI_Allreduce(&local, &sum, 1, MPI_INT64_T, MPI_SUM, comm_);
+  std::int64_t sum = local;
+  reduce(nullptr, 0, &sum, 1);
   return sum;
 }
 
 double MpiDecomposed::minimum(double local) const {
+  const double start = MPI_Wtime();
   double least = local;
   MPI_Allreduce(&local, &least, 1, MPI_DOUBLE, MPI_MIN, comm_);
+  ++reductions_;
+  reduction_bytes_ += 8;
+  reduction_seconds_ += MPI_Wtime() - start;
   return least;
 }
 

@@ -39,7 +39,7 @@ class MpiDecomposed : public Decomposed {
   void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
   void update_ghosts(std::vector<double>& a) const override { halo_->exchange(a); }
   double exact_sum(const std::vector<double>& per_node, double start = 0.0) const override;
-  void reduce(ExactSum* sums, int count) const override;
+  void reduce(ExactSum* sums, int count, std::int64_t* integers = nullptr, int integer_count = 0) const override;
   std::int64_t total(std::int64_t local) const override;
   double minimum(double local) const override;
 

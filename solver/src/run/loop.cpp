@@ -32,8 +32,9 @@ class Energies {
   Energies(const ForceOperator& op, const State& state) : op_(op), state_(state) {}
   void at(std::int64_t step) {
     if (step_ == step) return;
-    kinetic = op_.kinetic_energy(state_);
-    strain = op_.strain_energy(state_);
+    const ForceOperator::KineticAndStrain e = op_.kinetic_and_strain_energy(state_);  // one reduction on several ranks
+    kinetic = e.kinetic;
+    strain = e.strain;
     step_ = step;
   }
   double kinetic = 0.0, strain = 0.0;
