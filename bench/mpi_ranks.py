@@ -4,8 +4,9 @@ beside LAMMPS peri/pmb on 2 MPI ranks, on the same bricks in the same sitting.
 Runs build/solver/pd_mpi_halo (solver/bench/mpi_halo.cpp) under `mpiexec --oversubscribe
 --bind-to none -np R` with T OpenMP threads per rank: the velocity-Verlet loop of the `make bench`
 brick with the two exact energy sums pdsolve's loop adds each step. Each rank reports, per
-step, the halo messages and bytes it sent, the exact sums (MPI_Allreduce) and their bytes,
-its ghosts per owned node, the wall time in communication, and its peak memory. The codes
+step, the halo messages and bytes it sent, the reductions (MPI_Allreduce) and their bytes,
+its ghosts per owned node, the wall time in communication (every MPI call, the waits for the other
+rank included), and its peak memory. The codes
 alternate, `repeats` runs each, and the best run of each configuration counts (a busy neighbour
 slows a run, nothing speeds it up). Writes out/bench/mpi.csv (one row per rank and configuration,
 LAMMPS rows with its loop time) and prints a summary with the load average.
@@ -13,7 +14,10 @@ LAMMPS rows with its loop time) and prints a summary with the load average.
     /usr/bin/python3 -m bench.mpi_ranks [--build build/solver] [--sides 40 100] [--repeats 2]
 
 2 ranks × 2 threads on a 2-core machine oversubscribe it (4 threads): that row shows the cost of
-oversubscription, not of the decomposition.
+oversubscription, not of the decomposition, and says so. Such a row runs with OMP_WAIT_POLICY=passive
+(unless the environment sets it): OpenMP's threads then sleep at the end of a loop instead of
+spinning, and do not take the core from the other rank's threads or from its MPI wait
+(docs/performance.md, MPI: 40³ at 2 × 2 went from 0.8–0.9e8 to 4.3–4.5e8 bond updates/s).
 """
 import argparse
 import csv
@@ -22,16 +26,26 @@ import shutil
 import subprocess
 import tempfile
 
-STEPS = {40: 40, 46: 30, 100: 10}
+# 40³: 100 steps, a timed window of ~1.5 s on 2 ranks; at 40 steps (~0.6 s) one preemption by another
+# process moved the 2-rank row by 10 % or more.
+STEPS = {40: 100, 46: 30, 100: 10}
 CONFIGURATIONS = [(1, 1), (1, 2), (2, 1), (2, 2)]  # (ranks, threads per rank)
 MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def oversubscribed(ranks, threads):
+    """More threads in all than the machine has cores."""
+    return ranks * threads > (os.cpu_count() or 1)
 
 
 def run_ours(exe, side, steps, ranks, threads):
     """The per-rank rows pd_mpi_halo prints, as dicts."""
     command = ["mpiexec", "--oversubscribe", "--bind-to", "none", "-np", str(ranks), exe, "--side", str(side),
                "--steps", str(steps), "--threads", str(threads)]
-    out = subprocess.run(command, capture_output=True, text=True, env=dict(MPI_ENV, OMP_NUM_THREADS=str(threads)))
+    env = dict(MPI_ENV, OMP_NUM_THREADS=str(threads))
+    if oversubscribed(ranks, threads):
+        env.setdefault("OMP_WAIT_POLICY", "passive")  # spinning threads would take the cores from the others
+    out = subprocess.run(command, capture_output=True, text=True, env=env)
     if out.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} failed (exit {out.returncode}):\n{out.stdout[-2000:]}{out.stderr[-2000:]}")
     lines = [line for line in out.stdout.splitlines() if line.strip()]
@@ -70,7 +84,7 @@ def main():
             load = f"{os.getloadavg()[0]:.2f}"
             for (ranks, threads), run in best.items():
                 for r in run:
-                    rows.append(dict(code="pdsolve", load_average=load, **r))
+                    rows.append(dict(code="pdsolve", load_average=load, oversubscribed=int(oversubscribed(ranks, threads)), **r))
             directed = float(best[(1, 1)][0]["directed_bonds"])
             nodes = int(best[(1, 1)][0]["nodes"])
             if best_lammps is not None:
@@ -82,9 +96,12 @@ def main():
             rate = {k: float(v[0]["bond_updates_per_s"]) for k, v in best.items()}
             for (ranks, threads), run in best.items():
                 r0 = run[0]
-                print(f"  {side}³ = {nodes} nodes, {ranks} rank(s) × {threads} thread(s): {rate[(ranks, threads)]:.3e} "
+                crowded = (f" [oversubscribed: {ranks * threads} threads on {os.cpu_count()} cores, "
+                           f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY', 'passive')}]") if oversubscribed(ranks, threads) else ""
+                print(f"  {side}³ = {nodes} nodes, {ranks} rank(s) × {threads} thread(s){crowded}: {rate[(ranks, threads)]:.3e} "
                       f"directed bond updates/s; per rank and step: {r0['halo_messages_per_step']} messages, "
-                      f"{r0['halo_bytes_per_step']} halo bytes, {r0['reduction_bytes_per_step']} bytes of exact sums (MPI_Allreduce), "
+                      f"{r0['halo_bytes_per_step']} halo bytes, {r0['reductions_per_step']} reductions (MPI_Allreduce) "
+                      f"of {r0['reduction_bytes_per_step']} bytes, "
                       f"{r0['ghosts_per_owned']} ghosts per owned node, {float(r0['communication_s_per_step']) * 1e3:.3f} ms "
                       f"in communication ({100 * float(r0['communication_share']):.1f} %), peak {r0['peak_rss_mb']} MB "
                       f"(load {load})", flush=True)
@@ -96,7 +113,7 @@ def main():
     fields = ["code", "rank", "side", "nodes", "ranks", "threads", "steps", "directed_bonds", "loop_s",
               "bond_updates_per_s", "owned", "ghosts", "ghosts_per_owned", "halo_messages_per_step",
               "halo_bytes_per_step", "reductions_per_step", "reduction_bytes_per_step", "communication_s_per_step",
-              "communication_share", "peak_rss_mb", "load_average"]
+              "communication_share", "peak_rss_mb", "oversubscribed", "load_average"]
     with open(args.out, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()

@@ -6,9 +6,9 @@
 // and strain energy as pdsolve's loop computes them for its blow-up watch, and prints, from rank 0, one
 // CSV row per rank: the loop's wall time (the slowest rank's) and directed bond updates per second
 // of the whole brick; the rank's owned nodes, ghosts and ghosts per owned node; per step the halo
-// messages and bytes it sent, the exact sums (MPI_Allreduce) and the bytes of their accumulators,
-// the wall time in communication (halo exchanges and sums, MPI waits included); and its peak
-// resident memory.
+// messages and bytes it sent, the reductions (MPI_Allreduce: the breaking pass's count with its lost
+// energy, the two energies) and their bytes, the wall time in communication (halo exchanges and
+// every Allreduce, the waits for the slower rank included); and its peak resident memory.
 //
 //   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T]
 #include <mpi.h>
@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
   for (int k = 0; k < steps; ++k) {
     dt = dt0;
     integrator->step(s, t, dt);
-    energy += op.kinetic_energy(s) + op.strain_energy(s);  // pdsolve's blow-up watch: 2 exact sums a step
+    const pd::ForceOperator::KineticAndStrain e = op.kinetic_and_strain_energy(s);  // pdsolve's blow-up watch
+    energy += e.kinetic + e.strain;
   }
   const double mine = std::chrono::duration<double>(Clock::now() - t0).count();
   double loop = mine;

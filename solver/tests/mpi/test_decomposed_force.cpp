@@ -112,6 +112,14 @@ TEST_P(Decomposed, ForceAndEnergiesEqualTheSerialSweepBitwise) {
   EXPECT_GT(strain, 0.0);
   EXPECT_TRUE(same_bits(strain, serial_op.strain_energy(serial))) << strain << " vs " << serial_op.strain_energy(serial);
   EXPECT_TRUE(same_bits(kinetic, serial_op.kinetic_energy(serial))) << kinetic << " vs " << serial_op.kinetic_energy(serial);
+  // Both at once (the run loop's call: one reduction instead of two), the same bits on every rank
+  // and serially.
+  const std::int64_t reductions = dec.traffic().reductions;
+  const pd::ForceOperator::KineticAndStrain both = op.kinetic_and_strain_energy(local);
+  EXPECT_EQ(dec.traffic().reductions, reductions + 1);
+  EXPECT_TRUE(same_bits(both.kinetic, kinetic) && same_bits(both.strain, strain));
+  const pd::ForceOperator::KineticAndStrain serial_both = serial_op.kinetic_and_strain_energy(serial);
+  EXPECT_TRUE(same_bits(serial_both.kinetic, kinetic) && same_bits(serial_both.strain, strain));
 }
 
 TEST_P(Decomposed, BondsCrossingRanksBreakOnBothEndsInTheSameStepAsSerially) {
@@ -219,6 +227,28 @@ TEST(ExactSumOverRanks, EqualsTheSerialExactSumBitwise) {
   EXPECT_TRUE(same_bits(sums[0].value(), pd::exact_sum(terms)));
   EXPECT_TRUE(same_bits(sums[1].value(), squares.value()));
   EXPECT_EQ(dec.traffic().reduction_bytes, 3 * 8 * pd::ExactSum::kLimbs);  // 1 + 2 accumulators, whatever n is
+}
+
+// Integers ride in the same MPI_Allreduce as the exact sums (the breaking pass's count with its
+// lost energy): each summed over the ranks, exactly, and the sums as without them.
+TEST(ExactSumOverRanks, IntegersSumInTheSameReduction) {
+  const pd::Model global = lattice_model(-1.0);
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, global);
+  const pd::LocalPiece& p = dec.piece();
+  pd::ExactSum volume;
+  for (std::int32_t l : p.owned_local) volume.add(p.model.nodes.volume[static_cast<std::size_t>(l)]);
+  std::int64_t integers[2] = {static_cast<std::int64_t>(p.owned_local.size()), dec.rank() + 1};
+  const pd::Decomposed::Traffic before = dec.traffic();
+  dec.reduce(&volume, 1, integers, 2);
+  const int r = rank_count();
+  EXPECT_EQ(integers[0], static_cast<std::int64_t>(global.nodes.size()));
+  EXPECT_EQ(integers[1], static_cast<std::int64_t>(r) * (r + 1) / 2);
+  EXPECT_TRUE(same_bits(volume.value(), pd::exact_sum(global.nodes.volume)));
+  EXPECT_EQ(dec.traffic().reductions, before.reductions + 1);
+  EXPECT_EQ(dec.traffic().reduction_bytes - before.reduction_bytes, 8 * (pd::ExactSum::kLimbs + 2));
+  // total() is such a reduction too, and counted.
+  EXPECT_EQ(dec.total(1), r);
+  EXPECT_EQ(dec.traffic().reductions, before.reductions + 2);
 }
 
 }  // namespace
