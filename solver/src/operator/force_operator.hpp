@@ -122,8 +122,6 @@ class ForceOperator {
   std::vector<const ForceTerm*> built_;                  // per registry entry: its term, or null
   const Decomposed* decomposed_ = nullptr;
   mutable Vec3Array ghosted_x_;  // apply_jacobian's x with its ghosts filled (decomposed only)
-  double decomposed_external_power(const State& s, double t) const;
-  double decomposed_damping_power(const State& s) const;
 };
 
 }  // namespace pd
