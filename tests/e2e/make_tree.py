@@ -50,11 +50,22 @@ def make(tree, name, *targets, timeout=600):
                           text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 
+def default_sigint():
+    """For preexec_fn: SIGINT at its default action in the child, whatever the runner's was.
+
+    A shell started in the background (`cmd &` in a script, nohup) starts its children with SIGINT
+    ignored; the solver keeps an inherited SIG_IGN on purpose (run/signals.cpp), so a test that
+    stops it by SIGINT would then hang. Batch systems and terminals send SIGINT to processes that
+    have it at its default: the tests set it so.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start_make(tree, name, *targets, prefix=()):
     """make in a session (and process group) of its own, as a CI job or a batch script runs it."""
     return subprocess.Popen([*prefix, *make_command(tree, name, *targets)], env=make_env(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            stdin=subprocess.DEVNULL, start_new_session=True)
+                            stdin=subprocess.DEVNULL, start_new_session=True, preexec_fn=default_sigint)
 
 
 def wait_for_steps(out, process, seconds=120):

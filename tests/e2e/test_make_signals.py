@@ -15,7 +15,7 @@ import time
 import pytest
 
 from e2e_support import SOLVER, new_case_folder  # noqa: E402
-from make_tree import make_tree, start_make, wait_for_steps
+from make_tree import default_sigint, make_tree, start_make, wait_for_steps
 
 NAME = "sig"
 
@@ -44,7 +44,8 @@ def assert_whole_checkpoint(out, signal_name):
     assert f"interrupted by {signal_name} after step" in (out / "run.log").read_text()
     # The solver itself accepts it (checksum, case and node-file hashes): restart and stop at once.
     restart = subprocess.Popen([SOLVER, str(out / "case.json"), "--restart", str(checkpoint), "--quiet"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=default_sigint)
     time.sleep(1.0)
     restart.send_signal(signal.SIGINT)
     _, err = restart.communicate(timeout=120)

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <memory>
 
-#include "core/exact_sum.hpp"
+#include "parallel/node_sum.hpp"
 
 namespace pd {
 
@@ -16,28 +16,16 @@ void BodyForceTerm::AddMult(double t, Vec3Array& f) const {
   }
 }
 
-double BodyForceTerm::power(double t, const Vec3Array& v) const {
+double BodyForceTerm::power(double t, const Vec3Array& v, const Decomposed* d) const {
+  // One exact sum per condition, continuing the last (parallel/node_sum.hpp): the same bits for
+  // any rank and thread count.
   double p = 0.0;
+  std::vector<double> scratch;
   for (const auto& b : model_.conditions.body_forces) {
     const double value = b.table.value(t);
     const auto& vc = v[static_cast<std::size_t>(b.component)];
-    ExactSum sum(p);  // one exact sum per condition, continuing the last (as the decomposed power below)
-    for (std::int32_t i : b.nodes) sum.add(model_.nodes.volume[static_cast<std::size_t>(i)] * value * vc[static_cast<std::size_t>(i)]);
-    p = sum.value();
-  }
-  return p;
-}
-
-double BodyForceTerm::power(double t, const Vec3Array& v, const Decomposed& d) const {
-  double p = 0.0;
-  std::vector<double> term(v[0].size());
-  for (const auto& b : model_.conditions.body_forces) {
-    const double value = b.table.value(t);
-    const auto& vc = v[static_cast<std::size_t>(b.component)];
-    std::fill(term.begin(), term.end(), 0.0);  // a node outside the set adds 0: nothing
-    for (std::int32_t i : b.nodes)
-      term[static_cast<std::size_t>(i)] = model_.nodes.volume[static_cast<std::size_t>(i)] * value * vc[static_cast<std::size_t>(i)];
-    p = d.exact_sum(term, p);
+    p = sum_over_set(d, b.nodes, v[0].size(), scratch, p,
+                     [&](std::size_t i) { return model_.nodes.volume[i] * value * vc[i]; });
   }
   return p;
 }
@@ -54,7 +42,7 @@ class BodyForceOnSets : public ForceTerm {
   explicit BodyForceOnSets(const Model& model) : model_(model) {}
   void add_force(State& s, double t) const override { BodyForceTerm(model_).AddMult(t, s.f); }
   void add_power(const State& s, double t, double& p) const override {
-    p += decomposed_ ? BodyForceTerm(model_).power(t, s.v, *decomposed_) : BodyForceTerm(model_).power(t, s.v);
+    p += BodyForceTerm(model_).power(t, s.v, decomposed_);
   }
   void add_jacobian_product(const State&, double, const Vec3Array&, Vec3Array&) const override {}
   bool add_tangent_diagonal(const State&, double, std::size_t, double*) const override { return true; }

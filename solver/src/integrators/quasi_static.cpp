@@ -12,7 +12,7 @@
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
-#include "core/exact_sum.hpp"
+#include "parallel/node_sum.hpp"
 #include "integrators/messages.hpp"
 #include "integrators/newton_krylov.hpp"
 
@@ -264,32 +264,23 @@ double QuasiStatic::load_scale(const State& s, double t) const {
   // body forces, as force vectors [N].
   const Model& m = op_.model();
   const Decomposed* d = op_.decomposed();
+  // One exact sum of r² per condition, continuing the last (parallel/node_sum.hpp), as
+  // ForceOperator's powers: the same bits serially and on any number of ranks.
   double sum = 0.0;
-  // One condition's Σ r², continuing the sum: an exact sum (core/exact_sum.hpp) over the
-  // condition's nodes, serially, or over the owned ones and the ranks (as ForceOperator's powers).
-  std::vector<double> term(d ? s.size() : 0);
-  const auto add = [&](const std::vector<std::int32_t>& nodes, const auto& r_of) {
-    if (!d) {
-      ExactSum exact(sum);
-      for (std::int32_t i32 : nodes) {
-        const double r = r_of(static_cast<std::size_t>(i32));
-        exact.add(r * r);
-      }
-      sum = exact.value();
-      return;
-    }
-    std::fill(term.begin(), term.end(), 0.0);
-    for (std::int32_t i32 : nodes) {
-      const double r = r_of(static_cast<std::size_t>(i32));
-      term[static_cast<std::size_t>(i32)] = r * r;
-    }
-    sum = d->exact_sum(term, sum);
-  };
-  for (const auto& p : m.conditions.prescribed)
-    add(p.nodes, [&](std::size_t i) { return m.nodes.volume[i] * s.f[static_cast<std::size_t>(p.component)][i]; });
+  std::vector<double> scratch;
+  for (const auto& p : m.conditions.prescribed) {
+    const auto& fc = s.f[static_cast<std::size_t>(p.component)];
+    sum = sum_over_set(d, p.nodes, s.size(), scratch, sum, [&](std::size_t i) {
+      const double r = m.nodes.volume[i] * fc[i];
+      return r * r;
+    });
+  }
   for (const auto& b : m.conditions.body_forces) {
     const double value = b.table.value(t);
-    add(b.nodes, [&](std::size_t i) { return m.nodes.volume[i] * value; });
+    sum = sum_over_set(d, b.nodes, s.size(), scratch, sum, [&](std::size_t i) {
+      const double r = m.nodes.volume[i] * value;
+      return r * r;
+    });
   }
   return std::sqrt(sum);
 }

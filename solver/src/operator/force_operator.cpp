@@ -338,69 +338,26 @@ ForceOperator::KineticAndStrain ForceOperator::kinetic_and_strain_energy(const S
 }
 
 double ForceOperator::external_power(const State& s, double t) const {
-  if (decomposed_) return decomposed_external_power(s, t);
-  double p = 0.0;
-  for (const ForceTerm* term : power_terms_) term->add_power(s, t, p);
-  for (const auto& bc : model_.conditions.prescribed) {
-    const auto c = static_cast<std::size_t>(bc.component);
-    const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;
-    ExactSum sum(p);  // one exact sum per condition, continuing the last (as decomposed_external_power)
-    for (std::int32_t i32 : bc.nodes) {
-      const auto i = static_cast<std::size_t>(i32);
-      const double reaction = model_.density[i] * a - s.f[c][i];  // force density the support applies
-      sum.add(model_.nodes.volume[i] * reaction * s.v[c][i]);
-    }
-    p = sum.value();
-  }
-  return p;
-}
-
-// The serial loops of external_power and damping_power, one exact sum per loop, each continuing
-// the last (parallel/decomposed.hpp): the same exact sums rounded at the same places, so the same bits.
-double ForceOperator::decomposed_external_power(const State& s, double t) const {
   // The force terms' powers first, in power order, each reduced by the term itself (it knows the
-  // decomposition: ForceTerm::set_decomposed), then the supports' loops.
+  // decomposition: ForceTerm::set_decomposed), then one exact sum per support, continuing the last
+  // (parallel/node_sum.hpp): the same bits serially and on any number of ranks.
   double p = 0.0;
   for (const ForceTerm* term : power_terms_) term->add_power(s, t, p);
-  std::vector<double> term(s.size());
+  std::vector<double> scratch;
   for (const auto& bc : model_.conditions.prescribed) {
     const auto c = static_cast<std::size_t>(bc.component);
     const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;
-    std::fill(term.begin(), term.end(), 0.0);
-    for (std::int32_t i32 : bc.nodes) {
-      const auto i = static_cast<std::size_t>(i32);
-      const double reaction = model_.density[i] * a - s.f[c][i];
-      term[i] = model_.nodes.volume[i] * reaction * s.v[c][i];
-    }
-    p = decomposed_->exact_sum(term, p);
+    p = sum_over_set(decomposed_, bc.nodes, s.size(), scratch, p, [&](std::size_t i) {
+      const double reaction = model_.density[i] * a - s.f[c][i];  // force density the support applies
+      return model_.nodes.volume[i] * reaction * s.v[c][i];
+    });
   }
   return p;
-}
-
-double ForceOperator::decomposed_damping_power(const State& s) const {
-  if (model_.damping == 0.0) return 0.0;
-  const Model& m = model_;
-  // The three components' exact sums in one reduction; then each continues the last as the serial
-  // loop does (exact_sum(term, p) adds p after the ranks' sums): the same bits.
-  std::array<ExactSum, 3> sum;
-  for (std::int32_t l : decomposed_->piece().owned_local)
-    for (std::size_t d = 0; d < 3; ++d) {
-      const auto i = static_cast<std::size_t>(l);
-      if (!m.conditions.fixed[d][i]) sum[d].add(m.density[i] * m.nodes.volume[i] * s.v[d][i] * s.v[d][i]);
-    }
-  decomposed_->reduce(sum.data(), 3);
-  double p = 0.0;
-  for (std::size_t d = 0; d < 3; ++d) {
-    sum[d].add(p);
-    p = sum[d].value();
-  }
-  return model_.damping * p;
 }
 
 void ForceOperator::update_work(State& s, double t, double dt) const {
   const double pe = external_power(s, t);
-  const double pd = decomposed_ ? decomposed_damping_power(s)
-                                : damping_power(model_.damping, model_.density, model_.nodes.volume, s.v, model_.conditions.fixed);
+  const double pd = damping_power(model_.damping, model_.density, model_.nodes.volume, s.v, model_.conditions.fixed, decomposed_);
   s.external_work += 0.5 * dt * (s.external_power + pe);
   s.damping_work += 0.5 * dt * (s.damping_power + pd);
   s.external_power = pe;

@@ -132,8 +132,6 @@ class ForceOperator {
   // report.broken and report.energy summed over the ranks from this rank's count and lost_, in one
   // reduction (decomposed only).
   void reduce_break_report(BreakReport& report);
-  double decomposed_external_power(const State& s, double t) const;
-  double decomposed_damping_power(const State& s) const;
 };
 
 }  // namespace pd

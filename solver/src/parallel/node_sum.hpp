@@ -6,6 +6,7 @@
 #pragma once
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "core/exact_sum.hpp"
@@ -37,11 +38,41 @@ std::array<double, K> sums_over_nodes(const Decomposed* d, std::size_t n, Terms 
   return out;
 }
 
-// Σ_i term(i) over the n local nodes (the owned ones on a decomposed run), exactly, rounded once.
-// Collective on a decomposed run.
+// start + Σ_i term(i) over the n local nodes (the owned ones on a decomposed run), exactly, rounded
+// once. Collective on a decomposed run. `start` lets one sum continue another with one rounding
+// per loop, so a run's serial and decomposed sums round at the same places.
 template <class Term>
-double sum_over_nodes(const Decomposed* d, std::size_t n, Term term) {
-  return sums_over_nodes<1>(d, n, [&](std::size_t i) { return std::array<double, 1>{term(i)}; })[0];
+double sum_over_nodes(const Decomposed* d, std::size_t n, Term term, double start = 0.0) {
+  if (!d) {
+    ExactSum sum(start);
+    for (std::size_t i = 0; i < n; ++i) sum.add(term(i));
+    return sum.value();
+  }
+  // The owned nodes' terms straight into the accumulator (no per-node buffer), then the ranks'
+  // accumulators, then start once (Decomposed::exact_sum's order; exact, so any order is the same).
+  ExactSum sum;
+  for (std::int32_t l : d->piece().owned_local) sum.add(term(static_cast<std::size_t>(l)));
+  d->reduce(&sum, 1);
+  sum.add(start);
+  return sum.value();
+}
+
+// start + Σ_{i in nodes} term(i) over one node set (a condition's nodes, local indices), exactly,
+// rounded once. Serially in the set's order; decomposed as a per-node array of the n local nodes,
+// 0 outside the set, summed over the owned nodes and the ranks (a 0 adds nothing to an exact sum,
+// so both give the same bits). `scratch` is reused between calls so a loop over conditions
+// allocates once. Collective on a decomposed run.
+template <class Term>
+double sum_over_set(const Decomposed* d, const std::vector<std::int32_t>& nodes, std::size_t n,
+                    std::vector<double>& scratch, double start, Term term) {
+  if (!d) {
+    ExactSum sum(start);
+    for (std::int32_t i : nodes) sum.add(term(static_cast<std::size_t>(i)));
+    return sum.value();
+  }
+  scratch.assign(n, 0.0);
+  for (std::int32_t i : nodes) scratch[static_cast<std::size_t>(i)] = term(static_cast<std::size_t>(i));
+  return d->exact_sum(scratch, start);
 }
 
 }  // namespace pd
