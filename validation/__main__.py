@@ -12,7 +12,7 @@ import subprocess
 import sys
 import time
 
-from . import branching, convergence, drum, plate_with_hole, static, three_point_bending, traction, wave, wave_lps
+from . import branching, c3_lps, convergence, drum, plate_with_hole, static, three_point_bending, traction, wave, wave_lps
 from .figures import FIGURES
 from .runner import ROOT
 
@@ -24,7 +24,7 @@ CONFIGS = {"branching-lps": ("branching", "lps")}
 # Checks that run their own small models (validation/models/) into out/validate/work/<name>/ and
 # draw their own PNG: validate(report_dir) -> rows.
 MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.validate, "wave_lps": wave_lps.validate,
-                "static": static.validate}
+                "static": static.validate, "c3_lps": c3_lps.validate}
 
 
 def main(argv: list[str]) -> int:

@@ -17,6 +17,11 @@ struct Tension {
   bool converged = false;
   double interior_xx = 0.0, interior_yy = 0.0;  // ε fitted 2δ or more from the lateral faces
   double section_xx = 0.0, section_yy = 0.0;    // ε fitted over every node of the middle third
+  // Where the interior's strain comes from (measurement, validation/README.md): per x layer i the
+  // interior ε_yy (slope of u_y over y, and of u_z over z in 3D, averaged) and ε_xx (central
+  // difference of the interior's mean u_x); per gap j between y rows, (u_y(j+1) − u_y(j))/dx averaged
+  // over the middle third in x and the interior in z.
+  std::vector<double> layer_xx, layer_yy, gap_yy;
 };
 
 // An nx × ny × nz lattice (nz = 1 in 2D) at spacing dx: u_x = 0 on its left face (x = 0), and u_y,
@@ -107,6 +112,41 @@ inline Tension static_tension(const pd::Model& m, int nx, int ny, int nz, double
   const int kin_lo = plane ? 0 : inner, kin_hi = plane ? 0 : nz - 1 - inner;
   fit(inner, ny - 1 - inner, kin_lo, kin_hi, out.interior_xx, out.interior_yy);
   fit(0, ny - 1, 0, nz - 1, out.section_xx, out.section_yy);
+  // The profiles. Slope of u_c over coordinate c on layer i: least squares over the interior nodes.
+  std::vector<double> mean_ux(static_cast<std::size_t>(nx), 0.0);
+  out.layer_yy.assign(static_cast<std::size_t>(nx), 0.0);
+  for (int i = 0; i < nx; ++i) {
+    double slope_sum = 0.0;
+    int slopes = 0, count = 0;
+    for (int c = 1; c <= (plane ? 1 : 2); ++c) {
+      double sx = 0.0, sxx = 0.0, su = 0.0, sxu = 0.0;
+      int n_c = 0;
+      for (int k = kin_lo; k <= kin_hi; ++k)
+        for (int j = inner; j <= ny - 1 - inner; ++j) {
+          const std::size_t q = node_index(i, j, k, nx, ny);
+          const double xc = m.nodes.x[static_cast<std::size_t>(c)][q], uc = u[static_cast<std::size_t>(c)][q];
+          sx += xc, sxx += xc * xc, su += uc, sxu += xc * uc, ++n_c;
+          if (c == 1) mean_ux[static_cast<std::size_t>(i)] += u[0][q], ++count;
+        }
+      slope_sum += (n_c * sxu - sx * su) / (n_c * sxx - sx * sx);
+      ++slopes;
+    }
+    out.layer_yy[static_cast<std::size_t>(i)] = slope_sum / slopes;
+    mean_ux[static_cast<std::size_t>(i)] /= count;
+  }
+  out.layer_xx.assign(static_cast<std::size_t>(nx), 0.0);
+  for (int i = 1; i + 1 < nx; ++i)
+    out.layer_xx[static_cast<std::size_t>(i)] =
+        (mean_ux[static_cast<std::size_t>(i + 1)] - mean_ux[static_cast<std::size_t>(i - 1)]) / (2.0 * dx);
+  out.gap_yy.assign(static_cast<std::size_t>(ny - 1), 0.0);
+  for (int j = 0; j + 1 < ny; ++j) {
+    double s = 0.0;
+    int c = 0;
+    for (int k = kin_lo; k <= kin_hi; ++k)
+      for (int i = nx / 3; i < 2 * nx / 3; ++i, ++c)
+        s += u[1][node_index(i, j + 1, k, nx, ny)] - u[1][node_index(i, j, k, nx, ny)];
+    out.gap_yy[static_cast<std::size_t>(j)] = s / (c * dx);
+  }
   return out;
 }
 
