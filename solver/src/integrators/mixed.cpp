@@ -135,14 +135,21 @@ void Mixed::step(State& state, double& t, double& dt) {
     static_dt_ = dt;
     static_.guess_from_velocity(step_mode_ == kQuasiStatic);  // not from an explicit step's velocity
     // The first load step after a return on the separation rule is tentative: the pieces left
-    // ringing may hold mechanisms (nodes hanging by one bond or by collinear ones) that keep Newton
-    // from converging (measured on plate_with_hole at dx = 0.5 mm: 6 attempts of 30 iterations, then
-    // explicit again); it then fails after kTentativeIterations, and the rule is given up.
+    // ringing may hold mechanisms that keep Newton from converging (measured on plate_with_hole at
+    // dx = 0.5 mm before hanging nodes were left out of the solve, integrators/hanging_nodes.hpp:
+    // 6 attempts of 30 iterations, then explicit again); it then fails after kTentativeIterations,
+    // and the rule is given up.
     const bool tentative = step_mode_ == kExplicit && separated_ && !separation_given_up_;
     if (tentative) static_.try_once(kTentativeIterations);
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();
+      if (tentative)
+        log_lines_.push_back("mixed: t = " + message_number(t) + " s: back in load steps: equilibrium in " +
+                             std::to_string(report_.iterations) + " Newton iterations (" +
+                             std::to_string(static_.hanging_nodes()) +
+                             " nodes hanging by collinear bonds left out of the solve and placed on their bonds' line, " +
+                             std::to_string(static_.free_fragment_nodes()) + " nodes of free fragments left as they were)");
       step_mode_ = kQuasiStatic;
       static_dt_ = report_.next_dt;
       return;

@@ -31,6 +31,10 @@ void QuasiStatic::configure(const Case& c, double) {
     throw Error(c.file.string() + ": damping: quasi_static solves for equilibrium, where damping does nothing; "
                 "set damping: 0 (or use time.integrator: verlet)");
   choose_linear_solver(c);
+  // Whether the law is bond-based (has bond_tangent_row): only then are hanging nodes left out.
+  const Model& m = op_.model();
+  std::vector<double> probe(9 * (m.bonds.offsets.size() > 1 ? static_cast<std::size_t>(m.bonds.offsets[1]) : 0) + 9);
+  bond_based_ = m.nodes.size() == 0 || m.bond_model->bond_tangent_row(m, make_vec3(m.nodes.size()), 0, probe.data());
 }
 
 // direct or cg, and why (for describe()). The 3D threshold kCgFromDofs3d is measured with
@@ -175,6 +179,8 @@ void QuasiStatic::initialize(State& state, double t) {
   }
   trial_ = State(state.size());
   report_ = StepReport{};
+  hanging_ = HangingNodes{};
+  skip_dof_.clear();
   carried_load_ = 0.0;
   started_cold_ = false;
   if (use_cg_) {
@@ -256,6 +262,8 @@ double QuasiStatic::residual_norm(const State& s) const {
     const double r = volume[i] * s.f[dofs_.component[k]][i];
     terms_[k] = r * r;
   }
+  for (std::size_t k = 0; k < skip_dof_.size(); ++k)
+    if (skip_dof_[k]) terms_[k] = 0.0;  // a hanging or free node's (hanging_nodes.hpp)
   return std::sqrt(sums_.sum(terms_));
 }
 
@@ -376,6 +384,12 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   std::memcpy(&t, at, sizeof t), at += sizeof t;
   std::memcpy(&factorisations, at, sizeof factorisations), at += sizeof factorisations;
   have_factor_ = false;
+  // The factorisation and the hierarchy were made with the hanging nodes' bonds masked, if there were
+  // any: the same nodes now (a function of the broken flags, which have not changed since: breaking
+  // forgets both), so the same masked K.
+  broken_since_start_ = op_.any_broken();
+  find_hanging();
+  MaskedBonds masked(hanging_, op_.model().bonds, !skip_dof_.empty());
   if (have) {
     State s(n);
     for (auto& component : s.u) std::memcpy(component.data(), at, n * sizeof(double)), at += n * sizeof(double);
@@ -399,7 +413,46 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   }
 }
 
+void QuasiStatic::find_hanging() {
+  skip_dof_.clear();
+  // Only a bond-based law: masking a bond of a state-based one (LPS) would change its neighbours'
+  // dilatation, not only the hanging node's force. Before any bond has broken the lattice is whole
+  // (and a node hanging from the start makes the first factorisation fail with its own message).
+  if (!bond_based_ || !broken_since_start_) {
+    hanging_ = HangingNodes{};
+    return;
+  }
+  hanging_.find(op_.model(), op_.fixed(), op_.decomposed());
+  if (hanging_.count() == 0 && hanging_.free_count() == 0) return;
+  skip_dof_.assign(dofs_.size(), 0);
+  for (std::size_t q = 0; q < dofs_.size(); ++q) skip_dof_[q] = hanging_.left_out(static_cast<std::size_t>(dofs_.node[q])) ? 1 : 0;
+}
+
+// Newton with the hanging nodes' bonds and the free fragments left out, then the hanging nodes placed
+// on their bonds' line and the force evaluated with every bond (hanging_nodes.hpp): what a caller and
+// the next explicit step see. Without either: Newton alone, as before (the same operations, the same
+// bits).
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
+  find_hanging();
+  if (skip_dof_.empty()) return newton(s, t1, u_start, iterations, omega);
+  // A free fragment stays where the last state left it: not where the predictor would carry it (its
+  // last mean velocity, extrapolated, would go on stretching it load step after load step).
+  for (std::size_t q = 0; q < dofs_.size(); ++q) {
+    const auto i = static_cast<std::size_t>(dofs_.node[q]);
+    if (hanging_.free(i)) s.u[dofs_.component[q]][i] = u_start[dofs_.component[q]][i];
+  }
+  MaskedBonds masked(hanging_, op_.model().bonds, hanging_.count() > 0);
+  const bool converged = newton(s, t1, u_start, iterations, omega);
+  masked.release();
+  if (!converged) return false;
+  if (hanging_.count() == 0) return true;  // only free fragments: nothing was masked, s.f stands
+  hanging_.place(op_.model(), s.u, op_.decomposed());
+  op_.evaluate(s, t1);
+  ++report_.force_evaluations;
+  return true;
+}
+
+bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
   double previous = HUGE_VAL;
   double eta = kEtaMax;  // the forcing term of the matrix-free path
   bool evaluated = false;  // s.f is already the force at s.u (the line search's accepted trial)
@@ -461,6 +514,10 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       const auto i = static_cast<std::size_t>(dofs_.node[q]);
       rhs_[q] = volume[i] * s.f[dofs_.component[q]][i];
     }
+    // A hanging node's force (its bonds masked: only a body force or contact, if any) is not solved
+    // for: it is placed after the solve; nor a free fragment's (it carries no load: it stays).
+    for (std::size_t q = 0; q < skip_dof_.size(); ++q)
+      if (skip_dof_[q]) rhs_[q] = 0.0;
     if (use_cg_) {
       // Eisenstat–Walker choice 2: η_k = γ (‖F_k‖/‖F_{k−1}‖)², γ = 0.9, kept ≥ γ η_{k−1}² when that is
       // above 0.1 (so that η does not fall too fast), ≤ kEtaMax; and no tighter than half the
@@ -479,6 +536,8 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
       ++solves_;
     }
+    for (std::size_t q = 0; q < skip_dof_.size(); ++q)
+      if (skip_dof_[q]) correction_[q] = 0.0;
     previous = residual;
     // Backtracking: the full step unless it raises the residual (then ½, ¼, … up to 1/32).
     double alpha = 1.0, step_norm = 0.0, motion = 0.0;
@@ -506,6 +565,8 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
       terms_[q] = du * du;
       motion_terms_[q] = from_start * from_start;
     }
+    for (std::size_t q = 0; q < skip_dof_.size(); ++q)
+      if (skip_dof_[q]) terms_[q] = motion_terms_[q] = 0.0;  // placed after the solve, or staying: not in ω
     const std::vector<double> norms = sums_.sums({&terms_, &motion_terms_});
     step_norm = norms[0];
     motion = norms[1];
@@ -638,7 +699,10 @@ std::vector<std::string> QuasiStatic::describe(double) const {
                          ", Eisenstat-Walker forcing (cg, "
                    : std::string("; tangent factorised by CHOLMOD (direct, ")) +
           solver_reason_ + ")" + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
-          " s, dt_max " + message_number(dt_max_) + " s"};
+          " s, dt_max " + message_number(dt_max_) + " s" +
+          (bond_based_ ? "; once bonds have broken, nodes hanging by bonds on one line and one side are left out of "
+                         "each solve and placed on their bonds' line after it, and free fragments stay where they are"
+                       : std::string())};
 }
 
 }  // namespace pd

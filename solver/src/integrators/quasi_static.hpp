@@ -42,10 +42,16 @@
 // on, by large rotations or compressed bonds). The point of the set-up (u, t) and that first rate
 // are checkpointed, and load_state sets the hierarchy up again there: hypre's serial set-up is
 // deterministic, so a restarted run continues bitwise.
+//
+// Once bonds have broken, nodes that hang by bonds on one line and one side (or by none) are left
+// out of each static solve and placed on their bonds' line after it (integrators/hanging_nodes.hpp:
+// Newton converges on their sideways offset only linearly, and they carry no load in statics); so
+// are free fragments (no intact chain to a prescribed motion), which stay where they are.
 #pragma once
 #include <algorithm>
 #include <memory>
 
+#include "integrators/hanging_nodes.hpp"
 #include "integrators/integrator.hpp"
 #include "linalg/amg.hpp"
 #include "linalg/cholesky.hpp"
@@ -109,11 +115,22 @@ class QuasiStatic : public Integrator {
   const std::string& failure_reason() const { return failure_reason_; }
   double dt_min() const { return dt_min_; }
   double dt_max() const { return dt_max_; }
+  // The nodes the last static solve left out as hanging (hanging_nodes.hpp), over the whole model.
+  std::int64_t hanging_nodes() const { return hanging_.count(); }
+  std::int64_t free_fragment_nodes() const { return hanging_.free_count(); }
 
  private:
   // Newton at load t1 from state.u (prescribed components already at t1). True when converged;
   // iterations, the last ω_K and the evaluations are added to the report.
   bool solve_equilibrium(State& trial, double t1, const Vec3Array& u_start, int& iterations, double& omega);
+  // Newton itself, over the free dofs but those of hanging nodes (solve_equilibrium masks their bonds).
+  bool newton(State& trial, double t1, const Vec3Array& u_start, int& iterations, double& omega);
+  // Finds the hanging nodes now (after bonds have broken, for a bond-based law): skip_dof_ is then
+  // 1 at their dofs, else empty. Collective.
+  void find_hanging();
+  HangingNodes hanging_;
+  bool bond_based_ = false;               // the law has bond_tangent_row (PMB): see hanging_nodes.hpp
+  std::vector<std::uint8_t> skip_dof_;    // per free dof: a hanging or free node's (empty: none)
   double load_scale(const State& s, double t) const;
   // The force the residual test measures against: the load now, or the largest load an accepted
   // load step has carried when that is larger (see solve_equilibrium).

@@ -1,0 +1,248 @@
+// Finding, masking and placing the nodes that hang by collinear bonds (integrators/hanging_nodes.hpp).
+#include "integrators/hanging_nodes.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "parallel/decomposed.hpp"
+#include "parallel/local_model.hpp"
+
+namespace pd {
+
+namespace {
+
+// Whether the bonds of row i to the nodes `active` lets through lie on one line and on one side of
+// i in the reference configuration (or there are none).
+template <class Active>
+bool hangs(const Model& m, std::size_t i, const Active& active) {
+  const auto& X = m.nodes.x;
+  const auto& bonds = m.bonds;
+  bool first = true;
+  double e[3] = {0.0, 0.0, 0.0};
+  for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    if (bonds.broken[ku]) continue;
+    const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+    if (!active(j)) continue;
+    const double length = bond_length(X, i, j);
+    const double n[3] = {(X[0][j] - X[0][i]) / length, (X[1][j] - X[1][i]) / length, (X[2][j] - X[2][i]) / length};
+    if (first) {
+      std::copy(n, n + 3, e);
+      first = false;
+      continue;
+    }
+    const double cross[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]};
+    const double sine = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+    if (sine > HangingNodes::kCollinearSine || e[0] * n[0] + e[1] * n[1] + e[2] * n[2] <= 0.0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d) {
+  const std::size_t n = m.nodes.size();
+  round_.assign(n, 0.0);
+  masked_.clear();
+  rounds_ = 0;
+  total_ = 0;
+  const int dimension = m.nodes.dimension;
+  std::vector<std::uint8_t> candidate(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    bool free = !d || d->piece().owned[i];
+    for (int c = 0; c < dimension; ++c) free = free && !fixed[static_cast<std::size_t>(c)][i];
+    candidate[i] = free ? 1 : 0;
+  }
+  const auto count = static_cast<std::int64_t>(n);
+  std::vector<std::uint8_t> now_found(n, 0);
+  for (int r = 1;; ++r) {
+    // Round r: a node still in the body hangs when its bonds to the nodes that were still in the body
+    // at the start of the round hang; a Jacobi sweep (the verdicts written after it), so they do
+    // not depend on the order in which the threads reach the nodes.
+    std::int64_t found = 0;
+#pragma omp parallel for schedule(dynamic, 512) reduction(+ : found)
+    for (std::int64_t q = 0; q < count; ++q) {
+      const auto i = static_cast<std::size_t>(q);
+      now_found[i] = 0;
+      if (!candidate[i] || round_[i] > 0.0) continue;
+      if (hangs(m, i, [&](std::size_t j) { return round_[j] == 0.0; })) {
+        now_found[i] = 1;
+        ++found;
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (now_found[i]) round_[i] = r;
+    if (d) {
+      d->update_ghosts(round_);
+      found = d->total(found);
+    }
+    if (found == 0) break;
+    rounds_ = r;
+    total_ += found;
+  }
+  find_free(m, fixed, d);
+}
+
+void HangingNodes::find_free(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d) {
+  // held_: reached from a node with a prescribed component through intact bonds between nodes that
+  // do not hang. A breadth-first search over the rows this piece owns, seeded with the held nodes
+  // and the owned neighbours of held ghosts; on a decomposed run the ghosts' verdicts are exchanged
+  // and the search goes on until no rank finds more (the closure is unique: the same nodes as the
+  // serial search).
+  const std::size_t n = m.nodes.size();
+  const auto& bonds = m.bonds;
+  held_.assign(n, 0.0);
+  free_total_ = 0;
+  const auto owned = [&](std::size_t i) { return !d || d->piece().owned[i] != 0; };
+  std::vector<std::size_t> queue;
+  for (std::size_t i = 0; i < n; ++i)
+    if (owned(i) && (fixed[0][i] || fixed[1][i] || fixed[2][i])) held_[i] = 1.0, queue.push_back(i);
+  const auto link = [&](std::size_t k, std::size_t i) {
+    const auto j = static_cast<std::size_t>(bonds.neighbour[k]);
+    return bonds.broken[k] == 0 && round_[i] == 0.0 && round_[j] == 0.0 ? j : n;
+  };
+  for (;;) {
+    for (std::size_t at = 0; at < queue.size(); ++at) {
+      const std::size_t i = queue[at];
+      for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+        const std::size_t j = link(static_cast<std::size_t>(k), i);
+        if (j == n || held_[j] != 0.0) continue;
+        held_[j] = 1.0;
+        if (owned(j)) queue.push_back(j);
+      }
+    }
+    if (!d) break;
+    d->update_ghosts(held_);
+    // Owned nodes bonded to a ghost held on its owner's side: the search goes on from them.
+    queue.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!owned(i) || held_[i] != 0.0) continue;
+      for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+        const std::size_t j = link(static_cast<std::size_t>(k), i);
+        if (j != n && held_[j] != 0.0) {
+          held_[i] = 1.0, queue.push_back(i);
+          break;
+        }
+      }
+    }
+    if (d->total(static_cast<std::int64_t>(queue.size())) == 0) break;
+  }
+  std::int64_t free_here = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (owned(i) && free(i)) ++free_here;
+  free_total_ = d ? d->total(free_here) : free_here;
+}
+
+void HangingNodes::mask(BondList& bonds) {
+  masked_.clear();
+  if (total_ == 0) return;
+  const std::size_t n = bonds.nodes();
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      if (bonds.broken[ku]) continue;
+      if (round_[i] > 0.0 || round_[static_cast<std::size_t>(bonds.neighbour[ku])] > 0.0) {
+        bonds.broken[ku] = kMasked;
+        masked_.push_back(k);
+      }
+    }
+}
+
+void HangingNodes::unmask(BondList& bonds) {
+  for (std::int64_t k : masked_) bonds.broken[static_cast<std::size_t>(k)] = 0;
+  masked_.clear();
+}
+
+void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) const {
+  if (total_ == 0) return;
+  const auto& X = m.nodes.x;
+  const auto& bonds = m.bonds;
+  const std::size_t n = m.nodes.size();
+  const int dimension = m.nodes.dimension;
+  for (int r = rounds_; r >= 1; --r) {
+    // The anchors of round r's nodes are placed (later rounds) or in the body: their ghosts' u first.
+    if (d) d->update_ghosts(u);
+    const double now = r;
+    // Two passes: the new positions from u as it is (a node of this round may be bonded to another
+    // of this round, read by the law's tangent row), then written.
+    std::vector<std::int64_t> nodes;
+    for (std::size_t i = 0; i < n; ++i)
+      if (round_[i] == now) nodes.push_back(static_cast<std::int64_t>(i));
+    const auto members = static_cast<std::int64_t>(nodes.size());
+    std::vector<double> placed(3 * nodes.size());
+    std::vector<std::uint8_t> moved(nodes.size(), 0);
+#pragma omp parallel
+    {
+      std::vector<double> blocks;
+#pragma omp for schedule(dynamic, 64)
+      for (std::int64_t g = 0; g < members; ++g) {
+        const auto i = static_cast<std::size_t>(nodes[static_cast<std::size_t>(g)]);
+        const auto first = bonds.offsets[i], last = bonds.offsets[i + 1];
+        // The axial stiffness of each bond from the law's own tangent row at u, w_b = n_bᵀ K_b n_b.
+        blocks.assign(static_cast<std::size_t>(9 * (last - first)), 0.0);
+        const bool have_tangent = m.bond_model->bond_tangent_row(m, u, i, blocks.data());
+        // The anchors: intact bonds to nodes in the body or placed in a later round.
+        std::int64_t nearest = -1, farthest = -1;
+        double near_length = HUGE_VAL, far_length = -HUGE_VAL;
+        for (std::int64_t k = first; k < last; ++k) {
+          const auto ku = static_cast<std::size_t>(k);
+          const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+          if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+          const double length = bond_length(X, i, j);
+          if (length < near_length) near_length = length, nearest = k;
+          if (length > far_length) far_length = length, farthest = k;
+        }
+        if (nearest < 0) continue;  // hangs by nothing that holds it: stays
+        const auto position = [&](std::size_t j, int c) {
+          return X[static_cast<std::size_t>(c)][j] + u[static_cast<std::size_t>(c)][j];
+        };
+        // n: from the nearest anchor to the farthest now (the line rotates with them), or the
+        // reference direction of a single anchor (the node is carried by its translation).
+        double line[3] = {0.0, 0.0, 0.0};
+        {
+          const auto jn = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(nearest)]);
+          const auto jf = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(farthest)]);
+          double norm = 0.0;
+          if (far_length > near_length) {
+            for (int c = 0; c < 3; ++c) line[c] = position(jf, c) - position(jn, c);
+          } else {
+            for (int c = 0; c < 3; ++c) line[c] = X[static_cast<std::size_t>(c)][jn] - X[static_cast<std::size_t>(c)][i];
+          }
+          for (int c = 0; c < 3; ++c) norm += line[c] * line[c];
+          norm = std::sqrt(norm);
+          for (double& component : line) component /= norm;
+        }
+        double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0};
+        for (std::int64_t k = first; k < last; ++k) {
+          const auto ku = static_cast<std::size_t>(k);
+          const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+          if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+          const double length = bond_length(X, i, j);
+          double w = 0.0;
+          if (have_tangent) {
+            double y[3], norm = 0.0;
+            for (int c = 0; c < 3; ++c) y[c] = position(j, c) - position(i, c), norm += y[c] * y[c];
+            norm = std::sqrt(norm);
+            const double* b = &blocks[static_cast<std::size_t>(9 * (k - first))];
+            if (norm > 0.0)
+              for (int a = 0; a < 3; ++a)
+                for (int c = 0; c < 3; ++c) w += y[a] * b[3 * a + c] * y[c] / (norm * norm);
+          }
+          if (!(w > 0.0) || !std::isfinite(w)) w = 1.0 / length;  // a law without a tangent row: ν·V equal
+          weight_sum += w;
+          for (int c = 0; c < 3; ++c) sum[c] += w * (position(j, c) - length * line[c]);
+        }
+        for (int c = 0; c < 3; ++c) placed[3 * static_cast<std::size_t>(g) + static_cast<std::size_t>(c)] = sum[c] / weight_sum;
+        moved[static_cast<std::size_t>(g)] = 1;
+      }
+    }
+    for (std::size_t g = 0; g < nodes.size(); ++g)
+      if (moved[g])
+        for (int c = 0; c < dimension; ++c) {
+          const auto i = static_cast<std::size_t>(nodes[g]);
+          u[static_cast<std::size_t>(c)][i] = placed[3 * g + static_cast<std::size_t>(c)] - X[static_cast<std::size_t>(c)][i];
+        }
+  }
+}
+
+}  // namespace pd
