@@ -74,6 +74,7 @@ void Mixed::to_explicit(State&, double t, const std::string& reason) {
 void Mixed::to_quasi_static(State& state, double t, double kinetic, double strain) {
   mode_ = kQuasiStatic;
   ++switches_;
+  if (separated_ && !separation_given_up_) probation_steps_ = kProbationSteps;
   static_.forget_factorisation();  // bonds broke in the explicit steps
   // The next load step finds equilibrium and leaves only the mean velocity of the load step: the
   // kinetic energy now is given up, booked as damping work so that the balance closes.
@@ -139,12 +140,15 @@ void Mixed::step(State& state, double& t, double& dt) {
     // dx = 0.5 mm before hanging nodes were left out of the solve, integrators/hanging_nodes.hpp:
     // 6 attempts of 30 iterations, then explicit again); it then fails after kTentativeIterations,
     // and the rule is given up.
-    const bool tentative = step_mode_ == kExplicit && separated_ && !separation_given_up_;
+    // So are the kProbationSteps - 1 after it (probation_steps_).
+    const bool returning = step_mode_ == kExplicit && separated_ && !separation_given_up_;
+    const bool tentative = returning || probation_steps_ > 0;
     if (tentative) static_.try_once(kTentativeIterations);
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();
-      if (tentative)
+      if (tentative) probation_steps_ = std::max(probation_steps_ - 1, 0);
+      if (returning)
         log_lines_.push_back("mixed: t = " + message_number(t) + " s: back in load steps: equilibrium in " +
                              std::to_string(report_.iterations) + " Newton iterations (" +
                              std::to_string(static_.hanging_nodes()) +
@@ -165,7 +169,7 @@ void Mixed::step(State& state, double& t, double& dt) {
       static_.forget_factorisation();
       evaluations = static_.last_step().force_evaluations;
       rejected = static_.last_step().rejected + 1;
-      if (tentative) separation_given_up_ = true;
+      if (tentative) separation_given_up_ = true, probation_steps_ = 0;
       to_explicit(state, t, static_.failure_reason() +
                                 (tentative ? "; no more returns on the separation, only when the motion has died down" : ""));
     }
@@ -213,7 +217,9 @@ std::vector<char> Mixed::save_state() const {
   const int mode = mode_;
   const std::uint8_t cracked = cracked_ ? 1 : 0;
   put(mode), put(step_mode_), put(calm_steps_), put(static_dt_), put(switches_), put(cracked);
-  const std::uint8_t given_up = separation_given_up_ ? 1 : 0;
+  // The separation rule in one byte (older checkpoints hold 0 or 1): 0 active, 1 given up, 1 + k
+  // active with k load steps of probation left.
+  const std::uint8_t given_up = separation_given_up_ ? 1 : probation_steps_ > 0 ? static_cast<std::uint8_t>(1 + probation_steps_) : 0;
   if (home_ == kImplicit) put(breaking_steps_);
   else put(given_up);
   const std::vector<char> inner = home_ == kImplicit ? implicit_.save_state() : static_.save_state();
@@ -245,7 +251,8 @@ void Mixed::load_state(const std::vector<char>& bytes) {
     // The bonds of the checkpoint are restored before load_state (run/start.cpp).
     std::uint8_t given_up = 0;
     get(given_up);
-    separation_given_up_ = given_up != 0;
+    separation_given_up_ = given_up == 1;
+    probation_steps_ = given_up > 1 ? given_up - 1 : 0;
     // A restart restored the whole model's broken flags on every rank (run/start.cpp) before this.
     separated_ = load_path_ && load_path_->separated(whole_ ? whole_->bonds : op_.model().bonds);
     static_.load_state(inner);
