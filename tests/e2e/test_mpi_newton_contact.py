@@ -11,8 +11,8 @@ the plate (the contact distance is 1.35 dx = 0.675 mm):
 Both with linear_solver: cg, so that the serial run takes the same path. The runs on 2 and 3 ranks
 (and implicit on 2 ranks × 2 threads) write byte for byte the serial run's frames, frames.pvd and
 history.csv (but for its wall_time column; contact_energy included).
-Measured: the file takes 25 s on a 2-core machine at load ~4 (each run 1–5 s, most of it mpiexec's
-start; the solves themselves take under 1 s of CPU).
+Measured: the file took 12 s on the shared 2-core machine at load 7 and 31 s in a busier sitting
+(each run 1–2 s; the solves themselves take under 1 s of CPU).
 """
 import json
 import os
