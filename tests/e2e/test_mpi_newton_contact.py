@@ -14,7 +14,6 @@ history.csv (but for its wall_time column; contact_energy included).
 Measured: the file took 12 s on the shared 2-core machine at load 7 and 31 s in a busier sitting
 (each run 1–2 s; the solves themselves take under 1 s of CPU).
 """
-import json
 import os
 import shutil
 
@@ -23,6 +22,7 @@ import yaml
 
 from e2e_support import ROOT, new_case_folder, prepare_stages  # noqa: E402
 from test_mpi_checkpoint import assert_same_run
+from test_mpi_implicit import copy_case, run_serially
 from test_mpi_ranks import history_without_wall_time, pytestmark, solve  # noqa: F401
 
 # y of the disk's lowest node minus that of the plate's highest at dx = 0.5 mm (the lattice's rows).
@@ -77,17 +77,6 @@ def implicit(case):
 CHANGES = {"mixed": mixed, "implicit": implicit}
 
 
-def copy_case(prepared, name, change):
-    work, out = prepared
-    target = work / name
-    target.mkdir()
-    shutil.copy(out / "nodes.vtu", target / "nodes.vtu")
-    case = json.loads((out / "case.json").read_text())
-    change(case)
-    (target / "case.json").write_text(json.dumps(case))
-    return target
-
-
 def column(folder, name):
     history = history_without_wall_time(folder)
     at = history[0].split(",").index(name)
@@ -96,13 +85,7 @@ def column(folder, name):
 
 @pytest.fixture(scope="module")
 def serial_runs(prepared):
-    runs = {}
-    for name, change in CHANGES.items():
-        folder = copy_case(prepared, f"{name}_serial", change)
-        result = solve(folder, None)
-        assert result.returncode == 0, f"{name}: {result.stderr}"
-        runs[name] = folder
-    return runs
+    return run_serially(prepared, CHANGES)
 
 
 def test_the_disk_presses_on_the_plate_inside_the_newton_solves(serial_runs):

@@ -230,6 +230,7 @@ def test_what_is_not_decomposed_is_refused_before_any_output(prepared):
     before, is decomposed now: test_mpi_newton_contact.py.)"""
     def amg_on_ranks(case):
         case["time"]["integrator"] = "quasi_static"
+        case["damping"] = 0.0  # quasi_static refuses damping (before the preconditioner)
         case["quasi_static"]["preconditioner"] = "amg"
     folder = copy_case(prepared, "refused", amg_on_ranks)
     result = solve(folder, 2)
