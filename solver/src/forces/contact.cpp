@@ -1,7 +1,6 @@
 // The short-range contact kernel over the Verlet list (see contact.hpp).
 #include "forces/contact.hpp"
 
-#include "core/error.hpp"
 #include "core/exact_sum.hpp"
 #include "forces/contact_on_piece.hpp"
 
@@ -79,7 +78,6 @@ double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, V
 }
 
 void add_contact_jacobian_product(const ContactArrays& a, const Vec3Array& du, double* y0, double* y1, double* y2) {
-  const auto& x = du;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i64 = 0; i64 < a.nodes; ++i64) {
     const auto i = static_cast<std::size_t>(i64);
@@ -95,7 +93,7 @@ void add_contact_jacobian_product(const ContactArrays& a, const Vec3Array& du, d
       const double k_vj = a.stiffness_over_horizon * c_row[a.block[j]] * a.volume[j];
       // f_i = −k (d − r) n, n = e/r: δf_i = k [n nᵀ − ((d − r)/r)(I − n nᵀ)] (δu_j − δu_i)
       const double n0 = e0 / r, n1 = e1 / r, n2 = e2 / r;
-      const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
+      const double d0 = du[0][j] - du[0][i], d1 = du[1][j] - du[1][i], d2 = du[2][j] - du[2][i];
       const double along = n0 * d0 + n1 * d1 + n2 * d2, lateral = -k_vj * gap / r;
       s0 += k_vj * along * n0 + lateral * (d0 - along * n0);
       s1 += k_vj * along * n1 + lateral * (d1 - along * n1);
