@@ -95,15 +95,20 @@ def implicit_lps(case):
 CHANGES = {"quasi_static": quasi_static, "mixed": mixed, "implicit": implicit, "implicit_lps": implicit_lps}
 
 
-@pytest.fixture(scope="module")
-def serial_runs(prepared):
+def run_serially(prepared, changes):
+    """Each change's run without mpirun, in folder <name>_serial: {name: folder}."""
     runs = {}
-    for name, change in CHANGES.items():
+    for name, change in changes.items():
         folder = copy_case(prepared, f"{name}_serial", change)
         result = solve(folder, None)
         assert result.returncode == 0, f"{name}: {result.stderr}"
         runs[name] = folder
     return runs
+
+
+@pytest.fixture(scope="module")
+def serial_runs(prepared):
+    return run_serially(prepared, CHANGES)
 
 
 def broken_bonds(folder):

@@ -225,16 +225,17 @@ def test_a_feature_that_reads_whole_rows_keeps_the_whole_list_and_says_so(varian
 
 
 def test_what_is_not_decomposed_is_refused_before_any_output(prepared):
-    """Contact inside a Newton solve: the contact's linearised force is not decomposed."""
-    def contact_in_newton(case):
-        case["contact"].update(self_contact=True)
+    """quasi_static's amg preconditioner is set up on one process's assembled tangent: refused on
+    several ranks, once, by rank 0, before any output. (Contact inside a Newton solve, refused here
+    before, is decomposed now: test_mpi_newton_contact.py.)"""
+    def amg_on_ranks(case):
         case["time"]["integrator"] = "quasi_static"
-    folder = copy_case(prepared, "refused", contact_in_newton)
+        case["damping"] = 0.0  # quasi_static refuses damping (before the preconditioner)
+        case["quasi_static"]["preconditioner"] = "amg"
+    folder = copy_case(prepared, "refused", amg_on_ranks)
     result = solve(folder, 2)
     assert result.returncode != 0
-    assert ("contact with time.integrator: quasi_static (the contact's linearised force) is not decomposed "
-            "over MPI ranks yet") in result.stderr, result.stderr
-    assert "verlet, adaptive, quasi_static, implicit and mixed integrators with pmb and lps bonds" in result.stderr
-    assert "run this case on one rank" in result.stderr
+    assert ("quasi_static.preconditioner: amg is set up on one process and is not decomposed over MPI ranks "
+            "(here 2); use preconditioner: block_jacobi (or auto), or run on one rank") in result.stderr, result.stderr
     assert result.stderr.count("pdsolve: error") == 1  # said once, by rank 0
     assert not (folder / "history.csv").exists() and not (folder / "frames").exists()

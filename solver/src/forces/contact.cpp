@@ -1,7 +1,6 @@
 // The short-range contact kernel over the Verlet list (see contact.hpp).
 #include "forces/contact.hpp"
 
-#include "core/error.hpp"
 #include "core/exact_sum.hpp"
 #include "forces/contact_on_piece.hpp"
 
@@ -49,7 +48,7 @@ double ShortRangeForce::AddMult(const Vec3Array& u, Vec3Array& f) const {
   return AddMult(model_.contact_list.pairs(), u, f);
 }
 
-double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, Vec3Array& f) const {
+ContactArrays ShortRangeForce::arrays(const ContactPairs& pairs, const Vec3Array& u) const {
   const Model& m = model_;
   ContactArrays a;
   a.offsets = pairs.offsets.data();
@@ -65,6 +64,12 @@ double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, V
   a.blocks = m.material.blocks;
   a.nodes = static_cast<std::int64_t>(m.nodes.size());
   a.stiffness_over_horizon = m.contact.stiffness_factor / m.horizon;
+  return a;
+}
+
+double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, Vec3Array& f) const {
+  const Model& m = model_;
+  const ContactArrays a = arrays(pairs, u);
   std::vector<double> e(m.nodes.size());
   add_contact_force_density(a, f[0].data(), f[1].data(), f[2].data(), e.data());
   ExactSum total;  // exact (core/exact_sum.hpp): the bits of the decomposed run's sum (contact_on_piece)
@@ -72,71 +77,60 @@ double ShortRangeForce::AddMult(const ContactPairs& pairs, const Vec3Array& u, V
   return total.value();
 }
 
-}  // namespace pd
-
-namespace pd {
-
-void ShortRangeForce::AddJacobianProduct(const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
-  const Model& m = model_;
-  const ContactPairs& pairs = m.contact_list.pairs();
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
-  const auto nb = static_cast<std::size_t>(m.material.blocks);
-  const double factor = m.contact.stiffness_factor / m.horizon;
-  const auto& X = m.nodes.x;
+void add_contact_jacobian_product(const ContactArrays& a, const Vec3Array& du, double* y0, double* y1, double* y2) {
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i64 = 0; i64 < n; ++i64) {
+  for (std::int64_t i64 = 0; i64 < a.nodes; ++i64) {
     const auto i = static_cast<std::size_t>(i64);
-    const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
+    const double* c_row = a.c_pair + a.block[i] * a.blocks;
+    const double yi0 = a.x[0][i] + a.u[0][i], yi1 = a.x[1][i] + a.u[1][i], yi2 = a.x[2][i] + a.u[2][i];
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    for (std::int64_t k = pairs.offsets[i]; k < pairs.offsets[i + 1]; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      const auto j = static_cast<std::size_t>(pairs.neighbour[ku]);
-      const double e0 = (X[0][j] + u[0][j]) - yi0, e1 = (X[1][j] + u[1][j]) - yi1, e2 = (X[2][j] + u[2][j]) - yi2;
+    for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
+      const auto j = static_cast<std::size_t>(a.neighbour[k]);
+      const double e0 = (a.x[0][j] + a.u[0][j]) - yi0, e1 = (a.x[1][j] + a.u[1][j]) - yi1, e2 = (a.x[2][j] + a.u[2][j]) - yi2;
       const double r = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-      const double gap = pairs.distance[ku] - r;
+      const double gap = a.distance[k] - r;
       if (!(gap > 0.0) || !(r > 0.0)) continue;  // apart, or at one point (no direction, no force)
-      const double k_vj = factor * m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
-                                                                static_cast<std::size_t>(m.block_index[j])] *
-                          m.nodes.volume[j];
+      const double k_vj = a.stiffness_over_horizon * c_row[a.block[j]] * a.volume[j];
       // f_i = −k (d − r) n, n = e/r: δf_i = k [n nᵀ − ((d − r)/r)(I − n nᵀ)] (δu_j − δu_i)
       const double n0 = e0 / r, n1 = e1 / r, n2 = e2 / r;
-      const double d0 = x[0][j] - x[0][i], d1 = x[1][j] - x[1][i], d2 = x[2][j] - x[2][i];
+      const double d0 = du[0][j] - du[0][i], d1 = du[1][j] - du[1][i], d2 = du[2][j] - du[2][i];
       const double along = n0 * d0 + n1 * d1 + n2 * d2, lateral = -k_vj * gap / r;
       s0 += k_vj * along * n0 + lateral * (d0 - along * n0);
       s1 += k_vj * along * n1 + lateral * (d1 - along * n1);
       s2 += k_vj * along * n2 + lateral * (d2 - along * n2);
     }
-    y[0][i] += s0;
-    y[1][i] += s1;
-    y[2][i] += s2;
+    y0[i] += s0;
+    y1[i] += s1;
+    y2[i] += s2;
   }
 }
 
-void ShortRangeForce::AddJacobianDiagonal(const Vec3Array& u, std::size_t i, double block[9], bool definite) const {
-  const Model& m = model_;
-  const ContactPairs& pairs = m.contact_list.pairs();
-  const auto nb = static_cast<std::size_t>(m.material.blocks);
-  const double factor = m.contact.stiffness_factor / m.horizon;
-  const auto& X = m.nodes.x;
-  const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
-  for (std::int64_t k = pairs.offsets[i]; k < pairs.offsets[i + 1]; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
-    const auto j = static_cast<std::size_t>(pairs.neighbour[ku]);
-    const double e[3] = {(X[0][j] + u[0][j]) - yi0, (X[1][j] + u[1][j]) - yi1, (X[2][j] + u[2][j]) - yi2};
+void add_contact_jacobian_diagonal(const ContactArrays& a, std::int64_t i, double block[9], bool definite) {
+  const double* c_row = a.c_pair + a.block[i] * a.blocks;
+  const double yi0 = a.x[0][i] + a.u[0][i], yi1 = a.x[1][i] + a.u[1][i], yi2 = a.x[2][i] + a.u[2][i];
+  for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
+    const auto j = static_cast<std::size_t>(a.neighbour[k]);
+    const double e[3] = {(a.x[0][j] + a.u[0][j]) - yi0, (a.x[1][j] + a.u[1][j]) - yi1, (a.x[2][j] + a.u[2][j]) - yi2};
     const double r = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    const double gap = pairs.distance[ku] - r;
+    const double gap = a.distance[k] - r;
     if (!(gap > 0.0) || !(r > 0.0)) continue;
-    const double k_vj = factor * m.material.micromodulus_pair[static_cast<std::size_t>(m.block_index[i]) * nb +
-                                                              static_cast<std::size_t>(m.block_index[j])] *
-                        m.nodes.volume[j];
-    // ∂f_i/∂u_i = −k [n nᵀ − ((d − r)/r)(I − n nᵀ)] (AddJacobianProduct with δu_j = 0).
+    const double k_vj = a.stiffness_over_horizon * c_row[a.block[j]] * a.volume[j];
+    // ∂f_i/∂u_i = −k [n nᵀ − ((d − r)/r)(I − n nᵀ)] (the product with δu_j = 0).
     const double lateral = definite ? 0.0 : -k_vj * gap / r;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        const double nn = e[a] * e[b] / (r * r);
-        block[3 * a + b] -= k_vj * nn + lateral * ((a == b ? 1.0 : 0.0) - nn);
+    for (int p = 0; p < 3; ++p)
+      for (int q = 0; q < 3; ++q) {
+        const double nn = e[p] * e[q] / (r * r);
+        block[3 * p + q] -= k_vj * nn + lateral * ((p == q ? 1.0 : 0.0) - nn);
       }
   }
+}
+
+void ShortRangeForce::AddJacobianProduct(const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  add_contact_jacobian_product(arrays(model_.contact_list.pairs(), u), x, y[0].data(), y[1].data(), y[2].data());
+}
+
+void ShortRangeForce::AddJacobianDiagonal(const Vec3Array& u, std::size_t i, double block[9], bool definite) const {
+  add_contact_jacobian_diagonal(arrays(model_.contact_list.pairs(), u), static_cast<std::int64_t>(i), block, definite);
 }
 
 namespace {
@@ -155,12 +149,21 @@ class ContactTerm : public ForceTerm {
   }
   void add_power(const State&, double, double&) const override {}  // conservative, at rest
   void add_jacobian_product(const State& s, double, const Vec3Array& x, Vec3Array& y) const override {
-    refuse_decomposed();
+    if (decomposed_) {  // collective: the pairs' ghosts get u and δu from their owners
+      if (on_piece_) on_piece_->add_jacobian_product(s.u, x, y);
+      return;  // no force evaluated yet: no list, as serially
+    }
     ShortRangeForce(model_).AddJacobianProduct(s.u, x, y);
   }
   bool add_tangent_diagonal(const State&, double, std::size_t, double*) const override { return false; }
+  void prepare_jacobian_diagonal(const State& s, double) const override {
+    if (decomposed_ && on_piece_) on_piece_->update_displacement(s.u);
+  }
   void add_jacobian_diagonal(const State& s, double, std::size_t i, double block[9], bool definite) const override {
-    refuse_decomposed();
+    if (decomposed_) {
+      if (on_piece_) on_piece_->add_jacobian_diagonal(i, block, definite);
+      return;
+    }
     ShortRangeForce(model_).AddJacobianDiagonal(s.u, i, block, definite);
   }
   std::vector<std::string> work_plan() const override {
@@ -172,11 +175,6 @@ class ContactTerm : public ForceTerm {
   }
 
  private:
-  // The linearised contact force reads the serial list; on a piece the list is ContactOnPiece's
-  // (explicit integrators only: run/prepare refuses the others with contact on several ranks).
-  void refuse_decomposed() const {
-    if (decomposed_) throw Error("contact's linearised force is not decomposed over MPI ranks yet (issue 15)");
-  }
   const Model& model_;
   mutable std::unique_ptr<ContactOnPiece> on_piece_;  // a decomposed run's (made at the first force)
 };

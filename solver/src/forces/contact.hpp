@@ -36,6 +36,15 @@ struct ContactArrays {
 // ½ (c_s/δ) V_i V_j (d_ij − r)², per unit volume (overwritten, not accumulated).
 void add_contact_force_density(const ContactArrays& a, double* f0, double* f1, double* f2, double* e = nullptr);
 
+// y_i += Σ_j ∂f_i/∂u·δu over row i's listed pairs closer than d_ij, for every row of `a` (each pair
+// a spring along its line and, for the pressed gap, a negative lateral stiffness). Each row writes
+// only its own y_i: bitwise the same for any thread count, and on a piece of a decomposed run
+// (forces/contact_on_piece) for the same rows with exact copies of u and δu.
+void add_contact_jacobian_product(const ContactArrays& a, const Vec3Array& du, double* y0, double* y1, double* y2);
+// block += ∂f_i/∂u_i of row i's pairs (row-major 3×3); definite: without the pressed gaps'
+// negative lateral stiffness.
+void add_contact_jacobian_diagonal(const ContactArrays& a, std::int64_t i, double block[9], bool definite);
+
 // The force term: refreshes the model's Verlet list when the skin rule asks for it, then adds the
 // forces. Returns the contact potential energy [J], summed serially in node order.
 class ShortRangeForce {
@@ -52,6 +61,8 @@ class ShortRangeForce {
   void AddJacobianDiagonal(const Vec3Array& u, std::size_t i, double block[9], bool definite) const;
 
  private:
+  // The kernels' view of the whole model at u over a list.
+  ContactArrays arrays(const ContactPairs& pairs, const Vec3Array& u) const;
   const Model& model_;
 };
 

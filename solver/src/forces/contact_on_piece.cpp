@@ -115,8 +115,12 @@ void ContactOnPiece::build(const Vec3Array& u, bool counted) {
   for (std::size_t e = 0; e < pairs_.neighbour.size(); ++e)
     list.neighbour[e] = kept_as[static_cast<std::size_t>(pairs_.neighbour[e])];
   list.distance = pairs_.distance;  // rows keep their order: the owned rows are the only non-empty ones
+  set_of_piece_.assign(piece.global.size(), -1);
+  for (std::size_t k = 0; k < kept; ++k)
+    if (piece_local_[k] >= 0) set_of_piece_[static_cast<std::size_t>(piece_local_[k])] = static_cast<std::int32_t>(k);
   u_ = make_vec3(kept);
   f_ = make_vec3(kept);
+  du_ = make_vec3(kept);
   energy_.assign(kept, 0.0);
   halo_ = d_.make_node_halo(global_, extra);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -139,14 +143,32 @@ double ContactOnPiece::add_force(const Vec3Array& u, Vec3Array& f) {
     if (moved == 1) build(u, true);  // 2: not finite, not binned (the time loop stops on it)
   }
 
-  // The set's displacements: owned nodes and bond ghosts from the piece, the others from their owners.
+  update_displacement(u);
+  const ContactArrays a = arrays();
+  for (auto& fc : f_) std::fill(fc.begin(), fc.end(), 0.0);
+  add_contact_force_density(a, f_[0].data(), f_[1].data(), f_[2].data(), energy_.data());
+  add_owned_rows(f_, f);
+  // The energy: the serial exact Σ e_i V_i.
+  std::vector<double> per_node(f[0].size(), 0.0);
+  for (std::int32_t k : owned_) {
+    const auto c = static_cast<std::size_t>(k);
+    per_node[static_cast<std::size_t>(piece_local_[c])] = energy_[c] * volume_[c];
+  }
+  return d_.exact_sum(per_node);
+}
+
+void ContactOnPiece::update_displacement(const Vec3Array& u) {
+  // Owned nodes and bond ghosts from the piece, the others from their owners.
   const std::size_t n = global_.size();
   for (std::size_t c = 0; c < n; ++c)
     if (piece_local_[c] >= 0)
       for (std::size_t d = 0; d < 3; ++d) u_[d][c] = u[d][static_cast<std::size_t>(piece_local_[c])];
   halo_->exchange(u_);
+}
 
-  const ContactPairs& pairs = list.pairs();
+ContactArrays ContactOnPiece::arrays() const {
+  const Model& m = model_;
+  const ContactPairs& pairs = m.contact_list.pairs();
   ContactArrays a;
   a.offsets = pairs.offsets.data();
   a.neighbour = pairs.neighbour.data();
@@ -154,25 +176,44 @@ double ContactOnPiece::add_force(const Vec3Array& u, Vec3Array& f) {
   for (std::size_t d = 0; d < 3; ++d) {
     a.x[d] = x_[d].data();
     a.u[d] = u_[d].data();
-    std::fill(f_[d].begin(), f_[d].end(), 0.0);
   }
   a.volume = volume_.data();
   a.block = block_.data();
   a.c_pair = m.material.micromodulus_pair.data();
   a.blocks = m.material.blocks;
-  a.nodes = static_cast<std::int64_t>(n);
+  a.nodes = static_cast<std::int64_t>(global_.size());
   a.stiffness_over_horizon = m.contact.stiffness_factor / m.horizon;
-  add_contact_force_density(a, f_[0].data(), f_[1].data(), f_[2].data(), energy_.data());
-  // Into the piece: 0 + s = s exactly (a row's sum s starts at +0 and so is never −0), so f_i gets
-  // the serial f_i += s. The energy: the serial exact Σ e_i V_i.
-  std::vector<double> per_node(f[0].size(), 0.0);
+  return a;
+}
+
+void ContactOnPiece::add_owned_rows(const Vec3Array& set_values, Vec3Array& piece_values) const {
+  // 0 + s = s exactly (a row's sum s starts at +0 and so is never −0), so the piece's row gets the
+  // serial row's += s.
   for (std::int32_t k : owned_) {
     const auto c = static_cast<std::size_t>(k);
     const auto l = static_cast<std::size_t>(piece_local_[c]);
-    for (std::size_t d = 0; d < 3; ++d) f[d][l] += f_[d][c];
-    per_node[l] = energy_[c] * volume_[c];
+    for (std::size_t d = 0; d < 3; ++d) piece_values[d][l] += set_values[d][c];
   }
-  return d_.exact_sum(per_node);
+}
+
+void ContactOnPiece::add_jacobian_product(const Vec3Array& u, const Vec3Array& du, Vec3Array& y) {
+  // The serial product reads the list of the last force evaluation; a restart's record has none
+  // until the first force (add_force), the same on every rank: nothing to add then, as serially.
+  if (model_.contact_list.pairs().offsets.empty()) return;
+  update_displacement(u);
+  const std::size_t n = global_.size();
+  for (std::size_t c = 0; c < n; ++c)
+    if (piece_local_[c] >= 0)
+      for (std::size_t d = 0; d < 3; ++d) du_[d][c] = du[d][static_cast<std::size_t>(piece_local_[c])];
+  halo_->exchange(du_);
+  for (auto& fc : f_) std::fill(fc.begin(), fc.end(), 0.0);
+  add_contact_jacobian_product(arrays(), du_, f_[0].data(), f_[1].data(), f_[2].data());
+  add_owned_rows(f_, y);
+}
+
+void ContactOnPiece::add_jacobian_diagonal(std::size_t i, double block[9], bool definite) const {
+  if (model_.contact_list.pairs().offsets.empty() || i >= set_of_piece_.size() || set_of_piece_[i] < 0) return;
+  add_contact_jacobian_diagonal(arrays(), set_of_piece_[i], block, definite);
 }
 
 }  // namespace pd

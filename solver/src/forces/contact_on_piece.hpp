@@ -15,6 +15,11 @@
 //   serial row's nodes in the serial order. The nodes no owned row names are dropped again;
 // - in every force evaluation the kept ghosts that are not bond ghosts get their displacement
 //   from their owners (Decomposed::make_node_halo); the bond ghosts' come from the bonds' halo;
+// - the linearised force (the Newton solves of quasi_static, implicit and mixed): the product
+//   ∂f/∂u·δu over the same list, with the contact ghosts' u and δu from their owners through the
+//   same halo (δu's bond ghosts filled by ForceOperator::apply_jacobian), and the diagonal blocks
+//   of the owned rows from the set's u fetched before (update_displacement); an owned row sums
+//   the serial row's pairs in the serial order from exact copies, so it is the serial row's bits;
 // - the energy is the serial exact sum (Decomposed::exact_sum), and the build count is the
 //   same on every rank because every rank builds together.
 // The piece's NeighbourList (model.contact_list) records the builds (count, time, the piece's
@@ -28,6 +33,7 @@
 
 #include "core/model.hpp"
 #include "core/neighbour_list.hpp"
+#include "forces/contact.hpp"
 #include "parallel/decomposed.hpp"
 
 namespace pd {
@@ -39,10 +45,24 @@ class ContactOnPiece {
   // f += the contact force density of the owned rows at the piece's displacement u (ghosts
   // current); returns the contact potential energy [J], the serial sum's bits. Collective.
   double add_force(const Vec3Array& u, Vec3Array& f);
+  // y += ∂f/∂u·du over the owned rows of the current list at the piece's displacement u; u's and
+  // du's bond ghosts must be current. Collective.
+  void add_jacobian_product(const Vec3Array& u, const Vec3Array& du, Vec3Array& y);
+  // The set's displacements at the piece's u (bond ghosts current): from the piece, and the
+  // contact ghosts' from their owners. Collective.
+  void update_displacement(const Vec3Array& u);
+  // block += ∂f_i/∂u_i of owned piece node i's pairs at the set's displacement of the last
+  // update_displacement (or force). Reads only: callable from threads.
+  void add_jacobian_diagonal(std::size_t i, double block[9], bool definite) const;
 
  private:
   // Finds the contact ghosts and the owned rows' pairs at the piece's displacement u. Collective.
   void build(const Vec3Array& u, bool counted);
+  // The kernels' view of the set at its displacement u_ over the current list.
+  ContactArrays arrays() const;
+  // The owned rows' sums of the set, s_c = 0 + s exactly, into the piece's rows: f_l += s_c, the
+  // serial f_i += s.
+  void add_owned_rows(const Vec3Array& set_values, Vec3Array& piece_values) const;
 
   const Model& model_;
   const Decomposed& d_;
@@ -50,7 +70,8 @@ class ContactOnPiece {
   std::vector<std::int32_t> global_;
   std::vector<std::int32_t> piece_local_;  // its piece-local number, −1 for a ghost outside the piece
   std::vector<std::int32_t> owned_;        // the owned entries of the set
-  Vec3Array x_, u_, f_;
+  std::vector<std::int32_t> set_of_piece_; // per piece node: its entry of the set, −1 if none
+  Vec3Array x_, u_, f_, du_;
   std::vector<double> volume_, energy_;
   std::vector<std::int32_t> block_;
   ContactPairs pairs_;  // scratch of the search (the current list is in model.contact_list)

@@ -41,6 +41,13 @@ class ForceTerm {
     (void)definite;
     add_tangent_diagonal(s, t, i, block);
   }
+  // Before add_jacobian_diagonal is called for the nodes at (s.u, t) (from threads, so it cannot
+  // communicate): a term whose diagonal reads nodes other ranks own fetches them here. Collective
+  // on a decomposed run; nothing to do serially or for a term that acts on each node alone.
+  virtual void prepare_jacobian_diagonal(const State& s, double t) const {
+    (void)s;
+    (void)t;
+  }
   // Lines of the work plan (run.log) for this term.
   virtual std::vector<std::string> work_plan() const = 0;
 

@@ -165,6 +165,7 @@ bool ForceOperator::stiffness_diagonal_blocks(const State& s, double t, const Fr
   const auto groups = static_cast<std::int64_t>(node_of.size());
   blocks.assign(static_cast<std::size_t>(9 * groups), 0.0);
   const auto& off = m.bonds.offsets;
+  for (const auto& term : terms_) term->prepare_jacobian_diagonal(s, t);  // collective on a decomposed run
 #pragma omp parallel
   {
     std::vector<double> row;

@@ -86,19 +86,17 @@ void check_decomposable(const Prepared& p) {
     what = "blocks[].model: " + p.model.bond_model->name();
   // Decomposed: LAMMPS's α rule (the ghosts' s0 refreshed before each breaking pass), breaking_order:
   // lammps, surface_correction (its factors computed on the whole model, copied into the pieces'
-  // rows), contact (forces/contact_on_piece) with the explicit integrators, and every integrator:
-  // verlet, adaptive (its norms of eq. 2.6 are exact sums: core/exact_sum.hpp), and quasi_static,
-  // implicit and mixed on their matrix-free path (their norms and CG's dot products exact sums:
-  // parallel/dof_sums.hpp; linear_solver: direct is refused by the integrator). dt: exact is
-  // decomposed too: choose_dt ran on the whole model on every rank, before the decomposition.
-  // Not yet: the contact's linearised force (forces/contact.cpp) inside a Newton solve.
-  else if (p.model.contact.pairs && c.time.integrator != "verlet" && c.time.integrator != "adaptive")
-    what = "contact with time.integrator: " + c.time.integrator + " (the contact's linearised force)";
+  // rows), contact (forces/contact_on_piece, its linearised force too) with every integrator, and
+  // every integrator: verlet, adaptive (its norms of eq. 2.6 are exact sums: core/exact_sum.hpp),
+  // and quasi_static, implicit and mixed on their matrix-free path (their norms and CG's dot
+  // products exact sums: parallel/dof_sums.hpp; linear_solver: direct is refused by the
+  // integrator). dt: exact is decomposed too: choose_dt ran on the whole model on every rank,
+  // before the decomposition.
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
                 "verlet, adaptive, quasi_static, implicit and mixed integrators with pmb and lps bonds, dt: stable, exact or fixed, "
-                "breaking (breaking_order thesis or lammps, critical_stretch_alpha), surface_correction, contact with verlet "
-                "and adaptive, displacement and velocity conditions, body forces, indenters, "
+                "breaking (breaking_order thesis or lammps, critical_stretch_alpha), surface_correction, contact with every "
+                "integrator, displacement and velocity conditions, body forces, indenters, "
                 "damping, frames, history, checkpoints and restarts on any rank count): run this case on one rank, without mpirun, or with mpirun -np 1 (here " + ranks + " ranks)");
 }
 

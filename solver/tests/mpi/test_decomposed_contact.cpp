@@ -3,17 +3,23 @@
 // After every Verlet step the gathered u and v, the contact energy, the kinetic energy and the
 // list's build count equal the serial run's bit for bit, for 1, 2 and 3 ranks (ctest mpi_ranks_R)
 // and 1 and 2 threads per rank; the owned rows of the last list add up to the serial list.
+// The linearised contact force of the Newton solves (quasi_static, implicit, mixed): with the square
+// pressed into the plate, the decomposed J·δu and diagonal blocks equal the serial ones bit for bit.
 #include <gtest/gtest.h>
 #include <mpi.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "bits.hpp"
 #include "core/model.hpp"
+#include "forces/contact.hpp"
 #include "integrators/verlet.hpp"
 #include "lattice.hpp"
 #include "operator/force_operator.hpp"
+#include "parallel/local_model.hpp"
 #include "parallel/mpi_decomposed.hpp"
 
 namespace {
@@ -123,6 +129,82 @@ TEST_P(DecomposedContact, EveryStepEqualsTheSerialStepBitwise) {
   EXPECT_EQ(dec.contact_traffic().halo_exchanges, steps + 1);
   // On several ranks some pairs crossed them: the square and the plate share no bond, so a pair
   // between nodes of two ranks needs a contact ghost that the bonds' halo does not bring.
+  if (dec.ranks() > 1) EXPECT_GT(dec.total(dec.contact_traffic().halo_bytes), 0);
+}
+
+
+namespace {
+
+// The 3×3 diagonal block of every node (zero where a node has no free dof), 9 values per node, from
+// stiffness_diagonal_blocks' groups over `dofs`.
+std::vector<double> per_node_blocks(const pd::ForceOperator& op, const pd::State& s, const pd::FreeDofs& dofs) {
+  std::vector<std::int64_t> first;
+  std::vector<double> blocks, out(9 * s.size(), 0.0);
+  EXPECT_TRUE(op.stiffness_diagonal_blocks(s, 0.0, dofs, first, blocks));
+  for (std::size_t g = 0; g + 1 < first.size(); ++g) {
+    const auto i = static_cast<std::size_t>(dofs.node[static_cast<std::size_t>(first[g])]);
+    std::copy(&blocks[9 * g], &blocks[9 * g] + 9, &out[9 * i]);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_P(DecomposedContact, JacobianProductAndDiagonalBlocksEqualTheSerialOnesBitwise) {
+  omp_set_num_threads(GetParam());
+  pd::Model global = plate_and_square();
+  const pd::Model initial = global;
+  // The square moved 3.6 dx down: 0.9 dx from the plate, inside the contact distance 1.35 dx, and a
+  // wavy part on every node so that no two rows are alike; δu wavy too.
+  pd::Vec3Array u = pd::make_vec3(global.nodes.size()), du = pd::make_vec3(global.nodes.size());
+  for (std::size_t i = 0; i < global.nodes.size(); ++i) {
+    const double x = global.nodes.x[0][i] / kDx, y = global.nodes.x[1][i] / kDx;
+    u[0][i] = 0.02 * kDx * std::sin(0.7 * y + 0.3 * x);
+    u[1][i] = (global.block_index[i] == 1 ? -3.6 * kDx : 0.0) + 0.02 * kDx * std::cos(0.5 * x - 0.2 * y);
+    du[0][i] = std::cos(0.9 * x + 0.4 * y);
+    du[1][i] = std::sin(0.3 * x - 0.8 * y) + 0.5;
+  }
+  pd::ForceOperator serial_op(global);
+  pd::State serial(global.nodes.size());
+  serial.u = u;
+  serial_op.evaluate(serial, 0.0);  // builds the contact list, as a Newton iteration's residual does
+  ASSERT_GT(serial.contact_energy, 0.0);
+  pd::Vec3Array serial_y = pd::make_vec3(serial.size());
+  serial_op.apply_jacobian(serial, 0.0, du, serial_y);
+  // The contact part is there: the product without it differs.
+  pd::Vec3Array contact_only = pd::make_vec3(serial.size());
+  pd::ShortRangeForce(global).AddJacobianProduct(serial.u, du, contact_only);
+  std::int64_t contact_rows = 0;
+  for (std::size_t i = 0; i < serial.size(); ++i) contact_rows += contact_only[1][i] != 0.0;
+  EXPECT_GT(contact_rows, 10);
+  const pd::FreeDofs serial_dofs = serial_op.free_dofs(3);
+  const std::vector<double> serial_blocks = per_node_blocks(serial_op, serial, serial_dofs);
+
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, initial);
+  pd::ForceOperator op(dec.piece().model);
+  op.set_decomposed(&dec);
+  pd::State local(dec.piece().size());
+  local.u = pd::to_local(dec.piece(), u);
+  op.evaluate(local, 0.0);
+  EXPECT_TRUE(pdtest::same_bits(local.contact_energy, serial.contact_energy));
+  // δu's ghosts from their owners inside apply_jacobian: the owned entries are all it may read.
+  pd::Vec3Array local_du = pd::to_local(dec.piece(), du);
+  for (std::int32_t g : dec.piece().ghost_local)
+    for (auto& component : local_du) component[static_cast<std::size_t>(g)] = -7.0;
+  const std::int64_t exchanges_before = dec.contact_traffic().halo_exchanges;
+  pd::Vec3Array y = pd::make_vec3(local.size());
+  op.apply_jacobian(local, 0.0, local_du, y);
+  EXPECT_EQ(dec.contact_traffic().halo_exchanges, exchanges_before + 2);  // u and δu of the contact ghosts
+  const pd::Vec3Array gathered = dec.gather(y);
+  const std::vector<double> blocks = dec.gather(per_node_blocks(op, local, op.free_dofs(3)), 9);
+  if (dec.rank() == 0) {
+    EXPECT_EQ(differing(gathered, serial_y), 0);
+    std::int64_t bad = 0;
+    for (std::size_t k = 0; k < blocks.size(); ++k) bad += !same_bits(blocks[k], serial_blocks[k]);
+    EXPECT_EQ(bad, 0);
+    EXPECT_EQ(blocks.size(), serial_blocks.size());
+  }
+  // On several ranks pairs crossed them (the square and the plate share no bond).
   if (dec.ranks() > 1) EXPECT_GT(dec.total(dec.contact_traffic().halo_bytes), 0);
 }
 
