@@ -12,8 +12,11 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
-def make(*args):
-    env = {k: v for k, v in os.environ.items() if k not in ("case", "config", "MAKEFLAGS", "MAKELEVEL")}
+def make(*args, threads=None):
+    """make in ROOT; threads: OMP_NUM_THREADS for it (None: unset, whatever the runner has)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("case", "config", "MAKEFLAGS", "MAKELEVEL", "OMP_NUM_THREADS")}
+    if threads is not None:
+        env["OMP_NUM_THREADS"] = str(threads)
     return subprocess.run(["make", "--no-print-directory", "-C", ROOT, *args], env=env,
                           capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
 
@@ -102,7 +105,25 @@ def test_ranks_puts_the_solver_under_mpiexec():
         return [line for line in result.stdout.splitlines() if "exec " in line and "--restart" not in line]
     assert not any("mpiexec" in line for line in solve_line())
     assert not any("mpiexec" in line for line in solve_line("RANKS=1"))
-    assert any("exec mpiexec --oversubscribe -np 3 'build/solver/pdsolve'" in line for line in solve_line("RANKS=3"))
+    assert any("exec mpiexec --oversubscribe -np 3 -x OMP_NUM_THREADS=" in line and "'build/solver/pdsolve'" in line
+               for line in solve_line("RANKS=3"))
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_ranks_share_the_cores_unless_omp_num_threads_is_set(ranks):
+    """R ranks with OMP_NUM_THREADS unset get cores // R threads each (at least 1), not all the cores
+    each; a user's OMP_NUM_THREADS is left to mpiexec's environment as it is."""
+    def solve_lines(threads):
+        result = make("-n", "-B", "case=membrane", f"RANKS={ranks}", "out/membrane/.solved", threads=threads)
+        return [line for line in result.stdout.splitlines() if line.strip().startswith("exec ")]
+    share = max(1, len(os.sched_getaffinity(0)) // ranks)  # what nproc counts
+    lines = solve_lines(None)
+    assert len(lines) == 2, lines  # the fresh solve and the resume
+    assert all(f"mpiexec --oversubscribe -np {ranks} -x OMP_NUM_THREADS={share} 'build/solver/pdsolve'" in line
+               for line in lines), lines
+    lines = solve_lines(2)
+    assert len(lines) == 2 and all(f"mpiexec --oversubscribe -np {ranks} 'build/solver/pdsolve'" in line
+                                   for line in lines), lines
 
 
 def test_ranks_resumes_a_checkpoint_under_mpiexec_too():
@@ -110,6 +131,7 @@ def test_ranks_resumes_a_checkpoint_under_mpiexec_too():
     the solve recipe runs under the same mpiexec as a fresh solve."""
     result = make("-n", "-B", "case=membrane", "RANKS=3", "out/membrane/.solved")
     resume = [line for line in result.stdout.splitlines() if line.strip().startswith("exec ") and "--restart" in line]
-    assert resume and all("exec mpiexec --oversubscribe -np 3 'build/solver/pdsolve'" in line for line in resume), resume
+    assert resume and all("exec mpiexec --oversubscribe -np 3 " in line and "'build/solver/pdsolve'" in line
+                          for line in resume), resume
     serial = make("-n", "-B", "case=membrane", "out/membrane/.solved")
     assert not any("mpiexec" in line for line in serial.stdout.splitlines() if "--restart" in line)
