@@ -20,11 +20,10 @@ double BodyForceTerm::power(double t, const Vec3Array& v, const Decomposed* d) c
   // One exact sum per condition, continuing the last (parallel/node_sum.hpp): the same bits for
   // any rank and thread count.
   double p = 0.0;
-  std::vector<double> scratch;
   for (const auto& b : model_.conditions.body_forces) {
     const double value = b.table.value(t);
     const auto& vc = v[static_cast<std::size_t>(b.component)];
-    p = sum_over_set(d, b.nodes, v[0].size(), scratch, p,
+    p = sum_over_set(d, b.nodes, p,
                      [&](std::size_t i) { return model_.nodes.volume[i] * value * vc[i]; });
   }
   return p;

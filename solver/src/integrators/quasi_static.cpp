@@ -275,17 +275,16 @@ double QuasiStatic::load_scale(const State& s, double t) const {
   // One exact sum of r² per condition, continuing the last (parallel/node_sum.hpp), as
   // ForceOperator's powers: the same bits serially and on any number of ranks.
   double sum = 0.0;
-  std::vector<double> scratch;
   for (const auto& p : m.conditions.prescribed) {
     const auto& fc = s.f[static_cast<std::size_t>(p.component)];
-    sum = sum_over_set(d, p.nodes, s.size(), scratch, sum, [&](std::size_t i) {
+    sum = sum_over_set(d, p.nodes, sum, [&](std::size_t i) {
       const double r = m.nodes.volume[i] * fc[i];
       return r * r;
     });
   }
   for (const auto& b : m.conditions.body_forces) {
     const double value = b.table.value(t);
-    sum = sum_over_set(d, b.nodes, s.size(), scratch, sum, [&](std::size_t i) {
+    sum = sum_over_set(d, b.nodes, sum, [&](std::size_t i) {
       const double r = m.nodes.volume[i] * value;
       return r * r;
     });

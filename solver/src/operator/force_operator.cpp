@@ -344,11 +344,10 @@ double ForceOperator::external_power(const State& s, double t) const {
   // (parallel/node_sum.hpp): the same bits serially and on any number of ranks.
   double p = 0.0;
   for (const ForceTerm* term : power_terms_) term->add_power(s, t, p);
-  std::vector<double> scratch;
   for (const auto& bc : model_.conditions.prescribed) {
     const auto c = static_cast<std::size_t>(bc.component);
     const double a = bc.kind == Kinematic::velocity ? bc.table.slope(t) : 0.0;
-    p = sum_over_set(decomposed_, bc.nodes, s.size(), scratch, p, [&](std::size_t i) {
+    p = sum_over_set(decomposed_, bc.nodes, p, [&](std::size_t i) {
       const double reaction = model_.density[i] * a - s.f[c][i];  // force density the support applies
       return model_.nodes.volume[i] * reaction * s.v[c][i];
     });

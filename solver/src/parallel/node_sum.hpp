@@ -57,22 +57,18 @@ double sum_over_nodes(const Decomposed* d, std::size_t n, Term term, double star
   return sum.value();
 }
 
-// start + Σ_{i in nodes} term(i) over one node set (a condition's nodes, local indices), exactly,
-// rounded once. Serially in the set's order; decomposed as a per-node array of the n local nodes,
-// 0 outside the set, summed over the owned nodes and the ranks (a 0 adds nothing to an exact sum,
-// so both give the same bits). `scratch` is reused between calls so a loop over conditions
-// allocates once. Collective on a decomposed run.
+// start + Σ_{i in nodes} term(i) over one node set (a condition's nodes, local indices; on a
+// decomposed run a condition holds its owned nodes only, parallel/local_model.cpp), exactly,
+// rounded once: the set's terms straight into the accumulator, then the ranks' accumulators in one
+// reduction, then start (exact, so the serial and decomposed sums give the same bits). Collective
+// on a decomposed run.
 template <class Term>
-double sum_over_set(const Decomposed* d, const std::vector<std::int32_t>& nodes, std::size_t n,
-                    std::vector<double>& scratch, double start, Term term) {
-  if (!d) {
-    ExactSum sum(start);
-    for (std::int32_t i : nodes) sum.add(term(static_cast<std::size_t>(i)));
-    return sum.value();
-  }
-  scratch.assign(n, 0.0);
-  for (std::int32_t i : nodes) scratch[static_cast<std::size_t>(i)] = term(static_cast<std::size_t>(i));
-  return d->exact_sum(scratch, start);
+double sum_over_set(const Decomposed* d, const std::vector<std::int32_t>& nodes, double start, Term term) {
+  ExactSum sum;
+  for (std::int32_t i : nodes) sum.add(term(static_cast<std::size_t>(i)));
+  if (d) d->reduce(&sum, 1);
+  sum.add(start);
+  return sum.value();
 }
 
 }  // namespace pd
