@@ -2,8 +2,9 @@
 
 - verlet: Δt is a constant, so three panels of it said nothing. Drawn instead: Δt against the
   stability limits run.log reports (thesis eq. 2.5 and, when computed, the exact limit 2/ω_max),
-  with the margin Δt/Δt_limit in the title, and the wall-clock time against simulated time (the
-  run's speed, and where it slowed down).
+  with the margin Δt/Δt_limit in the title, the steps shortened to land on an output time as points
+  of their own, and the wall-clock time against simulated time (the run's speed, and where it
+  slowed down).
 - adaptive, quasi_static: Δt against step and against time, and the fixed-point or Newton
   iterations K with rejected attempts against step, like the thesis's membrane figures (§5.1).
 - mixed: the same with Δt on a log scale, quasi-static and explicit steps in their own colours.
@@ -71,7 +72,15 @@ def _plot_verlet(history: dict, case, path: str, limits: dict) -> str:
     factor, unit = si_scale(np.concatenate([dt, list(limits.values())]), "s")
     fig, axes = new_figure(2, 1, size=(7.5, 6.5), sharex=True)
     a, b = axes[:, 0]
-    a.plot(t, dt * factor, linewidth=1.5, label="time step Δt")
+    # The loop shortens the step that would pass an output time so that it lands on it (run/schedule):
+    # drawn as one line, those steps read as spikes of instability. So the step the rule gives is the
+    # line, and the shortened steps are points of their own, counted in the legend.
+    nominal = float(np.max(dt))
+    shortened = dt < nominal * (1.0 - 1e-9)
+    a.plot(t, np.full_like(dt, nominal) * factor, linewidth=1.5, label="time step Δt")
+    if np.any(shortened):
+        a.plot(t[shortened], dt[shortened] * factor, linestyle="none", marker=".", markersize=3,
+               color="C1", label=f"{int(np.count_nonzero(shortened))} steps shortened to land on an output time")
     margins = []
     for (name, limit), style in zip(limits.items(), ("--", ":")):
         a.axhline(limit * factor, color="C3", linestyle=style, linewidth=1.0, label=f"stable limit, {name}")

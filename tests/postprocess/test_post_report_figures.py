@@ -122,7 +122,26 @@ def test_verlet_timestep_shows_dt_against_its_stability_limit(tmp_path, keep):
     limit = [line for line in a.get_lines() if "stable limit" in line.get_label()]
     assert len(limit) == 1 and limit[0].get_ydata()[0] == pytest.approx(710.674)
     assert a.get_title() == "branching: Verlet, Δt = 0.8 × eq. 2.5"
+    assert not [line for line in a.get_lines() if "shortened" in line.get_label()]  # none was
     check_readable(fig)
+
+
+def test_verlet_steps_shortened_to_land_on_output_times_are_points_not_spikes(tmp_path, keep):
+    # The loop cuts the step before each output time (run/schedule): 3 such steps of 4.4e-7 s among
+    # 5.68539e-7 s ones. The line is the rule's step; the three are drawn and counted apart.
+    (tmp_path / "run.log").write_text(RUN_LOG)
+    h = fracture_history()
+    h["dt"] = np.full(len(h["step"]), 5.68539e-07)
+    cut = [3, 7, len(h["dt"]) - 1]
+    h["dt"][cut] = 4.4e-07
+    timestep_plot.plot_timestep(h, case(integrator="verlet"), "timestep.png", run_log=str(tmp_path / "run.log"))
+    a = keep["timestep.png"].axes[0]
+    step_line = [line for line in a.get_lines() if line.get_label() == "time step Δt"][0]
+    assert np.all(step_line.get_ydata() == pytest.approx(568.539))
+    points = [line for line in a.get_lines() if "shortened" in line.get_label()]
+    assert len(points) == 1 and points[0].get_label() == "3 steps shortened to land on an output time"
+    assert points[0].get_ydata() == pytest.approx([440.0] * 3)
+    check_readable(keep["timestep.png"])
 
 
 def test_run_log_limits_are_read_for_every_dt_rule(tmp_path):
