@@ -69,8 +69,11 @@ class HangingNodes {
 
   // Finds them from the model's broken flags and reference positions (see above). Collective on a
   // decomposed run (d not null).
-  void find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d);
-  std::int64_t count() const { return total_; }  // over the whole model
+  // strands: links of strands (collinear bonds on both sides) too: only where no piece carries load.
+  void find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d,
+            bool strands = false);
+  std::int64_t count() const { return total_; }  // over the whole model, links of linkages included
+  std::int64_t linkage_count() const { return linkage_total_; }  // the links of linkages among them
   bool hanging(std::size_t i) const { return !round_.empty() && round_[i] > 0.0; }
   // A node of a free fragment: no chain of intact bonds (between nodes that do not hang) joins it
   // to a prescribed motion (see above). Over the whole model: free_count().
@@ -88,6 +91,8 @@ class HangingNodes {
  private:
   void find_free(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d);
   std::vector<double> round_;  // per local node, ghosts included: 0 not hanging, r found in round r
+  std::vector<std::uint8_t> kind_;  // per local node: 1 hanging by collinear bonds, 2 a link of a linkage, 3 of a strand
+  std::int64_t linkage_total_ = 0;
   std::vector<double> held_;   // per local node: 1 joined to a prescribed motion (free(): 0 and not hanging)
   std::int64_t free_total_ = 0;
   std::vector<std::int64_t> masked_;
