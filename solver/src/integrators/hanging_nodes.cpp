@@ -90,17 +90,12 @@ void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_
   std::vector<double> weak(n, 0.0);  // per local node, ghosts from their owners: see linkage()
   for (int r = 1;; ++r) {
     // Round r: a node still in the body hangs when its bonds to the nodes that were still in the body
-    // at the start of the round hang, or is a link of a linkage (linkage(): weak, with a weak
-    // neighbour); a Jacobi sweep (the verdicts written after it), so they do not depend on the
-    // order in which the threads reach the nodes.
-#pragma omp parallel for schedule(dynamic, 512)
-    for (std::int64_t q = 0; q < count; ++q) {
-      const auto i = static_cast<std::size_t>(q);
-      weak[i] = candidate[i] && round_[i] == 0.0 && intact_degree(m, i, round_) <= dimension ? 1.0 : 0.0;
-    }
-    if (d) d->update_ghosts(weak);
+    // at the start of the round hang; a Jacobi sweep (the verdicts written after it), so they do
+    // not depend on the order in which the threads reach the nodes. Only a round in which no node
+    // hangs looks for links of linkages and strands (the same Jacobi sweep): so the hanging nodes
+    // and their rounds are those found without them, and a link's anchors are placed before it.
     std::int64_t found = 0, linkages = 0;
-#pragma omp parallel for schedule(dynamic, 512) reduction(+ : found, linkages)
+#pragma omp parallel for schedule(dynamic, 512) reduction(+ : found)
     for (std::int64_t q = 0; q < count; ++q) {
       const auto i = static_cast<std::size_t>(q);
       now_found[i] = 0;
@@ -108,21 +103,34 @@ void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_
       if (hangs(m, i, [&](std::size_t j) { return round_[j] == 0.0; })) {
         now_found[i] = 1;
         ++found;
-      } else if (linkage(m, i, round_, weak, dimension)) {
-        now_found[i] = 2;
-        ++found, ++linkages;
-      } else if (strands && hangs(m, i, [&](std::size_t j) { return round_[j] == 0.0; }, false)) {
-        now_found[i] = 3;
-        ++found, ++linkages;
       }
+    }
+    if (d) found = d->total(found);
+    if (found == 0) {
+#pragma omp parallel for schedule(dynamic, 512)
+      for (std::int64_t q = 0; q < count; ++q) {
+        const auto i = static_cast<std::size_t>(q);
+        weak[i] = candidate[i] && round_[i] == 0.0 && intact_degree(m, i, round_) <= dimension ? 1.0 : 0.0;
+      }
+      if (d) d->update_ghosts(weak);
+#pragma omp parallel for schedule(dynamic, 512) reduction(+ : linkages)
+      for (std::int64_t q = 0; q < count; ++q) {
+        const auto i = static_cast<std::size_t>(q);
+        if (!candidate[i] || round_[i] > 0.0) continue;
+        if (linkage(m, i, round_, weak, dimension)) {
+          now_found[i] = 2;
+          ++linkages;
+        } else if (strands && hangs(m, i, [&](std::size_t j) { return round_[j] == 0.0; }, false)) {
+          now_found[i] = 3;
+          ++linkages;
+        }
+      }
+      if (d) linkages = d->total(linkages);
+      found = linkages;
     }
     for (std::size_t i = 0; i < n; ++i)
       if (now_found[i]) round_[i] = r, kind_[i] = now_found[i];
-    if (d) {
-      d->update_ghosts(round_);
-      found = d->total(found);
-      linkages = d->total(linkages);
-    }
+    if (d) d->update_ghosts(round_);
     if (found == 0) break;
     rounds_ = r;
     total_ += found;
