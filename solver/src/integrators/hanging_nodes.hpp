@@ -40,6 +40,16 @@
 // Its nodes are left out of the solve too and stay where they are (their bonds as the explicit
 // phase left them: the static answer for a free piece is any rigid position; it is not relaxed).
 //
+// Links of linkages and strands (measured on plate_with_hole at dx = 0.25 mm: docs/accuracy.md,
+// "Linkages and strands"): in a round where no node hangs, a node with at most `dimension` intact
+// bonds to the body is weak; a weak node with fewer than `dimension` of them, or bonded to another
+// weak node, is a link of a linkage (Maxwell: a connected set W of weak nodes has fewer bonds than
+// dim·|W| dofs, so a mechanism) and is left out too, placed after the solve at its reference place
+// among its anchors translated by their weighted mean displacement. With `strands` (mixed, once the
+// cracks have cut the load path: no piece carries load) a node whose bonds lie on one line on both
+// sides (a link of an unloaded strand) is left out as well, placed on its anchors' line where their
+// axial forces balance.
+//
 // Collinear: the reference directions ξ/|ξ| (so the verdict is a function of the broken flags
 // only: the same before and after a restart) with |e × ξ/|ξ|| ≤ kCollinearSine of the first
 // intact bond's e. In 3D a node held by bonds in one plane (not on one line) is not handled.
