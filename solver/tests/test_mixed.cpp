@@ -567,3 +567,104 @@ TEST(Mixed, NodesHangingByCollinearBondsAreFoundAndPlacedAlikeForOneAndTwoThread
   EXPECT_TRUE(same_bits(one.state.u, two.state.u));
   EXPECT_TRUE(same_bits(one.state.f, two.state.f));
 }
+
+namespace {
+
+// The bar cut through between x = 5 dx and 6 dx (each half held by its grip only, so unloaded),
+// with a mechanism at the cut that is neither a node on one line nor a free piece, as the cracks of
+// plate_with_hole leave at dx = 0.25 mm (docs/accuracy.md, "Linkages and strands"):
+// - linkage: P = (5, 3, 3) keeps its bonds to (3, 3, 3), (4, 2, 2) and Q = (5, 1, 3); Q keeps its
+//   bonds to (3, 1, 3), (4, 0, 2) and P. Each has three bonds in three directions, but together they
+//   have 6 dofs and 5 bonds: a four-bar linkage in space, with no stiffness in its mode while the
+//   bonds are unstretched;
+// - strand: P = (5, 1, 3) keeps only its bonds along y to (5, 0, 3), (5, 2, 3) and (5, 3, 3): held
+//   on both sides of its line, sideways only by their tension, which is zero in the unloaded half.
+// They start off by (0, 60, 30) µm (the strand by (10, 0, 10) µm, sideways), as an explicit phase
+// leaves them; then the tentative load step of mixed (try_once, 10 Newton iterations). Measured with
+// the linkage and strand rules switched off (a throw-away environment switch in hanging_nodes.cpp):
+// both steps throw StepFailed after 10 iterations (the linkage at (0, 20, 10) µm still converged,
+// in 9); with them, 5 iterations each.
+struct Mechanism {
+  pd::Model model = breakable_bar();
+  pd::ForceOperator op{model};
+  pd::QuasiStatic qs{op};
+  pd::State state{model.nodes.size()};
+  std::vector<std::size_t> nodes;                        // the mechanism's
+  std::vector<std::pair<std::size_t, std::size_t>> bonds;  // its intact bonds
+  double t = 0.0, dt = kEnd / 40;
+  int iterations = 0;
+  static std::size_t at(int i, int j, int k) { return pdtest::node_index(i, j, k, kNx, kNy); }
+  explicit Mechanism(bool strand) {
+    cut_bar(model, 5.5 * kDx, 0);
+    if (strand) {
+      const std::size_t p = at(5, 1, 3);
+      nodes = {p};
+      bonds = {{p, at(5, 0, 3)}, {p, at(5, 2, 3)}, {p, at(5, 3, 3)}};
+      hang_by(model, p, {at(5, 0, 3), at(5, 2, 3), at(5, 3, 3)});
+      qs.load_path_cut(true);  // as mixed after the separation: no piece carries load
+    } else {
+      const std::size_t p = at(5, 3, 3), q = at(5, 1, 3);
+      nodes = {p, q};
+      bonds = {{p, at(3, 3, 3)}, {p, at(4, 2, 2)}, {p, q}, {q, at(3, 1, 3)}, {q, at(4, 0, 2)}};
+      hang_by(model, p, {at(3, 3, 3), at(4, 2, 2), q});
+      hang_by(model, q, {at(3, 1, 3), at(4, 0, 2), p});
+    }
+    qs.configure(mixed_case());
+    qs.initialize(state, t);
+    if (strand) state.u[0][nodes[0]] = 1e-5, state.u[2][nodes[0]] = 1e-5;
+    else
+      for (std::size_t i : nodes) state.u[1][i] = 6e-5, state.u[2][i] = 3e-5;
+    qs.guess_from_velocity(false);  // as after an explicit step
+    qs.try_once(10);
+    qs.step(state, t, dt);  // throws StepFailed when no equilibrium in 10 iterations
+    iterations = qs.last_step().iterations;
+  }
+};
+
+void expect_at_rest(const Mechanism& r) {
+  EXPECT_EQ(r.t, kEnd / 40);
+  // Placed among their anchors (the left half is unloaded: its anchors at rest), their bonds
+  // unstretched, and the force the next explicit step starts from ~0 there (against the force
+  // density of one bond at the critical stretch, c s0 V ≈ 3e10 N/m³ here).
+  for (const auto& bond : r.bonds) EXPECT_LT(std::fabs(stretch(r.model, r.state.u, bond.first, bond.second)), 1e-9);
+  for (std::size_t i : r.nodes)
+    for (std::size_t d = 0; d < 3; ++d) {
+      EXPECT_LT(std::fabs(r.state.u[d][i]), 1e-12) << i << " " << d;
+      EXPECT_LT(std::fabs(r.state.f[d][i]), 1.0) << i << " " << d;
+    }
+  for (auto flag : r.model.bonds.broken) ASSERT_LE(flag, 1);  // nothing masked left behind
+}
+
+}  // namespace
+
+TEST(Mixed, TheTentativeLoadStepConvergesWithALinkageAtTheCut) {
+  std::unique_ptr<Mechanism> run;
+  ASSERT_NO_THROW(run = std::make_unique<Mechanism>(false));
+  EXPECT_EQ(run->qs.hanging_nodes(), 2);
+  EXPECT_EQ(run->qs.linkage_nodes(), 2);
+  EXPECT_LE(run->iterations, 5);
+  expect_at_rest(*run);
+  std::printf("linkage: %d Newton iterations\n", run->iterations);
+}
+
+TEST(Mixed, OnceTheLoadPathIsCutTheTentativeLoadStepConvergesWithAStrandAtTheCut) {
+  std::unique_ptr<Mechanism> run;
+  ASSERT_NO_THROW(run = std::make_unique<Mechanism>(true));
+  EXPECT_EQ(run->qs.hanging_nodes(), 1);
+  EXPECT_EQ(run->qs.linkage_nodes(), 1);
+  EXPECT_LE(run->iterations, 5);
+  expect_at_rest(*run);
+  std::printf("strand: %d Newton iterations\n", run->iterations);
+}
+
+TEST(Mixed, LinkagesAreFoundAndPlacedAlikeForOneAndTwoThreads) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  Mechanism one(false);
+  omp_set_num_threads(2);
+  Mechanism two(false);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(one.iterations, two.iterations);
+  EXPECT_TRUE(same_bits(one.state.u, two.state.u));
+  EXPECT_TRUE(same_bits(one.state.f, two.state.f));
+}

@@ -14,7 +14,7 @@ namespace {
 // Whether the bonds of row i to the nodes `active` lets through lie on one line and on one side of
 // i in the reference configuration (or there are none).
 template <class Active>
-bool hangs(const Model& m, std::size_t i, const Active& active) {
+bool hangs(const Model& m, std::size_t i, const Active& active, bool one_side = true) {
   const auto& X = m.nodes.x;
   const auto& bonds = m.bonds;
   bool first = true;
@@ -33,14 +33,44 @@ bool hangs(const Model& m, std::size_t i, const Active& active) {
     }
     const double cross[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]};
     const double sine = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-    if (sine > HangingNodes::kCollinearSine || e[0] * n[0] + e[1] * n[1] + e[2] * n[2] <= 0.0) return false;
+    if (sine > HangingNodes::kCollinearSine || (one_side && e[0] * n[0] + e[1] * n[1] + e[2] * n[2] <= 0.0)) return false;
   }
   return true;
 }
 
+// The intact bonds of row i to nodes still in the body (round 0).
+std::int64_t intact_degree(const Model& m, std::size_t i, const std::vector<double>& round) {
+  const auto& bonds = m.bonds;
+  std::int64_t degree = 0;
+  for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    if (!bonds.broken[ku] && round[static_cast<std::size_t>(bonds.neighbour[ku])] == 0.0) ++degree;
+  }
+  return degree;
+}
+
+// A link of a linkage (hanging_nodes.hpp): weak (at most `dimension` intact bonds to the body) and
+// either with fewer than `dimension` of them, or bonded to another weak node. Row i must be owned
+// (its bonds); the neighbours' weak verdicts come from `weak` (ghosts' from their owners).
+bool linkage(const Model& m, std::size_t i, const std::vector<double>& round, const std::vector<double>& weak, int dimension) {
+  if (weak[i] == 0.0) return false;
+  const auto& bonds = m.bonds;
+  std::int64_t degree = 0;
+  bool weak_neighbour = false;
+  for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+    if (bonds.broken[ku] || round[j] != 0.0) continue;
+    ++degree;
+    weak_neighbour = weak_neighbour || weak[j] != 0.0;
+  }
+  return degree < dimension || weak_neighbour;
+}
+
 }  // namespace
 
-void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d) {
+void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d,
+                        bool strands) {
   const std::size_t n = m.nodes.size();
   round_.assign(n, 0.0);
   masked_.clear();
@@ -55,11 +85,16 @@ void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_
   }
   const auto count = static_cast<std::int64_t>(n);
   std::vector<std::uint8_t> now_found(n, 0);
+  kind_.assign(n, 0);
+  linkage_total_ = 0;
+  std::vector<double> weak(n, 0.0);  // per local node, ghosts from their owners: see linkage()
   for (int r = 1;; ++r) {
     // Round r: a node still in the body hangs when its bonds to the nodes that were still in the body
     // at the start of the round hang; a Jacobi sweep (the verdicts written after it), so they do
-    // not depend on the order in which the threads reach the nodes.
-    std::int64_t found = 0;
+    // not depend on the order in which the threads reach the nodes. Only a round in which no node
+    // hangs looks for links of linkages and strands (the same Jacobi sweep): so the hanging nodes
+    // and their rounds are those found without them, and a link's anchors are placed before it.
+    std::int64_t found = 0, linkages = 0;
 #pragma omp parallel for schedule(dynamic, 512) reduction(+ : found)
     for (std::int64_t q = 0; q < count; ++q) {
       const auto i = static_cast<std::size_t>(q);
@@ -70,15 +105,36 @@ void HangingNodes::find(const Model& m, const std::array<std::vector<std::uint8_
         ++found;
       }
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (now_found[i]) round_[i] = r;
-    if (d) {
-      d->update_ghosts(round_);
-      found = d->total(found);
+    if (d) found = d->total(found);
+    if (found == 0) {
+#pragma omp parallel for schedule(dynamic, 512)
+      for (std::int64_t q = 0; q < count; ++q) {
+        const auto i = static_cast<std::size_t>(q);
+        weak[i] = candidate[i] && round_[i] == 0.0 && intact_degree(m, i, round_) <= dimension ? 1.0 : 0.0;
+      }
+      if (d) d->update_ghosts(weak);
+#pragma omp parallel for schedule(dynamic, 512) reduction(+ : linkages)
+      for (std::int64_t q = 0; q < count; ++q) {
+        const auto i = static_cast<std::size_t>(q);
+        if (!candidate[i] || round_[i] > 0.0) continue;
+        if (linkage(m, i, round_, weak, dimension)) {
+          now_found[i] = 2;
+          ++linkages;
+        } else if (strands && hangs(m, i, [&](std::size_t j) { return round_[j] == 0.0; }, false)) {
+          now_found[i] = 3;
+          ++linkages;
+        }
+      }
+      if (d) linkages = d->total(linkages);
+      found = linkages;
     }
+    for (std::size_t i = 0; i < n; ++i)
+      if (now_found[i]) round_[i] = r, kind_[i] = now_found[i];
+    if (d) d->update_ghosts(round_);
     if (found == 0) break;
     rounds_ = r;
     total_ += found;
+    linkage_total_ += linkages;
   }
   find_free(m, fixed, d);
 }
@@ -181,6 +237,24 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
         // The axial stiffness of each bond from the law's own tangent row at u, w_b = n_bᵀ K_b n_b.
         blocks.assign(static_cast<std::size_t>(9 * (last - first)), 0.0);
         const bool have_tangent = m.bond_model->bond_tangent_row(m, u, i, blocks.data());
+        const auto position = [&](std::size_t j, int c) {
+          return X[static_cast<std::size_t>(c)][j] + u[static_cast<std::size_t>(c)][j];
+        };
+        // w_b = n_bᵀ K_b n_b of bond `slot` of row i to j, from the law's tangent row at u.
+        const auto axial_weight = [&](std::int64_t slot, std::size_t i_, std::size_t j) {
+          double w = 0.0;
+          if (have_tangent) {
+            double y[3], norm = 0.0;
+            for (int c = 0; c < 3; ++c) y[c] = position(j, c) - position(i_, c), norm += y[c] * y[c];
+            norm = std::sqrt(norm);
+            const double* b = &blocks[static_cast<std::size_t>(9 * slot)];
+            if (norm > 0.0)
+              for (int a = 0; a < 3; ++a)
+                for (int c = 0; c < 3; ++c) w += y[a] * b[3 * a + c] * y[c] / (norm * norm);
+          }
+          if (!(w > 0.0) || !std::isfinite(w)) w = 1.0 / bond_length(X, i_, j);  // a law without a tangent row: ν·V equal
+          return w;
+        };
         // The anchors: intact bonds to nodes in the body or placed in a later round.
         std::int64_t nearest = -1, farthest = -1;
         double near_length = HUGE_VAL, far_length = -HUGE_VAL;
@@ -193,9 +267,63 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
           if (length > far_length) far_length = length, farthest = k;
         }
         if (nearest < 0) continue;  // hangs by nothing that holds it: stays
-        const auto position = [&](std::size_t j, int c) {
-          return X[static_cast<std::size_t>(c)][j] + u[static_cast<std::size_t>(c)][j];
-        };
+        if (kind_[i] == 3) {
+          // A link of a strand (bonds on one line, on both sides): on its anchors' line where their
+          // axial forces balance, x_i = Σ w_b (x_b − (ξ_b·e) e_now) / Σ w_b, e the reference line
+          // and e_now the line of its two outermost anchors now (e alone for one anchor).
+          const auto jn = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(nearest)]);
+          double e[3], along_low = HUGE_VAL, along_high = -HUGE_VAL;
+          for (int c = 0; c < 3; ++c) e[c] = (X[static_cast<std::size_t>(c)][jn] - X[static_cast<std::size_t>(c)][i]) / near_length;
+          std::size_t low = jn, high = jn;
+          for (std::int64_t k = first; k < last; ++k) {
+            const auto ku = static_cast<std::size_t>(k);
+            const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+            if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+            double along = 0.0;
+            for (int c = 0; c < 3; ++c) along += (X[static_cast<std::size_t>(c)][j] - X[static_cast<std::size_t>(c)][i]) * e[c];
+            if (along < along_low) along_low = along, low = j;
+            if (along > along_high) along_high = along, high = j;
+          }
+          double e_now[3] = {e[0], e[1], e[2]};
+          if (along_high > along_low) {
+            double norm = 0.0;
+            for (int c = 0; c < 3; ++c) e_now[c] = position(high, c) - position(low, c), norm += e_now[c] * e_now[c];
+            norm = std::sqrt(norm);
+            for (double& component : e_now) component /= norm;
+          }
+          double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0};
+          for (std::int64_t k = first; k < last; ++k) {
+            const auto ku = static_cast<std::size_t>(k);
+            const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+            if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+            double along = 0.0;
+            for (int c = 0; c < 3; ++c) along += (X[static_cast<std::size_t>(c)][j] - X[static_cast<std::size_t>(c)][i]) * e[c];
+            const double w = axial_weight(k - first, i, j);
+            weight_sum += w;
+            for (int c = 0; c < 3; ++c) sum[c] += w * (position(j, c) - along * e_now[c]);
+          }
+          for (int c = 0; c < 3; ++c) placed[3 * static_cast<std::size_t>(g) + static_cast<std::size_t>(c)] = sum[c] / weight_sum;
+          moved[static_cast<std::size_t>(g)] = 1;
+          continue;
+        }
+        if (kind_[i] == 2) {
+          // A link of a linkage: carried by its anchors' translation, at its reference place among
+          // them (x_i = X_i + Σ w_b u_b / Σ w_b, w_b the axial stiffness as below): its bonds to
+          // them unstretched while they translate together.
+          double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0};
+          for (std::int64_t k = first; k < last; ++k) {
+            const auto ku = static_cast<std::size_t>(k);
+            const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+            if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+            const double w = axial_weight(k - first, i, j);
+            weight_sum += w;
+            for (int c = 0; c < 3; ++c) sum[c] += w * u[static_cast<std::size_t>(c)][j];
+          }
+          for (int c = 0; c < 3; ++c)
+            placed[3 * static_cast<std::size_t>(g) + static_cast<std::size_t>(c)] = X[static_cast<std::size_t>(c)][i] + sum[c] / weight_sum;
+          moved[static_cast<std::size_t>(g)] = 1;
+          continue;
+        }
         // n: from the nearest anchor to the farthest now (the line rotates with them), or the
         // reference direction of a single anchor (the node is carried by its translation).
         double line[3] = {0.0, 0.0, 0.0};
@@ -218,17 +346,7 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
           const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
           if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
           const double length = bond_length(X, i, j);
-          double w = 0.0;
-          if (have_tangent) {
-            double y[3], norm = 0.0;
-            for (int c = 0; c < 3; ++c) y[c] = position(j, c) - position(i, c), norm += y[c] * y[c];
-            norm = std::sqrt(norm);
-            const double* b = &blocks[static_cast<std::size_t>(9 * (k - first))];
-            if (norm > 0.0)
-              for (int a = 0; a < 3; ++a)
-                for (int c = 0; c < 3; ++c) w += y[a] * b[3 * a + c] * y[c] / (norm * norm);
-          }
-          if (!(w > 0.0) || !std::isfinite(w)) w = 1.0 / length;  // a law without a tangent row: ν·V equal
+          const double w = axial_weight(k - first, i, j);
           weight_sum += w;
           for (int c = 0; c < 3; ++c) sum[c] += w * (position(j, c) - length * line[c]);
         }

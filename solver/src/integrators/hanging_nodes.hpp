@@ -40,6 +40,16 @@
 // Its nodes are left out of the solve too and stay where they are (their bonds as the explicit
 // phase left them: the static answer for a free piece is any rigid position; it is not relaxed).
 //
+// Links of linkages and strands (measured on plate_with_hole at dx = 0.25 mm: docs/accuracy.md,
+// "Linkages and strands"): in a round where no node hangs, a node with at most `dimension` intact
+// bonds to the body is weak; a weak node with fewer than `dimension` of them, or bonded to another
+// weak node, is a link of a linkage (Maxwell: a connected set W of weak nodes has fewer bonds than
+// dim·|W| dofs, so a mechanism) and is left out too, placed after the solve at its reference place
+// among its anchors translated by their weighted mean displacement. With `strands` (mixed, once the
+// cracks have cut the load path: no piece carries load) a node whose bonds lie on one line on both
+// sides (a link of an unloaded strand) is left out as well, placed on its anchors' line where their
+// axial forces balance.
+//
 // Collinear: the reference directions ξ/|ξ| (so the verdict is a function of the broken flags
 // only: the same before and after a restart) with |e × ξ/|ξ|| ≤ kCollinearSine of the first
 // intact bond's e. In 3D a node held by bonds in one plane (not on one line) is not handled.
@@ -69,8 +79,11 @@ class HangingNodes {
 
   // Finds them from the model's broken flags and reference positions (see above). Collective on a
   // decomposed run (d not null).
-  void find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d);
-  std::int64_t count() const { return total_; }  // over the whole model
+  // strands: links of strands (collinear bonds on both sides) too: only where no piece carries load.
+  void find(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d,
+            bool strands = false);
+  std::int64_t count() const { return total_; }  // over the whole model, links of linkages included
+  std::int64_t linkage_count() const { return linkage_total_; }  // the links of linkages among them
   bool hanging(std::size_t i) const { return !round_.empty() && round_[i] > 0.0; }
   // A node of a free fragment: no chain of intact bonds (between nodes that do not hang) joins it
   // to a prescribed motion (see above). Over the whole model: free_count().
@@ -88,6 +101,8 @@ class HangingNodes {
  private:
   void find_free(const Model& m, const std::array<std::vector<std::uint8_t>, 3>& fixed, const Decomposed* d);
   std::vector<double> round_;  // per local node, ghosts included: 0 not hanging, r found in round r
+  std::vector<std::uint8_t> kind_;  // per local node: 1 hanging by collinear bonds, 2 a link of a linkage, 3 of a strand
+  std::int64_t linkage_total_ = 0;
   std::vector<double> held_;   // per local node: 1 joined to a prescribed motion (free(): 0 and not hanging)
   std::int64_t free_total_ = 0;
   std::vector<std::int64_t> masked_;

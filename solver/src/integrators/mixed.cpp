@@ -143,6 +143,7 @@ void Mixed::step(State& state, double& t, double& dt) {
     // So are the kProbationSteps - 1 after it (probation_steps_).
     const bool returning = step_mode_ == kExplicit && separated_ && !separation_given_up_;
     const bool tentative = returning || probation_steps_ > 0;
+    static_.load_path_cut(separated_ && !separation_given_up_);  // strands carry no load then (hanging_nodes.hpp)
     if (tentative) static_.try_once(kTentativeIterations);
     try {
       static_.step(state, t, dt);
@@ -255,6 +256,7 @@ void Mixed::load_state(const std::vector<char>& bytes) {
     probation_steps_ = given_up > 1 ? given_up - 1 : 0;
     // A restart restored the whole model's broken flags on every rank (run/start.cpp) before this.
     separated_ = load_path_ && load_path_->separated(whole_ ? whole_->bonds : op_.model().bonds);
+    static_.load_path_cut(separated_ && !separation_given_up_);  // the nodes load_state masks, as step() found them
     static_.load_state(inner);
   }
 }

@@ -421,7 +421,7 @@ void QuasiStatic::find_hanging() {
     hanging_ = HangingNodes{};
     return;
   }
-  hanging_.find(op_.model(), op_.fixed(), op_.decomposed());
+  hanging_.find(op_.model(), op_.fixed(), op_.decomposed(), strands_);
   if (hanging_.count() == 0 && hanging_.free_count() == 0) return;
   skip_dof_.assign(dofs_.size(), 0);
   for (std::size_t q = 0; q < dofs_.size(); ++q) skip_dof_[q] = hanging_.left_out(static_cast<std::size_t>(dofs_.node[q])) ? 1 : 0;

@@ -118,6 +118,11 @@ class QuasiStatic : public Integrator {
   // The nodes the last static solve left out as hanging (hanging_nodes.hpp), over the whole model.
   std::int64_t hanging_nodes() const { return hanging_.count(); }
   std::int64_t free_fragment_nodes() const { return hanging_.free_count(); }
+  std::int64_t linkage_nodes() const { return hanging_.linkage_count(); }  // links of linkages and strands among them
+  // The cracks have cut the load path (mixed's separation rule): no piece carries load, so the links
+  // of strands (collinear bonds on both sides) are mechanisms too (hanging_nodes.hpp). Not
+  // checkpointed: mixed sets it from its own state before every step.
+  void load_path_cut(bool cut) { strands_ = cut; }
 
  private:
   // Newton at load t1 from state.u (prescribed components already at t1). True when converged;
@@ -129,6 +134,7 @@ class QuasiStatic : public Integrator {
   // 1 at their dofs, else empty. Collective.
   void find_hanging();
   HangingNodes hanging_;
+  bool strands_ = false;  // see load_path_cut()
   bool bond_based_ = false;               // the law has bond_tangent_row (PMB): see hanging_nodes.hpp
   std::vector<std::uint8_t> skip_dof_;    // per free dof: a hanging or free node's (empty: none)
   double load_scale(const State& s, double t) const;
