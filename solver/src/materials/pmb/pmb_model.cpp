@@ -21,6 +21,29 @@ BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u
   return r;
 }
 
+void PmbModel::add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                    const GhostsInFlight& u_ghosts) const {
+  add_pmb_force(model, u, f, w, RowSubset::of(u_ghosts.rows.interior));
+  u_ghosts.wait();
+  add_pmb_force(model, u, f, w, RowSubset::of(u_ghosts.rows.boundary));
+}
+
+BreakReport PmbModel::break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                           bool want_energy, double* lost_per_node,
+                                                           const GhostsInFlight& u_ghosts) const {
+  // Without lost_per_node the energy of the broken bonds is summed over every row at once:
+  // not a split sweep's (a decomposed run always passes it, operator/force_operator).
+  if (uses_lammps_rules(model) || !lost_per_node)
+    return BondModel::break_bonds_and_add_force_overlapped(model, u, f, w, want_energy, lost_per_node, u_ghosts);
+  // A row breaks only its own copies of its bonds (both copies of a crossing bond see the same
+  // stretch), so the interior rows may break theirs before the boundary rows have u's ghosts.
+  BreakReport r;
+  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, RowSubset::of(u_ghosts.rows.interior));
+  u_ghosts.wait();
+  r.broken += break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, RowSubset::of(u_ghosts.rows.boundary));
+  return r;
+}
+
 BreakReport PmbModel::break_bonds(Model& model, const Vec3Array& u, bool want_energy) const {
   BreakReport r;
   if (uses_lammps_rules(model)) r.broken = break_bonds_lammps_rules(model, u, nullptr, nullptr, want_energy ? &r.energy : nullptr);
