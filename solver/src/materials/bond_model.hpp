@@ -141,6 +141,13 @@ class BondModel {
   // y += J(u)·x, J = ∂f/∂u the linearised force density at u (a Jacobian–vector product, matrix-free):
   // the Newton and Krylov solves of the implicit integrators use it.
   virtual void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const = 0;
+  // The same on a decomposed run with x's ghost values still on their way (u's are current), as
+  // add_force_overlapped: interior rows, x_ghosts.wait(), boundary rows. By default no overlap.
+  virtual void add_jacobian_product_overlapped(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                               const GhostsInFlight& x_ghosts) const {
+    x_ghosts.wait();
+    add_jacobian_product(model, u, x, y);
+  }
   // The same Jacobian assembled, for a bond-based law whose force on i depends on u_j − u_i only:
   // blocks[9k..9k+8] = ∂f_i/∂u_j (row-major 3×3) for bond k of row i at u (zeros for a broken
   // bond); ∂f_i/∂u_i is minus their sum. Returns false for a law that has no such form (a

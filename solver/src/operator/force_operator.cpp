@@ -121,15 +121,19 @@ FreeDofs ForceOperator::free_dofs(int dimension) const {
 }
 
 void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x, Vec3Array& y) const {
-  const Vec3Array* in = &x;
-  if (decomposed_) {
-    ghosted_x_ = x;
-    decomposed_->update_ghosts(ghosted_x_);
-    in = &ghosted_x_;
-  }
   for (auto& yc : y) std::fill(yc.begin(), yc.end(), 0.0);
-  model_.bond_model->add_jacobian_product(model_, s.u, *in, y);
-  for (const auto& term : terms_) term->add_jacobian_product(s, t, *in, y);
+  if (!decomposed_) {
+    model_.bond_model->add_jacobian_product(model_, s.u, x, y);
+    for (const auto& term : terms_) term->add_jacobian_product(s, t, x, y);
+    return;
+  }
+  // x's ghosts travel while the law sweeps the rows that read none (parallel/row_split.hpp).
+  ghosted_x_ = x;
+  decomposed_->begin_update_ghosts(ghosted_x_);
+  const GhostsInFlight x_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(ghosted_x_); });
+  model_.bond_model->add_jacobian_product_overlapped(model_, s.u, ghosted_x_, y, x_ghosts);
+  x_ghosts.wait();
+  for (const auto& term : terms_) term->add_jacobian_product(s, t, ghosted_x_, y);
 }
 
 bool ForceOperator::has_assembled_stiffness(const State& s, double t) const {

@@ -148,6 +148,8 @@ class PmbModel : public BondModel {
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
+  void add_jacobian_product_overlapped(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                       const GhostsInFlight& x_ghosts) const override;
   bool bond_tangent_row(const Model& model, const Vec3Array& u, std::size_t i, double* blocks,
                         bool definite = false) const override;
 };

@@ -147,13 +147,16 @@ inline void bond_block(double c_vj, double length, double e0, double e1, double 
 
 }  // namespace
 
-void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
+namespace {
+
+// y += J(u)·x over `rows` (every row by default; parallel/row_split.hpp).
+void add_jacobian_rows(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y, RowSubset rows) {
+  const std::int64_t count = rows.size(static_cast<std::int64_t>(m.nodes.size()));
   const auto nb = static_cast<std::size_t>(m.material.blocks);
   const auto& X = m.nodes.x;
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i64 = 0; i64 < n; ++i64) {
-    const auto i = static_cast<std::size_t>(i64);
+  for (std::int64_t r = 0; r < count; ++r) {
+    const auto i = static_cast<std::size_t>(rows.at(r));
     const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
     const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;  // in bond order: the same for any thread count
@@ -176,6 +179,19 @@ void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Ve
     y[1][i] += s1;
     y[2][i] += s2;
   }
+}
+
+}  // namespace
+
+void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  add_jacobian_rows(m, u, x, y, RowSubset{});
+}
+
+void PmbModel::add_jacobian_product_overlapped(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                               const GhostsInFlight& x_ghosts) const {
+  add_jacobian_rows(m, u, x, y, RowSubset::of(x_ghosts.rows.interior));
+  x_ghosts.wait();
+  add_jacobian_rows(m, u, x, y, RowSubset::of(x_ghosts.rows.boundary));
 }
 
 bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t i, double* blocks,
