@@ -53,6 +53,17 @@ def run_ours(exe, side, steps, ranks, threads):
     return [dict(zip(header, line.split(","))) for line in lines[1:]]
 
 
+def waiting(row):
+    """', halo X ms, of which Y ms waiting': the halo exchanges' time and their second halves' (a
+    build before the overlap of the halo with the interior rows has no such columns)."""
+    halo, wait = row.get("halo_s_per_step"), row.get("halo_wait_s_per_step")
+    if not halo:
+        return ""
+    if not wait or wait == "nan":  # the exchange in one blocking piece
+        return f"; halo {float(halo) * 1e3:.3f} ms"
+    return f"; halo {float(halo) * 1e3:.3f} ms, of which {float(wait) * 1e3:.3f} ms waiting"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build/solver")
@@ -103,7 +114,8 @@ def main():
                       f"{r0['halo_bytes_per_step']} halo bytes, {r0['reductions_per_step']} reductions (MPI_Allreduce) "
                       f"of {r0['reduction_bytes_per_step']} bytes, "
                       f"{r0['ghosts_per_owned']} ghosts per owned node, {float(r0['communication_s_per_step']) * 1e3:.3f} ms "
-                      f"in communication ({100 * float(r0['communication_share']):.1f} %), peak {r0['peak_rss_mb']} MB "
+                      f"in communication ({100 * float(r0['communication_share']):.1f} %{waiting(r0)}), "
+                      f"peak {r0['peak_rss_mb']} MB "
                       f"(load {load})", flush=True)
             print(f"  2-rank efficiency against 2 threads (1 thread each): {rate[(2, 1)] / rate[(1, 2)]:.2f}", flush=True)
             if best_lammps is not None:
@@ -113,7 +125,7 @@ def main():
     fields = ["code", "rank", "side", "nodes", "ranks", "threads", "steps", "directed_bonds", "loop_s",
               "bond_updates_per_s", "owned", "ghosts", "ghosts_per_owned", "halo_messages_per_step",
               "halo_bytes_per_step", "reductions_per_step", "reduction_bytes_per_step", "communication_s_per_step",
-              "communication_share", "peak_rss_mb", "oversubscribed", "load_average"]
+              "communication_share", "peak_rss_mb", "halo_s_per_step", "halo_wait_s_per_step", "oversubscribed", "load_average"]
     with open(args.out, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()

@@ -8,7 +8,9 @@
 // of the whole brick; the rank's owned nodes, ghosts and ghosts per owned node; per step the halo
 // messages and bytes it sent, the reductions (MPI_Allreduce: the breaking pass's count with its lost
 // energy, the two energies) and their bytes, the wall time in communication (halo exchanges and
-// every Allreduce, the waits for the slower rank included); and its peak resident memory.
+// every Allreduce, the waits for the slower rank included); its peak resident memory; and, of the
+// communication time, the halo exchanges' (packing, MPI calls, waits, unpacking) and of that their
+// waits (their second halves: what the sweep of the interior rows did not hide, parallel/row_split.hpp).
 //
 //   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T]
 #include <mpi.h>
@@ -100,7 +102,7 @@ int main(int argc, char** argv) {
   const double per = 1.0 / steps;
   const double owned = dec ? static_cast<double>(dec->piece().owned_local.size()) : static_cast<double>(global.nodes.size());
   const double ghosts = dec ? static_cast<double>(dec->piece().ghost_local.size()) : 0.0;
-  constexpr int kColumns = 9;
+  constexpr int kColumns = 11;
   const double row[kColumns] = {owned,
                                 ghosts,
                                 static_cast<double>(after.halo_messages - before.halo_messages) * per,
@@ -109,7 +111,9 @@ int main(int argc, char** argv) {
                                 static_cast<double>(after.reduction_bytes - before.reduction_bytes) * per,
                                 (after.halo_seconds - before.halo_seconds + after.reduction_seconds - before.reduction_seconds) * per,
                                 mine,
-                                static_cast<double>(usage.ru_maxrss) / 1024.0};
+                                static_cast<double>(usage.ru_maxrss) / 1024.0,
+                                (after.halo_seconds - before.halo_seconds) * per,
+                                (after.halo_wait_seconds - before.halo_wait_seconds) * per};
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   std::vector<double> all(static_cast<std::size_t>(kColumns * ranks));
@@ -118,12 +122,12 @@ int main(int argc, char** argv) {
     const double directed = static_cast<double>(global.bonds.offsets.back());  // held or only counted
     std::printf("rank,side,nodes,ranks,threads,steps,directed_bonds,loop_s,bond_updates_per_s,owned,ghosts,ghosts_per_owned,"
                 "halo_messages_per_step,halo_bytes_per_step,reductions_per_step,reduction_bytes_per_step,"
-                "communication_s_per_step,communication_share,peak_rss_mb\n");
+                "communication_s_per_step,communication_share,peak_rss_mb,halo_s_per_step,halo_wait_s_per_step\n");
     for (int r = 0; r < ranks; ++r) {
       const double* v = &all[static_cast<std::size_t>(kColumns * r)];
-      std::printf("%d,%d,%zu,%d,%d,%d,%.0f,%.4f,%.4e,%.0f,%.0f,%.4f,%.1f,%.0f,%.2f,%.0f,%.4e,%.4f,%.1f\n", r, side,
+      std::printf("%d,%d,%zu,%d,%d,%d,%.0f,%.4f,%.4e,%.0f,%.0f,%.4f,%.1f,%.0f,%.2f,%.0f,%.4e,%.4f,%.1f,%.4e,%.4e\n", r, side,
                   global.nodes.size(), ranks, threads, steps, directed, loop, directed * steps / loop, v[0], v[1], v[1] / v[0],
-                  v[2], v[3], v[4], v[5], v[6], v[6] * steps / loop, v[8]);
+                  v[2], v[3], v[4], v[5], v[6], v[6] * steps / loop, v[8], v[9], v[10]);
     }
   }
   MPI_Finalize();

@@ -25,6 +25,7 @@
 #include "core/material.hpp"
 #include "core/nodes.hpp"
 #include "core/registry.hpp"
+#include "parallel/row_split.hpp"
 
 namespace pd {
 
@@ -93,6 +94,21 @@ class BondModel {
   // BreakReport::energy is 0 — the operator sums the shares over the ranks in node order.
   virtual BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                                 bool want_energy, double* lost_per_node = nullptr) const = 0;
+  // add_force and break_bonds_and_add_force on a decomposed run with u's ghost values still on
+  // their way (parallel/row_split.hpp says why): the law sweeps u_ghosts.rows.interior, calls
+  // u_ghosts.wait(), then sweeps u_ghosts.rows.boundary; the same f, w, flags and report as the
+  // plain call after the exchange, bit for bit. By default: wait, then the plain call (no overlap).
+  virtual void add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                    const GhostsInFlight& u_ghosts) const {
+    u_ghosts.wait();
+    add_force(model, u, f, w);
+  }
+  virtual BreakReport break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                           bool want_energy, double* lost_per_node,
+                                                           const GhostsInFlight& u_ghosts) const {
+    u_ghosts.wait();
+    return break_bonds_and_add_force(model, u, f, w, want_energy, lost_per_node);
+  }
   // Only the breaking of break_bonds_and_add_force.
   virtual BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const = 0;
   // W_i per node at u [J/m³].
@@ -125,6 +141,13 @@ class BondModel {
   // y += J(u)·x, J = ∂f/∂u the linearised force density at u (a Jacobian–vector product, matrix-free):
   // the Newton and Krylov solves of the implicit integrators use it.
   virtual void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const = 0;
+  // The same on a decomposed run with x's ghost values still on their way (u's are current), as
+  // add_force_overlapped: interior rows, x_ghosts.wait(), boundary rows. By default no overlap.
+  virtual void add_jacobian_product_overlapped(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                               const GhostsInFlight& x_ghosts) const {
+    x_ghosts.wait();
+    add_jacobian_product(model, u, x, y);
+  }
   // The same Jacobian assembled, for a bond-based law whose force on i depends on u_j − u_i only:
   // blocks[9k..9k+8] = ∂f_i/∂u_j (row-major 3×3) for bond k of row i at u (zeros for a broken
   // bond); ∂f_i/∂u_i is minus their sum. Returns false for a law that has no such form (a

@@ -36,9 +36,16 @@ void ForceOperator::set_decomposed(const Decomposed* d) {
 }
 
 void ForceOperator::evaluate(State& s, double t) const {
-  if (decomposed_) decomposed_->update_ghosts(s.u);
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
-  model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
+  if (!decomposed_) {
+    model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
+  } else {
+    // The ghosts' u travel while the law sweeps the rows that read none (parallel/row_split.hpp).
+    decomposed_->begin_update_ghosts(s.u);
+    const GhostsInFlight u_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(s.u); });
+    model_.bond_model->add_force_overlapped(model_, s.u, s.f, s.w.data(), u_ghosts);
+    u_ghosts.wait();  // the terms below read the ghosts' u (a law waits before its boundary rows anyway)
+  }
   s.contact_energy = 0.0;
   s.indenter_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
@@ -52,12 +59,17 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
   } else {
     // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
     // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
-    decomposed_->update_ghosts(s.u);
     // LAMMPS's α rule: a bond's threshold min(s0_i, s0_j) reads its ghost end's s0, which the
-    // previous pass updated on the owner only (a ghost's empty row leaves +inf).
+    // previous pass updated on the owner only (a ghost's empty row leaves +inf). Before u's
+    // exchange begins: one exchange at a time.
     if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
+    // The ghosts' u travel while the law sweeps the rows that read none (parallel/row_split.hpp).
+    decomposed_->begin_update_ghosts(s.u);
+    const GhostsInFlight u_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(s.u); });
     lost_.assign(s.size(), 0.0);
-    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true, lost_.data());
+    report = model_.bond_model->break_bonds_and_add_force_overlapped(model_, s.u, s.f, s.w.data(), true, lost_.data(),
+                                                                      u_ghosts);
+    u_ghosts.wait();
     reduce_break_report(report);
   }
   s.contact_energy = 0.0;
@@ -109,15 +121,19 @@ FreeDofs ForceOperator::free_dofs(int dimension) const {
 }
 
 void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x, Vec3Array& y) const {
-  const Vec3Array* in = &x;
-  if (decomposed_) {
-    ghosted_x_ = x;
-    decomposed_->update_ghosts(ghosted_x_);
-    in = &ghosted_x_;
-  }
   for (auto& yc : y) std::fill(yc.begin(), yc.end(), 0.0);
-  model_.bond_model->add_jacobian_product(model_, s.u, *in, y);
-  for (const auto& term : terms_) term->add_jacobian_product(s, t, *in, y);
+  if (!decomposed_) {
+    model_.bond_model->add_jacobian_product(model_, s.u, x, y);
+    for (const auto& term : terms_) term->add_jacobian_product(s, t, x, y);
+    return;
+  }
+  // x's ghosts travel while the law sweeps the rows that read none (parallel/row_split.hpp).
+  ghosted_x_ = x;
+  decomposed_->begin_update_ghosts(ghosted_x_);
+  const GhostsInFlight x_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(ghosted_x_); });
+  model_.bond_model->add_jacobian_product_overlapped(model_, s.u, ghosted_x_, y, x_ghosts);
+  x_ghosts.wait();
+  for (const auto& term : terms_) term->add_jacobian_product(s, t, ghosted_x_, y);
 }
 
 bool ForceOperator::has_assembled_stiffness(const State& s, double t) const {

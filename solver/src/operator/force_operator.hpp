@@ -31,9 +31,11 @@ class ForceOperator {
   // "Can anything break?", asked of the material's constants: the one place.
   bool can_break() const { return model_.material.can_break(); }
 
-  // A decomposed run (issue 15): the model is this rank's piece (parallel/local_model), and before
-  // each sweep the ghosts' displacements come from their owners; energies and break reports are
-  // reduced over the ranks in an order that does not depend on them. Null (the default): serial.
+  // A decomposed run (issue 15): the model is this rank's piece (parallel/local_model), and the
+  // ghosts' displacements come from their owners while the law sweeps the rows that read no ghost
+  // (parallel/row_split.hpp: evaluate, break_bonds_and_evaluate, apply_jacobian); energies and
+  // break reports are reduced over the ranks in an order that does not depend on them. Null (the
+  // default): serial.
   void set_decomposed(const Decomposed* d);
   const Decomposed* decomposed() const { return decomposed_; }
 

@@ -11,6 +11,7 @@
 #include "core/bonds.hpp"
 #include "core/exact_sum.hpp"
 #include "core/nodes.hpp"
+#include "parallel/row_split.hpp"
 
 namespace pd {
 
@@ -33,6 +34,17 @@ class Decomposed {
   virtual void update_ghosts(Vec3Array& a) const = 0;
   // The same for a scalar per node (LPS's P_i between its two sweeps).
   virtual void update_ghosts(std::vector<double>& a) const = 0;
+  // update_ghosts in two halves, so that the rows that read no ghost are swept while the values
+  // travel (parallel/row_split.hpp says why and how): begin sends a's owned entries to the ranks
+  // that hold them as ghosts and returns; end waits and sets a's ghost entries. Nothing may write
+  // a's owned entries or read its ghost entries in between, and one exchange runs at a time.
+  virtual void begin_update_ghosts(const Vec3Array& a) const = 0;
+  virtual void end_update_ghosts(Vec3Array& a) const = 0;
+  virtual void begin_update_ghosts(const std::vector<double>& a) const = 0;
+  virtual void end_update_ghosts(std::vector<double>& a) const = 0;
+  // The piece's owned rows split into those that read no ghost and the others, made once with the
+  // piece (its rows never change).
+  virtual const RowSplit& row_split() const = 0;
   // start + Σ over owned local nodes of per_node[l], summed exactly (core/exact_sum.hpp) and rounded
   // once, the same on every rank: the bits do not depend on the rank or thread count, and equal
   // the serial exact sum (parallel/node_sum.hpp) of the whole model's terms. Entries of ghosts are
@@ -105,6 +117,9 @@ class Decomposed {
     // Wall time inside MPI calls and packing (reductions: every Allreduce and the gathers), waits
     // for the other ranks included: a collective returns when the slowest rank has entered it.
     double halo_seconds = 0.0, reduction_seconds = 0.0;
+    // Of halo_seconds, the time in the exchanges' second halves: the wait for the messages that the
+    // interior rows' sweep did not hide (parallel/row_split.hpp), and the unpacking.
+    double halo_wait_seconds = 0.0;
   };
   virtual Traffic traffic() const = 0;
   // run.log's lines on the decomposed run's communication: per rank, per step of `steps`, the

@@ -2,6 +2,7 @@
 #include "parallel/halo.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace pd {
 
@@ -60,48 +61,75 @@ HaloExchange::HaloExchange(MPI_Comm comm, const LocalPiece& piece, const std::ve
   requests_.resize(send_rank_.size() + recv_rank_.size());
 }
 
-void HaloExchange::exchange(std::vector<double>& a) const {
-  constexpr int kTag = 16;  // not the displacements' tag, though one exchange runs at a time anyway
+// Tags: one per kind of array, though one exchange at a time runs anyway (begin refuses a second).
+namespace {
+constexpr int kVectorTag = 15;  // issue 15
+constexpr int kScalarTag = 16;
+}  // namespace
+
+void HaloExchange::post(int width, int tag) const {
   std::size_t q = 0;
   for (std::size_t m = 0; m < recv_rank_.size(); ++m) {
     const std::int64_t begin = recv_start_[m], count = recv_start_[m + 1] - begin;
-    MPI_Irecv(recv_buffer_.data() + begin, static_cast<int>(count), MPI_DOUBLE, recv_rank_[m], kTag, comm_,
+    MPI_Irecv(recv_buffer_.data() + width * begin, static_cast<int>(width * count), MPI_DOUBLE, recv_rank_[m], tag, comm_,
               &requests_[q++]);
   }
-  for (std::size_t k = 0; k < send_node_.size(); ++k) send_buffer_[k] = a[static_cast<std::size_t>(send_node_[k])];
   for (std::size_t m = 0; m < send_rank_.size(); ++m) {
     const std::int64_t begin = send_start_[m], count = send_start_[m + 1] - begin;
-    MPI_Isend(send_buffer_.data() + begin, static_cast<int>(count), MPI_DOUBLE, send_rank_[m], kTag, comm_,
+    MPI_Isend(send_buffer_.data() + width * begin, static_cast<int>(width * count), MPI_DOUBLE, send_rank_[m], tag, comm_,
               &requests_[q++]);
   }
-  MPI_Waitall(static_cast<int>(q), requests_.data(), MPI_STATUSES_IGNORE);
-  for (std::size_t k = 0; k < recv_node_.size(); ++k) a[static_cast<std::size_t>(recv_node_[k])] = recv_buffer_[k];
+  requests_posted_ = q;
 }
 
-void HaloExchange::exchange(Vec3Array& a) const {
-  constexpr int kTag = 15;  // issue 15; one exchange at a time, so one tag suffices
+void HaloExchange::begin(const std::vector<double>& a) const {
+  if (in_flight_) throw std::logic_error("HaloExchange::begin: an exchange is already under way");
+  for (std::size_t k = 0; k < send_node_.size(); ++k) send_buffer_[k] = a[static_cast<std::size_t>(send_node_[k])];
+  post(1, kScalarTag);
+  in_flight_ = 1;
+}
+
+void HaloExchange::end(std::vector<double>& a) const {
+  if (in_flight_ != 1) throw std::logic_error("HaloExchange::end: no exchange of a scalar under way");
+  MPI_Waitall(static_cast<int>(requests_posted_), requests_.data(), MPI_STATUSES_IGNORE);
+  for (std::size_t k = 0; k < recv_node_.size(); ++k) a[static_cast<std::size_t>(recv_node_[k])] = recv_buffer_[k];
+  in_flight_ = 0;
+}
+
+void HaloExchange::exchange(std::vector<double>& a) const {
+  begin(a);
+  end(a);
+}
+
+void HaloExchange::begin(const Vec3Array& a) const {
+  if (in_flight_) throw std::logic_error("HaloExchange::begin: an exchange is already under way");
   const double start = MPI_Wtime();
-  std::size_t q = 0;
-  for (std::size_t m = 0; m < recv_rank_.size(); ++m) {
-    const std::int64_t begin = recv_start_[m], count = recv_start_[m + 1] - begin;
-    MPI_Irecv(recv_buffer_.data() + 3 * begin, static_cast<int>(3 * count), MPI_DOUBLE, recv_rank_[m], kTag, comm_,
-              &requests_[q++]);
-  }
   // Node by node, three components together: one message per neighbour.
   for (std::size_t k = 0; k < send_node_.size(); ++k)
     for (int d = 0; d < 3; ++d)
       send_buffer_[3 * k + static_cast<std::size_t>(d)] = a[static_cast<std::size_t>(d)][static_cast<std::size_t>(send_node_[k])];
-  for (std::size_t m = 0; m < send_rank_.size(); ++m) {
-    const std::int64_t begin = send_start_[m], count = send_start_[m + 1] - begin;
-    MPI_Isend(send_buffer_.data() + 3 * begin, static_cast<int>(3 * count), MPI_DOUBLE, send_rank_[m], kTag, comm_,
-              &requests_[q++]);
-  }
-  MPI_Waitall(static_cast<int>(q), requests_.data(), MPI_STATUSES_IGNORE);
+  post(3, kVectorTag);
+  in_flight_ = 3;
+  seconds_ += MPI_Wtime() - start;
+}
+
+void HaloExchange::end(Vec3Array& a) const {
+  if (in_flight_ != 3) throw std::logic_error("HaloExchange::end: no exchange of a Vec3Array under way");
+  const double start = MPI_Wtime();
+  MPI_Waitall(static_cast<int>(requests_posted_), requests_.data(), MPI_STATUSES_IGNORE);
   for (std::size_t k = 0; k < recv_node_.size(); ++k)
     for (int d = 0; d < 3; ++d)
       a[static_cast<std::size_t>(d)][static_cast<std::size_t>(recv_node_[k])] = recv_buffer_[3 * k + static_cast<std::size_t>(d)];
+  in_flight_ = 0;
   ++exchanges_;
-  seconds_ += MPI_Wtime() - start;
+  const double spent = MPI_Wtime() - start;
+  seconds_ += spent;
+  wait_seconds_ += spent;
+}
+
+void HaloExchange::exchange(Vec3Array& a) const {
+  begin(a);
+  end(a);
 }
 
 }  // namespace pd

@@ -27,6 +27,7 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& global)
   MPI_Comm_rank(comm, &rank_);
   piece_ = make_local_piece(global, decomposition_.owner, rank_);
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
+  row_split_ = split_rows(piece_);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
 }
 
@@ -43,6 +44,7 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
     piece_ = make_local_piece(skeleton, decomposition_.owner, rank_, std::move(owned));
   }
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
+  row_split_ = split_rows(piece_);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
   // LAMMPS's s0 at rest: the owned rows give the owned nodes' (the serial values: the same rows),
   // and the ghosts take their owners' (a ghost's row is empty here).
@@ -116,6 +118,7 @@ Decomposed::Traffic MpiDecomposed::traffic() const {
   t.halo_messages = halo_->exchanges() * halo_->messages_sent();
   t.halo_bytes = halo_->exchanges() * halo_->bytes_sent();
   t.halo_seconds = halo_->seconds();
+  t.halo_wait_seconds = halo_->wait_seconds();
   t.reductions = reductions_;
   t.reduction_bytes = reduction_bytes_;
   t.gathers = sum_->calls();

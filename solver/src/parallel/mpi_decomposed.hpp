@@ -14,6 +14,7 @@
 #include "parallel/halo.hpp"
 #include "parallel/local_model.hpp"
 #include "parallel/ordered_sum.hpp"
+#include "parallel/row_split.hpp"
 
 namespace pd {
 
@@ -38,6 +39,11 @@ class MpiDecomposed : public Decomposed {
 
   void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
   void update_ghosts(std::vector<double>& a) const override { halo_->exchange(a); }
+  void begin_update_ghosts(const Vec3Array& a) const override { halo_->begin(a); }
+  void end_update_ghosts(Vec3Array& a) const override { halo_->end(a); }
+  void begin_update_ghosts(const std::vector<double>& a) const override { halo_->begin(a); }
+  void end_update_ghosts(std::vector<double>& a) const override { halo_->end(a); }
+  const RowSplit& row_split() const override { return row_split_; }
   double exact_sum(const std::vector<double>& per_node, double start = 0.0) const override;
   void reduce(ExactSum* sums, int count, std::int64_t* integers = nullptr, int integer_count = 0) const override;
   std::int64_t total(std::int64_t local) const override;
@@ -82,6 +88,7 @@ class MpiDecomposed : public Decomposed {
   Decomposition decomposition_;
   LocalPiece piece_;
   std::unique_ptr<HaloExchange> halo_;
+  RowSplit row_split_;  // of piece_'s owned rows (parallel/row_split.hpp)
   std::unique_ptr<OrderedSum> sum_;  // the gathers to rank 0
   mutable std::vector<std::int64_t> limbs_;  // reduce's buffer
   mutable std::int64_t reductions_ = 0, reduction_bytes_ = 0;

@@ -92,6 +92,13 @@ class LpsModel : public BondModel {
   void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const override;
   BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                         bool want_energy, double* lost_per_node = nullptr) const override;
+  // Both sweeps overlapped with the exchanges they need, u's and then P's (lps_kernel.cpp
+  // overlapped_sweeps; parallel/row_split.hpp says why).
+  void add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                            const GhostsInFlight& u_ghosts) const override;
+  BreakReport break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                   bool want_energy, double* lost_per_node,
+                                                   const GhostsInFlight& u_ghosts) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override;

@@ -173,14 +173,19 @@ std::int64_t dilatation_row(const LpsKernel& k, std::int64_t i, const Breaking* 
 
 // Sweep 1 over every node: θ and P per node. Returns the bonds broken now (each once). A row with
 // candidates for breaking (rare: near a crack tip) is redone by dilatation_row, exactly.
+// rows: the rows swept (every row by default); theta and p are sized to the nodes (zeros) first
+// if they are not, and only the rows' entries are set. A row's θ and P do not depend on which other
+// rows are swept (parallel/row_split.hpp).
 template <Influence kKind>
 std::int64_t dilatation_sweep_of(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
-                                 std::vector<double>& p) {
-  theta.assign(static_cast<std::size_t>(k.nodes), 0.0);
-  p.assign(static_cast<std::size_t>(k.nodes), 0.0);
+                                 std::vector<double>& p, RowSubset rows) {
+  if (theta.size() != static_cast<std::size_t>(k.nodes)) theta.assign(static_cast<std::size_t>(k.nodes), 0.0);
+  if (p.size() != static_cast<std::size_t>(k.nodes)) p.assign(static_cast<std::size_t>(k.nodes), 0.0);
   std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
+  const std::int64_t count = rows.size(k.nodes);
 #pragma omp parallel for schedule(static) reduction(+ : newly)
-  for (std::int64_t i = 0; i < k.nodes; ++i) {
+  for (std::int64_t r = 0; r < count; ++r) {
+    const std::int64_t i = rows.at(r);
     double th = 0.0, st = 0.0, mi = 0.0;
     std::int64_t over = 0;
     if (br && !br->no_fail[i]) {
@@ -203,21 +208,24 @@ std::int64_t dilatation_sweep_of(const LpsKernel& k, const Breaking* br, std::ve
 }
 
 std::int64_t dilatation_sweep(const LpsKernel& k, const Breaking* br, std::vector<double>& theta,
-                              std::vector<double>& p) {
+                              std::vector<double>& p, RowSubset rows = {}) {
   switch (k.kind) {
-    case Influence::inverse_length: return dilatation_sweep_of<Influence::inverse_length>(k, br, theta, p);
-    case Influence::gaussian: return dilatation_sweep_of<Influence::gaussian>(k, br, theta, p);
+    case Influence::inverse_length: return dilatation_sweep_of<Influence::inverse_length>(k, br, theta, p, rows);
+    case Influence::gaussian: return dilatation_sweep_of<Influence::gaussian>(k, br, theta, p, rows);
     case Influence::one: break;
   }
-  return dilatation_sweep_of<Influence::one>(k, br, theta, p);
+  return dilatation_sweep_of<Influence::one>(k, br, theta, p, rows);
 }
 
 // Sweep 2: f_i += Σ_j (t_ij + t_ji) V_j e/y, t_ij + t_ji = ω(|ξ|(P_i + P_j) + (a_i + a_j) ext); W_i.
+// rows: the rows swept (every row by default), as dilatation_sweep_of.
 template <Influence kKind>
 void force_sweep_of(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
-                    double* w) {
+                    double* w, RowSubset rows) {
+  const std::int64_t count = rows.size(k.nodes);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < k.nodes; ++i) {
+  for (std::int64_t r = 0; r < count; ++r) {
+    const std::int64_t i = rows.at(r);
     const ForceRow r = force_row_fast<kKind>(k, i, theta.data(), p.data());
     const auto iu = static_cast<std::size_t>(i);
     f[0][iu] += r.f0;
@@ -228,13 +236,34 @@ void force_sweep_of(const LpsKernel& k, const std::vector<double>& theta, const 
 }
 
 void force_sweep(const LpsKernel& k, const std::vector<double>& theta, const std::vector<double>& p, Vec3Array& f,
-                 double* w) {
+                 double* w, RowSubset rows = {}) {
   switch (k.kind) {
-    case Influence::inverse_length: return force_sweep_of<Influence::inverse_length>(k, theta, p, f, w);
-    case Influence::gaussian: return force_sweep_of<Influence::gaussian>(k, theta, p, f, w);
+    case Influence::inverse_length: return force_sweep_of<Influence::inverse_length>(k, theta, p, f, w, rows);
+    case Influence::gaussian: return force_sweep_of<Influence::gaussian>(k, theta, p, f, w, rows);
     case Influence::one: break;
   }
-  force_sweep_of<Influence::one>(k, theta, p, f, w);
+  force_sweep_of<Influence::one>(k, theta, p, f, w, rows);
+}
+
+// Both sweeps on a decomposed run, each overlapped with the exchange it needs (parallel/row_split.hpp):
+// sweep 1 over the interior rows while u's ghosts travel, then over the boundary rows; P's
+// exchange begins once every owned P is known, and sweep 2 goes over the interior rows (P_j of
+// owned nodes only) while it travels, then over the boundary rows. The same θ, P, flags, f and W
+// as the plain sweeps after blocking exchanges, bit for bit. Returns the bonds broken (each once).
+std::int64_t overlapped_sweeps(const LpsKernel& k, const Breaking* br, const Decomposed& d, const GhostsInFlight& u_ghosts,
+                               Vec3Array& f, double* w) {
+  const RowSubset interior = RowSubset::of(u_ghosts.rows.interior), boundary = RowSubset::of(u_ghosts.rows.boundary);
+  std::vector<double> theta, p;
+  std::int64_t broken = dilatation_sweep(k, br, theta, p, interior);
+  u_ghosts.wait();
+  broken += dilatation_sweep(k, br, theta, p, boundary);
+  // P_j of the ghosts, after their owners broke their rows: both ends of a crossing bond broke it
+  // in this sweep (the same stretch from exact copies of u), so P_j is the serial one.
+  d.begin_update_ghosts(p);
+  force_sweep(k, theta, p, f, w, interior);
+  d.end_update_ghosts(p);
+  force_sweep(k, theta, p, f, w, boundary);
+  return broken;
 }
 
 Breaking breaking_of(Model& m, double* lost) {
@@ -268,6 +297,26 @@ BreakReport LpsModel::break_bonds_and_add_force(Model& model, const Vec3Array& u
   }
   if (r.broken > 0)
     r.energy += exact_sum(lost);  // exact (core/exact_sum.hpp): the same for any thread and rank count
+  return r;
+}
+
+void LpsModel::add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                    const GhostsInFlight& u_ghosts) const {
+  if (!decomposed_) return BondModel::add_force_overlapped(model, u, f, w, u_ghosts);
+  overlapped_sweeps(LpsKernel(*this, model, u), nullptr, *decomposed_, u_ghosts, f, w);
+}
+
+BreakReport LpsModel::break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                           bool want_energy, double* lost_per_node,
+                                                           const GhostsInFlight& u_ghosts) const {
+  // The shares of the lost energy stay per node (lost_per_node): a split sweep gives no whole sum.
+  if (!decomposed_ || !lost_per_node || !want_energy)
+    return BondModel::break_bonds_and_add_force_overlapped(model, u, f, w, want_energy, lost_per_node, u_ghosts);
+  std::fill(lost_per_node, lost_per_node + model.nodes.size(), 0.0);
+  const Breaking br = breaking_of(model, lost_per_node);
+  BreakReport r;
+  r.broken = overlapped_sweeps(LpsKernel(*this, model, u), model.material.can_break() ? &br : nullptr, *decomposed_,
+                               u_ghosts, f, w);
   return r;
 }
 

@@ -56,11 +56,15 @@ struct PmbBreaking {
 // bonds broken now, each counted once (0 without breaking).
 // Bonds are summed in row order in fixed-size chunks, so the sums are the same for any thread
 // count and any vector width the compiler picks (docs/performance.md).
+// rows: the rows swept (every row by default); the others' f, w and lost are not touched. A row's
+// values do not depend on which others are swept, so sweeping a piece's interior rows and then its
+// boundary rows gives every row the bits of one sweep (parallel/row_split.hpp).
 std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w = nullptr,
-                                   const PmbBreaking* breaking = nullptr);
+                                   const PmbBreaking* breaking = nullptr, RowSubset rows = {});
 
-// f += the PMB force density at u (add_pmb_force_density over the model's arrays).
-void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* energy_density = nullptr);
+// f += the PMB force density at u (add_pmb_force_density over the model's arrays), over `rows`.
+void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* energy_density = nullptr,
+                   RowSubset rows = {});
 
 // After the state update: every intact bond whose stretch exceeds s0 of its block pair breaks for
 // good, unless an end is in a no-fail set. The stretch is computed from y_j − y_i, which is the
@@ -76,9 +80,10 @@ std::int64_t update_broken_bonds(Model& model, const Vec3Array& u, double* energ
 // integrators take after each state update; bitwise the same flags, forces, W and energy).
 // lost_per_node (size = nodes): the per-node energies of the bonds broken now are left there, and
 // broken_energy is not touched (a decomposed run sums them over the ranks, operator/force_operator).
+// rows: the rows swept (every row by default), as add_pmb_force_density.
 std::int64_t break_bonds_and_add_pmb_force(Model& model, const Vec3Array& u, Vec3Array& f,
                                            double* energy_density = nullptr, double* broken_energy = nullptr,
-                                           double* lost_per_node = nullptr);
+                                           double* lost_per_node = nullptr, RowSubset rows = {});
 
 // True when the model breaks bonds by LAMMPS peri/pmb's rules (Model::break_after_force, or a
 // per-node critical stretch: some α > 0); then break_bonds_lammps_rules is the breaking pass.
@@ -123,6 +128,14 @@ class PmbModel : public BondModel {
   void add_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* w) const override;
   BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                         bool want_energy, double* lost_per_node = nullptr) const override;
+  // The interior rows while u's ghosts travel, then the boundary rows (parallel/row_split.hpp).
+  // LAMMPS's rules (uses_lammps_rules) keep the plain order: their pass ends by replacing every
+  // node's s0 at once, after all rows have read the old one.
+  void add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                            const GhostsInFlight& u_ghosts) const override;
+  BreakReport break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                   bool want_energy, double* lost_per_node,
+                                                   const GhostsInFlight& u_ghosts) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override { return bond_damage(model); }
@@ -135,6 +148,8 @@ class PmbModel : public BondModel {
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
+  void add_jacobian_product_overlapped(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                       const GhostsInFlight& x_ghosts) const override;
   bool bond_tangent_row(const Model& model, const Vec3Array& u, std::size_t i, double* blocks,
                         bool definite = false) const override;
 };

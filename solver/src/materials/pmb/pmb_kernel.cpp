@@ -183,11 +183,13 @@ RowSums pmb_row_of(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
 }  // namespace
 
 std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, double* f2, double* w,
-                                   const PmbBreaking* breaking) {
+                                   const PmbBreaking* breaking, RowSubset rows) {
   std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
   const double* s0_pair = breaking ? breaking->s0_pair : nullptr;
+  const std::int64_t count = rows.size(a.nodes);
 #pragma omp parallel for schedule(static) reduction(+ : newly)
-  for (std::int64_t i = 0; i < a.nodes; ++i) {
+  for (std::int64_t r = 0; r < count; ++r) {
+    const std::int64_t i = rows.at(r);
     const bool test_breaking = breaking != nullptr && breaking->no_fail[i] == 0;
     RowSums r = test_breaking ? pmb_row_of<true>(a, i, s0_pair) : pmb_row_of<false>(a, i, s0_pair);
     if (r.over > 0) {  // rare: near a crack tip or a no-fail set
@@ -207,8 +209,8 @@ std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, d
   return newly;
 }
 
-void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* energy_density) {
-  add_pmb_force_density(pmb_arrays(model, u), f[0].data(), f[1].data(), f[2].data(), energy_density);
+void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double* energy_density, RowSubset rows) {
+  add_pmb_force_density(pmb_arrays(model, u), f[0].data(), f[1].data(), f[2].data(), energy_density, nullptr, rows);
 }
 
 namespace {
@@ -234,19 +236,19 @@ std::int64_t update_broken_bonds(Model& m, const Vec3Array& u, double* energy) {
 }
 
 std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Array& f, double* energy_density,
-                                           double* broken_energy, double* lost_per_node) {
+                                           double* broken_energy, double* lost_per_node, RowSubset rows) {
   const PmbArrays a = pmb_arrays(m, u);
   if (!m.material.can_break()) {
-    add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density);
+    add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, nullptr, rows);
     return 0;
   }
   if (lost_per_node) {
     const PmbBreaking br = pmb_breaking(m, lost_per_node);
-    return add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br);
+    return add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br, rows);
   }
   std::vector<double> lost(broken_energy ? static_cast<std::size_t>(a.nodes) : 0, 0.0);
   const PmbBreaking br = pmb_breaking(m, broken_energy ? lost.data() : nullptr);
-  const std::int64_t newly = add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br);
+  const std::int64_t newly = add_pmb_force_density(a, f[0].data(), f[1].data(), f[2].data(), energy_density, &br, rows);
   if (broken_energy && newly > 0)
     *broken_energy += exact_sum(lost);  // exact, as update_broken_bonds
   return newly;

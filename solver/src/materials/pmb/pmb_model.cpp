@@ -21,6 +21,29 @@ BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u
   return r;
 }
 
+void PmbModel::add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                    const GhostsInFlight& u_ghosts) const {
+  add_pmb_force(model, u, f, w, RowSubset::of(u_ghosts.rows.interior));
+  u_ghosts.wait();
+  add_pmb_force(model, u, f, w, RowSubset::of(u_ghosts.rows.boundary));
+}
+
+BreakReport PmbModel::break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
+                                                           bool want_energy, double* lost_per_node,
+                                                           const GhostsInFlight& u_ghosts) const {
+  // Without lost_per_node the energy of the broken bonds is summed over every row at once:
+  // not a split sweep's (a decomposed run always passes it, operator/force_operator).
+  if (uses_lammps_rules(model) || !lost_per_node)
+    return BondModel::break_bonds_and_add_force_overlapped(model, u, f, w, want_energy, lost_per_node, u_ghosts);
+  // A row breaks only its own copies of its bonds (both copies of a crossing bond see the same
+  // stretch), so the interior rows may break theirs before the boundary rows have u's ghosts.
+  BreakReport r;
+  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, RowSubset::of(u_ghosts.rows.interior));
+  u_ghosts.wait();
+  r.broken += break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, RowSubset::of(u_ghosts.rows.boundary));
+  return r;
+}
+
 BreakReport PmbModel::break_bonds(Model& model, const Vec3Array& u, bool want_energy) const {
   BreakReport r;
   if (uses_lammps_rules(model)) r.broken = break_bonds_lammps_rules(model, u, nullptr, nullptr, want_energy ? &r.energy : nullptr);
@@ -124,13 +147,16 @@ inline void bond_block(double c_vj, double length, double e0, double e1, double 
 
 }  // namespace
 
-void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
-  const auto n = static_cast<std::int64_t>(m.nodes.size());
+namespace {
+
+// y += J(u)·x over `rows` (every row by default; parallel/row_split.hpp).
+void add_jacobian_rows(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y, RowSubset rows) {
+  const std::int64_t count = rows.size(static_cast<std::int64_t>(m.nodes.size()));
   const auto nb = static_cast<std::size_t>(m.material.blocks);
   const auto& X = m.nodes.x;
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i64 = 0; i64 < n; ++i64) {
-    const auto i = static_cast<std::size_t>(i64);
+  for (std::int64_t r = 0; r < count; ++r) {
+    const auto i = static_cast<std::size_t>(rows.at(r));
     const std::size_t bi = static_cast<std::size_t>(m.block_index[i]);
     const double yi0 = X[0][i] + u[0][i], yi1 = X[1][i] + u[1][i], yi2 = X[2][i] + u[2][i];
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;  // in bond order: the same for any thread count
@@ -153,6 +179,19 @@ void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Ve
     y[1][i] += s1;
     y[2][i] += s2;
   }
+}
+
+}  // namespace
+
+void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  add_jacobian_rows(m, u, x, y, RowSubset{});
+}
+
+void PmbModel::add_jacobian_product_overlapped(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                               const GhostsInFlight& x_ghosts) const {
+  add_jacobian_rows(m, u, x, y, RowSubset::of(x_ghosts.rows.interior));
+  x_ghosts.wait();
+  add_jacobian_rows(m, u, x, y, RowSubset::of(x_ghosts.rows.boundary));
 }
 
 bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t i, double* blocks,

@@ -1,0 +1,75 @@
+// Why a rank's rows are split in two: the halo exchange overlapped with the bond sweep (issue 15).
+//
+// A decomposed force evaluation needs its ghosts' values (u; LPS's P_j between its two sweeps) from
+// their owners. An owned row whose bond partners are all owned reads no ghost, so it can be swept
+// while those values are still on their way:
+//
+//   begin the exchange (MPI_Irecv / MPI_Isend, parallel/halo)
+//   sweep the interior rows   (every partner owned: no ghost read)
+//   wait for the exchange     (the ghosts now hold their owners' values)
+//   sweep the boundary rows   (at least one partner is a ghost)
+//
+// Each row is still summed alone, in bond order, from the same values, and no row of a sweep reads
+// another row's result of that sweep, so the result is bitwise the blocking exchange's (and the
+// serial run's): only the order in which the rows are visited changes. On a brick cut into slabs
+// the interior rows are most of a piece (its volume), the boundary rows a layer δ thick at each cut
+// (its surface), so most of the sweep hides the messages.
+//
+// The split depends only on the rows' neighbour lists — broken bonds count too: a broken bond still
+// reads its partner's u (its term is multiplied by 0, and a stale or NaN u would spoil that) — and
+// those never change during a run (a piece's rows are made once, parallel/local_model), so it is
+// made once per piece (parallel/mpi_decomposed). Pure bookkeeping, no MPI.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace pd {
+
+struct LocalPiece;
+
+struct RowSplit {
+  std::vector<std::int32_t> interior;  // owned rows whose bond partners are all owned, ascending
+  std::vector<std::int32_t> boundary;  // owned rows with at least one ghost partner, ascending
+};
+
+// The split of the piece's owned rows (above): every owned row in exactly one of the two lists.
+RowSplit split_rows(const LocalPiece& piece);
+
+// The rows a sweep visits: every row 0 … nodes − 1 (the default: the serial sweep, unchanged), or
+// row[0 … count) (of: a list, perhaps empty — a piece without ghosts has no boundary rows).
+struct RowSubset {
+  bool every = true;
+  const std::int32_t* row = nullptr;
+  std::int64_t count = 0;
+  static RowSubset of(const std::vector<std::int32_t>& rows) {
+    return RowSubset{false, rows.data(), static_cast<std::int64_t>(rows.size())};
+  }
+  std::int64_t size(std::int64_t nodes) const { return every ? nodes : count; }
+  std::int64_t at(std::int64_t r) const { return every ? r : row[r]; }
+};
+
+// An array's ghost values still on their way (Decomposed::begin_update_ghosts): what a law's
+// overlapped sweep (materials/bond_model.hpp) gets. It sweeps rows.interior, calls wait(), which
+// returns once every ghost entry holds its owner's value, then sweeps rows.boundary. wait() ends
+// the exchange once; later calls do nothing, so the operator calls it again after the law, for a
+// law that did not need to.
+class GhostsInFlight {
+ public:
+  GhostsInFlight(const RowSplit& split, std::function<void()> end) : rows(split), end_(std::move(end)) {}
+  GhostsInFlight(const GhostsInFlight&) = delete;
+  GhostsInFlight& operator=(const GhostsInFlight&) = delete;
+  const RowSplit& rows;
+  void wait() const {
+    if (waited_) return;
+    waited_ = true;
+    end_();
+  }
+  bool waited() const { return waited_; }
+
+ private:
+  std::function<void()> end_;
+  mutable bool waited_ = false;
+};
+
+}  // namespace pd
