@@ -28,6 +28,9 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& global)
   piece_ = make_local_piece(global, decomposition_.owner, rank_);
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
+  // The Morton order served the cut only (8 bytes a node of the whole cloud); the owners stay (the
+  // contact ghosts' halo asks them).
+  std::vector<std::int64_t>().swap(decomposition_.order);
 }
 
 MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks)
@@ -44,6 +47,9 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
   }
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
+  // The Morton order served the cut only (8 bytes a node of the whole cloud); the owners stay (the
+  // contact ghosts' halo asks them).
+  std::vector<std::int64_t>().swap(decomposition_.order);
   // LAMMPS's s0 at rest: the owned rows give the owned nodes' (the serial values: the same rows),
   // and the ghosts take their owners' (a ghost's row is empty here).
   if (skeleton.material.node_rule()) {
