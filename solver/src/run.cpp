@@ -85,9 +85,6 @@ int run(const RunOptions& opt) {
   // Output starts here. open_output refuses a restart whose history.csv or frames do not match the
   // checkpoint (bad input, exit 1, before it changes a file); a full disk there is a failed run.
   const HistoryColumns columns(p.model, p.c, p.integrator.get(), &p.op->model().contact_list);
-  // The whole cloud's per-node arrays on a rank that writes nothing and holds only its rows: no
-  // longer needed (issue 15; run/prepare.hpp).
-  release_whole_node_data(p);
   try {
     const std::unique_ptr<OutputWriter> out = open_output_on_ranks(opt, p, s, columns);
     return run_with_output(opt, p, s, columns, out.get());

@@ -2,6 +2,9 @@
 #include "run/prepare.hpp"
 
 #include <omp.h>
+#ifdef __GLIBC__
+#include <malloc.h>  // malloc_trim
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -152,10 +155,21 @@ std::int64_t node_data_bytes(const Model& m) {
   return bytes;
 }
 
+namespace {
+
+// Whether this rank may free the whole cloud's per-node arrays: rank 0 reads the whole model for
+// the output (frames, history's reactions, checkpoints, node positions in messages); a rank that
+// keeps the whole bond list keeps its nodes with it (the features that need it read both).
+bool frees_whole_node_data(const Prepared& p) { return p.decomposed && !p.whole_bonds && !p.writes_output(); }
+
+}  // namespace
+
+void release_whole_rows_offsets(Prepared& p) {
+  if (frees_whole_node_data(p)) release(p.model.bonds.offsets);  // Prepared::directed keeps the count
+}
+
 void release_whole_node_data(Prepared& p) {
-  // Rank 0 reads the whole model for the output (frames, history's reactions, checkpoints, node
-  // positions in messages); a rank that keeps the whole bond list keeps its nodes with it.
-  if (!p.decomposed || p.whole_bonds || p.writes_output()) return;
+  if (!frees_whole_node_data(p)) return;
   Model& m = p.model;
   for (auto& x : m.nodes.x) release(x);
   release(m.nodes.volume);
@@ -164,10 +178,15 @@ void release_whole_node_data(Prepared& p) {
   release(m.density);
   release(m.block_index);
   release(m.no_fail);
-  release(m.bonds.offsets);  // Prepared::directed keeps the count
   for (auto& pm : m.conditions.prescribed) release(pm.nodes);
   for (auto& bf : m.conditions.body_forces) release(bf.nodes);
   for (auto& fixed : m.conditions.fixed) release(fixed);
+  // Freed heap pages inside the heap stay resident until reused or trimmed: hand them back now, so
+  // that they do not add to the peak while the operator, the integrator and the state are made
+  // (glibc; measured in docs/performance.md §7).
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
   // LAMMPS's s0 stays: a checkpoint's gather is collective and every rank decides by its emptiness
   // (run/loop.cpp write_restart); 8 bytes a node, and only with the α rule.
 }
@@ -220,6 +239,8 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
       p->dt_stable = p->decomposed->minimum(stable_time_step(p->decomposed->piece().model));
       p->dt = explicit_time_step(c, p->dt_stable, [&p] { return p->exact_limit(); });
     }
+    // Before the operator, the integrator and the state are made, so that they do not add to it.
+    release_whole_node_data(*p);
   }
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());

@@ -81,10 +81,12 @@ std::unique_ptr<Prepared> prepare(const RunOptions& options);
 // LAMMPS's s0), by their vectors' capacities; and the same of a piece's model (parallel/local_model).
 std::int64_t node_data_bytes(const Model& model);
 // On a decomposed run whose ranks hold only their own rows, a rank that writes no output (not rank
-// 0) needs none of the whole cloud's per-node arrays once its piece is cut and its state made: they
-// are freed (issue 15: what a rank holds then falls as 1/R). Call after start_or_restore and after
-// every reader of the whole model's sets (HistoryColumns). Does nothing elsewhere.
+// 0) needs none of the whole cloud's per-node arrays once its piece is cut: prepare() frees them
+// there, before the operator, the integrator and the state are made (issue 15). Does nothing
+// elsewhere. The rows' offsets stay until start_or_restore has taken a checkpoint's broken flags,
+// which are in the whole list's order; release_whole_rows_offsets frees them then.
 void release_whole_node_data(Prepared& p);
+void release_whole_rows_offsets(Prepared& p);
 
 // run.log's first line: the version and the case.
 void log_title(RunLog& log, const RunOptions& options, const Prepared& p);

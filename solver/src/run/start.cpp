@@ -145,6 +145,7 @@ Start start_or_restore(const RunOptions& opt, Prepared& p) {
     s.loop.dt = p.dt;
     s.loop.broken = broken_bonds(p);
   }
+  release_whole_rows_offsets(p);  // a restart's flags were taken by the rows of the whole list
   if (first_non_finite(s.state) >= 0)
     throw Error((s.restarting ? opt.restart.string() + ": the checkpoint's state" : p.c.file.string() + ": the initial state") +
                 " is not finite");
