@@ -50,9 +50,6 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
   }
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
-  // The Morton order served the cut only (8 bytes a node of the whole cloud); the owners stay (the
-  // contact ghosts' halo asks them).
-  std::vector<std::int64_t>().swap(decomposition_.order);
   // LAMMPS's s0 at rest: the owned rows give the owned nodes' (the serial values: the same rows),
   // and the ghosts take their owners' (a ghost's row is empty here).
   if (skeleton.material.node_rule()) {

@@ -23,8 +23,8 @@ struct Prepared {
   // decomposition and the piece are cut from it); its bond list only when whole_bonds
   // (whole_bonds_reason() in prepare.cpp says why), else just the rows' offsets — each rank built
   // only its owned rows, in decomposed->piece() (issue 15). A rank that writes no output and holds
-  // only its rows frees the per-node arrays once its piece and state are made
-  // (release_whole_node_data): then only the scalars and the per-block data stay here.
+  // only its rows frees the per-node arrays once its piece is cut (release_whole_node_data): then
+  // only the scalars, the per-block data and the sets' and conditions' names stay here.
   Model model;
   bool whole_bonds = true;
   std::int64_t nodes = 0;  // nodes of the whole model, held or not
