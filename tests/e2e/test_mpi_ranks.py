@@ -213,6 +213,33 @@ def test_each_rank_holds_the_rows_of_its_own_nodes_only(runs):
         assert "each rank built only the rows of its own nodes" in line
 
 
+def node_data_held(log):
+    """run.log's bytes of per-node data each rank holds after set-up: (whole cloud's, piece's) per rank."""
+    line = re.search(r"^node data held per rank after set-up \(bytes: the whole cloud's arrays \+ the piece's\):(.*)$",
+                     log, re.M)
+    assert line, log
+    return [(int(w), int(p)) for w, p in re.findall(r"rank \d+ (\d+) \+ (\d+)", line.group(1))]
+
+
+def test_only_rank_0_keeps_the_whole_clouds_node_data(runs):
+    """Ranks other than 0 free the whole cloud's per-node arrays once their piece is cut (issue 15:
+    positions, volumes, blocks, sets, densities, conditions, the rows' offsets); rank 0 keeps them
+    for the gathered output. What a rank other than 0 then holds is its piece's, which falls with R
+    (before, every rank held the whole cloud's arrays: each held at least rank 0's bytes)."""
+    nodes = int(re.search(r"^nodes (\d+),", (runs["np2"] / "run.log").read_text(), re.M).group(1))
+    held = {name: node_data_held((runs[name] / "run.log").read_text()) for name in ("np2", "np3", "np2t2")}
+    whole = held["np2"][0][0]
+    # x, y, z, volume, density (8 bytes each), block, block index (4), no-fail (1), offsets (8 per node + 8).
+    assert whole >= 57 * nodes, held
+    for name, ranks in (("np2", 2), ("np3", 3), ("np2t2", 2)):
+        assert len(held[name]) == ranks, held
+        assert held[name][0][0] == whole, held  # rank 0 writes the output from the whole cloud
+        assert all(w == 0 for w, _ in held[name][1:]), held
+        # A piece is its owned nodes and their ghosts (3 layers each side on this coarse plate).
+        assert all(0 < piece < 0.6 * whole for _, piece in held[name]), held
+    assert max(p for _, p in held["np3"]) < max(p for _, p in held["np2"]), held
+
+
 def test_a_feature_that_reads_whole_rows_keeps_the_whole_list_and_says_so(variant_runs):
     """LPS (its per-node constants), the adaptive step's default dt_max and dt: exact (the exact limit's
     Lanczos on the whole model) keep the whole bond list on every rank, and run.log says which."""

@@ -14,7 +14,7 @@ namespace pd {
 struct Decomposition {
   int ranks = 1;
   std::vector<std::int32_t> owner;        // rank per node
-  std::vector<std::int64_t> order;        // the nodes along the Morton curve
+  std::vector<std::int64_t> order;        // the nodes along the Morton curve (MpiDecomposed frees it after the cut)
   std::vector<std::int64_t> piece_start;  // piece r = order[piece_start[r], piece_start[r+1])
   std::vector<std::int64_t> piece_work;   // Σ (1 + bonds in the row) over piece r's nodes
 };

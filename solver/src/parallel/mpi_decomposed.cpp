@@ -29,11 +29,17 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& global)
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   row_split_ = split_rows(piece_);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
+  // The Morton order served the cut only (8 bytes a node of the whole cloud); the owners stay (the
+  // contact ghosts' halo asks them).
+  std::vector<std::int64_t>().swap(decomposition_.order);
 }
 
 MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks)
     : comm_(comm), decomposition_(decompose(skeleton.nodes.x, skeleton.bonds.offsets, size_of(comm), skeleton.horizon)) {
   MPI_Comm_rank(comm, &rank_);
+  // The Morton order served the cut only (8 bytes a node of the whole cloud): freed before the rows
+  // are built, where a rank's memory peaks. The owners stay (the halos ask them).
+  std::vector<std::int64_t>().swap(decomposition_.order);
   std::vector<std::int32_t> rows;  // the owned nodes, ascending
   for (std::size_t i = 0; i < decomposition_.owner.size(); ++i)
     if (decomposition_.owner[i] == rank_) rows.push_back(static_cast<std::int32_t>(i));

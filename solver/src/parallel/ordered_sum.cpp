@@ -39,6 +39,10 @@ OrderedSum::OrderedSum(MPI_Comm comm, const LocalPiece& piece)
               MPI_INT32_T, 0, comm);
   send_.resize(owned_local_.size());
   if (rank_ == 0) received_.resize(static_cast<std::size_t>(global_nodes_));
+  // The whole model's directed bonds, the sum of the owned rows' (a ghost's row is empty): every rank
+  // knows it without the whole rows' offsets, which only rank 0 keeps (run/prepare.hpp).
+  std::int64_t owned_bonds = piece.model.bonds.directed();
+  MPI_Allreduce(&owned_bonds, &directed_bonds_, 1, MPI_INT64_T, MPI_SUM, comm);
 }
 
 std::vector<double> OrderedSum::gather(const std::vector<double>& per_node) const {
@@ -85,7 +89,7 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node, int 
 }
 
 void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
-  check_gather_size(global.offsets.back(), "directed bonds' broken flags");  // every rank holds the offsets
+  check_gather_size(directed_bonds_, "directed bonds' broken flags");  // the same on every rank
   const double start = MPI_Wtime();
   std::vector<std::uint8_t> flags;
   for (std::int32_t l : owned_local_)

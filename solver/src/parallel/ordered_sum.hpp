@@ -38,6 +38,7 @@ class OrderedSum {
   MPI_Comm comm_;
   int rank_ = 0;
   std::int64_t global_nodes_ = 0;
+  std::int64_t directed_bonds_ = 0;  // of the whole model: the owned rows' summed over the ranks
   std::vector<std::int32_t> owned_local_;
   int ranks_ = 1;
   std::vector<int> counts_, starts_;        // rank 0: per rank, its owned count and offset

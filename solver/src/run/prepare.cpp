@@ -2,12 +2,16 @@
 #include "run/prepare.hpp"
 
 #include <omp.h>
+#ifdef __GLIBC__
+#include <malloc.h>  // malloc_trim
+#endif
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/error.hpp"
@@ -125,6 +129,68 @@ double Prepared::exact_limit() {
   return dt_exact;
 }
 
+namespace {
+
+template <class T>
+std::int64_t bytes_of(const std::vector<T>& a) {
+  return static_cast<std::int64_t>(a.capacity() * sizeof(T));
+}
+
+template <class T>
+void release(std::vector<T>& a) {
+  std::vector<T>().swap(a);  // clear() keeps the capacity
+}
+
+}  // namespace
+
+std::int64_t node_data_bytes(const Model& m) {
+  std::int64_t bytes = bytes_of(m.nodes.volume) + bytes_of(m.nodes.block) + bytes_of(m.density) +
+                       bytes_of(m.block_index) + bytes_of(m.no_fail) + bytes_of(m.bonds.offsets) +
+                       bytes_of(m.node_critical_stretch);
+  for (const auto& x : m.nodes.x) bytes += bytes_of(x);
+  for (const auto& set : m.nodes.sets) bytes += bytes_of(set.member);
+  for (const auto& pm : m.conditions.prescribed) bytes += bytes_of(pm.nodes);
+  for (const auto& bf : m.conditions.body_forces) bytes += bytes_of(bf.nodes);
+  for (const auto& fixed : m.conditions.fixed) bytes += bytes_of(fixed);
+  return bytes;
+}
+
+namespace {
+
+// Whether this rank may free the whole cloud's per-node arrays: rank 0 reads the whole model for
+// the output (frames, history's reactions, checkpoints, node positions in messages); a rank that
+// keeps the whole bond list keeps its nodes with it (the features that need it read both).
+bool frees_whole_node_data(const Prepared& p) { return p.decomposed && !p.whole_bonds && !p.writes_output(); }
+
+}  // namespace
+
+void release_whole_rows_offsets(Prepared& p) {
+  if (frees_whole_node_data(p)) release(p.model.bonds.offsets);  // Prepared::directed keeps the count
+}
+
+void release_whole_node_data(Prepared& p) {
+  if (!frees_whole_node_data(p)) return;
+  Model& m = p.model;
+  for (auto& x : m.nodes.x) release(x);
+  release(m.nodes.volume);
+  release(m.nodes.block);
+  for (auto& set : m.nodes.sets) release(set.member);  // the names stay
+  release(m.density);
+  release(m.block_index);
+  release(m.no_fail);
+  for (auto& pm : m.conditions.prescribed) release(pm.nodes);
+  for (auto& bf : m.conditions.body_forces) release(bf.nodes);
+  for (auto& fixed : m.conditions.fixed) release(fixed);
+  // Freed heap pages inside the heap stay resident until reused or trimmed: hand them back now, so
+  // that they do not add to the peak while the operator, the integrator and the state are made
+  // (glibc; measured in docs/performance.md §7).
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+  // LAMMPS's s0 stays: a checkpoint's gather is collective and every rank decides by its emptiness
+  // (run/loop.cpp write_restart); 8 bytes a node, and only with the α rule.
+}
+
 std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   auto p = std::make_unique<Prepared>();
   Case& c = p->c;
@@ -153,6 +219,9 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
       p->model.node_critical_stretch.assign(p->model.nodes.size(), std::numeric_limits<double>::infinity());
   }
   p->build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
+  p->nodes = static_cast<std::int64_t>(p->model.nodes.size());
+  p->directed = p->model.bonds.offsets.empty() ? 0 : p->model.bonds.offsets.back();
+  std::tie(p->isolated, p->first_isolated) = isolated_nodes(p->model);
   check_materials(*p);
 
   if (p->whole_bonds) choose_dt(*p);
@@ -170,6 +239,8 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
       p->dt_stable = p->decomposed->minimum(stable_time_step(p->decomposed->piece().model));
       p->dt = explicit_time_step(c, p->dt_stable, [&p] { return p->exact_limit(); });
     }
+    // Before the operator, the integrator and the state are made, so that they do not add to it.
+    release_whole_node_data(*p);
   }
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
@@ -209,7 +280,7 @@ void log_title(RunLog& log, const RunOptions& opt, const Prepared& p) {
 void log_setup(RunLog& log, const Prepared& p) {
   const Case& c = p.c;
   const Model& model = p.model;
-  const std::size_t n = model.nodes.size();
+  const auto n = static_cast<std::size_t>(p.nodes);
   log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(p.directed_bonds() / 2) + " (" +
            format("%.1f", static_cast<double>(p.directed_bonds()) / static_cast<double>(n)) +
            " per node), built in " + format("%.3f", p.build_seconds) + " s");
@@ -227,10 +298,10 @@ void log_setup(RunLog& log, const Prepared& p) {
                                         : "fixed; stable " + format("%.6g", p.dt_stable) + " s") +
            (p.integrator->controls_step() ? ", the initial step" : "") +
            "), integrator " + p.integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
-  if (const auto [isolated, first] = isolated_nodes(model); isolated > 0)
-    log.line("warning: " + std::to_string(isolated) + " of " + std::to_string(n) +
+  if (p.isolated > 0 && p.writes_output())  // node_text reads the whole positions, which rank 0 keeps
+    log.line("warning: " + std::to_string(p.isolated) + " of " + std::to_string(n) +
              " nodes have no bond within the horizon (isolated: only loads and contact act on them); the first is " +
-             node_text(model, first));
+             node_text(model, p.first_isolated));
   for (const auto& text : p.step_warnings) log.line(text);
   for (const auto& text : work_summary(*p.op, c)) log.line(text);
   if (p.decomposed) {
@@ -245,7 +316,15 @@ void log_setup(RunLog& log, const Prepared& p) {
     std::string text = "directed bonds held per rank (of " + std::to_string(p.directed_bonds()) + "):";
     for (std::size_t r = 0; r < held.size(); ++r) text += " rank " + std::to_string(r) + " " + format("%.0f", held[r]) + (r + 1 < held.size() ? "," : "");
     log.line(text + (p.whole_bonds ? "; every rank holds the whole bond list too, for " + whole_bonds_reason(c)
-                                   : "; each rank built only the rows of its own nodes (the node data of the whole cloud: on every rank)"));
+                                   : "; each rank built only the rows of its own nodes"));
+    // What each rank holds of the per-node data after set-up: the whole cloud's arrays (rank 0, which
+    // writes the output, and every rank that keeps the whole bond list) and its piece's.
+    const std::vector<double> whole = d.per_rank(static_cast<double>(node_data_bytes(model)));
+    const std::vector<double> own = d.per_rank(static_cast<double>(node_data_bytes(d.piece().model)));
+    text = "node data held per rank after set-up (bytes: the whole cloud's arrays + the piece's):";
+    for (std::size_t r = 0; r < whole.size(); ++r)
+      text += " rank " + std::to_string(r) + " " + format("%.0f", whole[r]) + " + " + format("%.0f", own[r]) + (r + 1 < whole.size() ? "," : "");
+    log.line(text);
   }
   if (p.indenter_watch)
     for (const auto& ind : model.indenters) {

@@ -19,13 +19,21 @@ namespace pd {
 struct Prepared {
   Case c;
   int threads = 0;  // OpenMP's, after --threads
-  // The whole model. On a decomposed run every rank holds its per-node data (output and run.log
-  // read it); its bond list only when whole_bonds (whole_bonds_reason() in prepare.cpp says why), else just the
-  // rows' offsets — each rank built only its owned rows, in decomposed->piece() (issue 15).
+  // The whole model. On a decomposed run every rank holds its per-node data while it sets up (the
+  // decomposition and the piece are cut from it); its bond list only when whole_bonds
+  // (whole_bonds_reason() in prepare.cpp says why), else just the rows' offsets — each rank built
+  // only its owned rows, in decomposed->piece() (issue 15). A rank that writes no output and holds
+  // only its rows frees the per-node arrays once its piece is cut (release_whole_node_data): then
+  // only the scalars, the per-block data and the sets' and conditions' names stay here.
   Model model;
   bool whole_bonds = true;
+  std::int64_t nodes = 0;  // nodes of the whole model, held or not
   // Directed bonds of the whole model (each bond twice), held or not.
-  std::int64_t directed_bonds() const { return model.bonds.offsets.empty() ? 0 : model.bonds.offsets.back(); }
+  std::int64_t directed = 0;
+  std::int64_t directed_bonds() const { return directed; }
+  // Nodes without a bond (run.log's warning), counted before the whole rows' offsets may go: the
+  // count and the first one, −1 if none.
+  std::int64_t isolated = 0, first_isolated = -1;
   // A run on several MPI ranks (issue 15): this rank's piece, its ghosts and the exact sums; the
   // operator then works on the piece's model. Null on one rank: the serial path.
   std::unique_ptr<Decomposed> decomposed;
@@ -67,6 +75,18 @@ std::string whole_bonds_reason(const Case& c);
 
 // Throws pd::Error for bad input (naming the file), before anything is written.
 std::unique_ptr<Prepared> prepare(const RunOptions& options);
+
+// Bytes of the whole cloud's per-node arrays that p.model holds (positions, volumes, blocks, sets,
+// densities, block indices, no-fail flags, the rows' offsets, conditions' node lists and flags,
+// LAMMPS's s0), by their vectors' capacities; and the same of a piece's model (parallel/local_model).
+std::int64_t node_data_bytes(const Model& model);
+// On a decomposed run whose ranks hold only their own rows, a rank that writes no output (not rank
+// 0) needs none of the whole cloud's per-node arrays once its piece is cut: prepare() frees them
+// there, before the operator, the integrator and the state are made (issue 15). Does nothing
+// elsewhere. The rows' offsets stay until start_or_restore has taken a checkpoint's broken flags,
+// which are in the whole list's order; release_whole_rows_offsets frees them then.
+void release_whole_node_data(Prepared& p);
+void release_whole_rows_offsets(Prepared& p);
 
 // run.log's first line: the version and the case.
 void log_title(RunLog& log, const RunOptions& options, const Prepared& p);

@@ -63,7 +63,7 @@ void restore_piece(Prepared& p, State& whole, Start& s) {
 void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
   Integrator& integrator = *p.integrator;
-  const std::size_t n = model.nodes.size();
+  const auto n = static_cast<std::size_t>(p.nodes);
   Checkpoint checkpoint = read_checkpoint_on_ranks(opt, p.decomposed.get());
   const std::string where = opt.restart.string() + ": ";
   if (checkpoint.case_hash != s.case_hash)
@@ -118,7 +118,9 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
 
 Start start_or_restore(const RunOptions& opt, Prepared& p) {
   Start s;
-  s.state = State(p.model.nodes.size());
+  // A decomposed run's state is its piece's (owned nodes and ghosts): the whole cloud's state is
+  // never made on a rank, 80 bytes a node (issue 15). A restart sizes it in restore().
+  if (!p.decomposed) s.state = State(p.model.nodes.size());
   s.restarting = !opt.restart.empty();
   s.case_hash = file_hash(opt.case_file);
   s.nodes_hash = file_hash(p.c.nodes_file);
@@ -129,18 +131,21 @@ Start start_or_restore(const RunOptions& opt, Prepared& p) {
       throw start_over(opt, e);
     }
   } else {
-    apply_initial_conditions(p.c, p.model.nodes, s.state.u, s.state.v);
-    if (p.decomposed) {  // this rank's piece of the initial state; the operator works on the piece
+    // On a decomposed run, on the piece's nodes (owned and ghosts): a node's initial value depends
+    // only on its own position and set membership, which the piece holds as copies, so each entry
+    // is the whole cloud's, bit for bit. The operator works on the piece.
+    if (p.decomposed) {
       const LocalPiece& piece = p.decomposed->piece();
-      State local(piece.size());
-      local.u = to_local(piece, s.state.u);
-      local.v = to_local(piece, s.state.v);
-      s.state = std::move(local);
+      s.state = State(piece.size());
+      apply_initial_conditions(p.c, piece.model.nodes, s.state.u, s.state.v);
+    } else {
+      apply_initial_conditions(p.c, p.model.nodes, s.state.u, s.state.v);
     }
     p.integrator->initialize(s.state, 0.0);
     s.loop.dt = p.dt;
     s.loop.broken = broken_bonds(p);
   }
+  release_whole_rows_offsets(p);  // a restart's flags were taken by the rows of the whole list
   if (first_non_finite(s.state) >= 0)
     throw Error((s.restarting ? opt.restart.string() + ": the checkpoint's state" : p.c.file.string() + ": the initial state") +
                 " is not finite");
