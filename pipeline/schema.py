@@ -347,12 +347,6 @@ CASE = {
                          "(the crack arrested); back to quasi_static, the kinetic energy left is given up, as "
                          "damping work (implicit keeps it)",
                          default=200, minimum=1, maximum=1000000000),
-        pause_tries=Key("integer", "quasi_static start: once bonds have broken in the explicit phase and "
-                        "then none for the time a stress wave crosses a horizon (the crack has stopped "
-                        "running), one tentative load step is tried from the current state; if it "
-                        "finds equilibrium the load steps go on, else Verlet until the next pause. "
-                        "This many failed tries, then only the other rules; 0: never",
-                        default=3, minimum=0, maximum=1000000),
     ),
     "output": section(
         "what the solver writes and how often",

@@ -87,7 +87,6 @@ struct MixedSettings {
   int unstable_rounds = 3;         // re-solves at one load while bonds break, then explicit
   double kinetic_fraction = 0.05;  // back to quasi-static once kinetic < this × strain energy ...
   std::int64_t arrest_steps = 200;  // ... for this many explicit steps without a bond breaking
-  int pause_tries = 3;  // tentative load steps tried when a crack pauses (integrators/mixed.hpp); 0: none
 };
 
 struct OutputSettings {

@@ -42,7 +42,7 @@ void Mixed::configure(const Case& c, double dt_exact) {
 // without a Young's modulus in every block or with an implicit home.
 void Mixed::set_pause_steps() {
   pause_steps_ = 0;
-  if (home_ != kQuasiStatic || settings_.pause_tries == 0) return;
+  if (home_ != kQuasiStatic || pause_tries_ == 0) return;
   const Model& m = op_.model();
   double slowest = HUGE_VAL;
   for (const BlockMaterial& block : m.block_materials) {
@@ -51,11 +51,12 @@ void Mixed::set_pause_steps() {
     slowest = std::min(slowest, std::sqrt(*youngs / block.density));
   }
   if (!std::isfinite(slowest) || !(m.horizon > 0.0)) return;
+  // (less a round-off's worth, so that an exact ratio is not rounded up a step by its last bit)
   pause_steps_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(m.horizon / (slowest * dt_explicit_) - 1e-9)));
 }
 
 bool Mixed::crack_paused() const {
-  return pause_steps_ > 0 && cracked_ && quiet_steps_ >= pause_steps_ && pause_failures_ < settings_.pause_tries;
+  return pause_steps_ > 0 && cracked_ && quiet_steps_ >= pause_steps_ && pause_failures_ < pause_tries_;
 }
 
 void Mixed::initialize(State& state, double t) {
@@ -216,7 +217,7 @@ void Mixed::step(State& state, double& t, double& dt) {
         // The crack had not stopped, or the pieces hold what Newton cannot meet in a few iterations:
         // Verlet until bonds break and pause again (to_explicit), pause_tries failures in all.
         ++pause_failures_;
-        then = pause_failures_ < settings_.pause_tries ? "; the next try when the crack pauses again"
+        then = pause_failures_ < pause_tries_ ? "; the next try when the crack pauses again"
                                                        : "; no more tries on a pause of the crack";
       } else if (tentative) {
         separation_given_up_ = true;
@@ -361,7 +362,7 @@ std::vector<std::string> Mixed::describe(double dt_exact) const {
                        : "") +
                   (pause_steps_ > 0 ? "; and a tentative load step when the crack has stopped running (no bond broken for " +
                                           std::to_string(pause_steps_) + " steps, δ/c; at most " +
-                                          std::to_string(settings_.pause_tries) + " failed tries)"
+                                          std::to_string(pause_tries_) + " failed tries)"
                                     : ""));
   return lines;
 }

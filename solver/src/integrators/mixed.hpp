@@ -28,8 +28,8 @@
 //   (kTentativeIterations Newton iterations, no halving, and no more than unstable_rounds breaking
 //   rounds) from the current state at the current load. If it converges the crack is stable under
 //   the load and the load steps go on (the first kProbationSteps tentative); if not, the bonds it
-//   broke heal and Verlet goes on until the next pause. mixed.pause_tries failed tries, and the
-//   rule is given up. Why: the explicit phase is undamped, and after the crack has run its
+//   broke heal and Verlet goes on until the next pause. kPauseTries failed tries since the last load step past its probation, and the
+//   rule is given up until then. Why: the explicit phase is undamped, and after the crack has run its
 //   released energy rings in the pieces for ever; a slowly loaded test (the benchmark's reference:
 //   Verlet with ζ = 0.1 of light damping) loses that ringing to damping, and the pieces do not
 //   crack again. Measured on cases/traction at dx × 2 (docs/accuracy.md, "The pause rule"): without
@@ -103,6 +103,9 @@ class Mixed : public Integrator {
   // and the tentative returns on it that have failed so far.
   std::int64_t pause_steps() const { return pause_steps_; }
   int pause_failures() const { return pause_failures_; }
+  // Failed tries before the pause rule is given up (kPauseTries; 0 switches the rule off: the tests
+  // of the other rules). Before configure().
+  void set_pause_tries(int tries) { pause_tries_ = tries; }
   int factorisations_in_use() const { return home_ == kImplicit ? implicit_.factorisations() : static_.factorisations(); }
   Mode home() const { return home_; }  // mixed.start: the scheme away from a running crack
 
@@ -153,6 +156,8 @@ class Mixed : public Integrator {
   bool pause_return_ = false;
   bool pause_probation_ = false;
   int pause_failures_ = 0;
+  static constexpr int kPauseTries = 3;
+  int pause_tries_ = kPauseTries;
   // Sets the above from the model (configure).
   void set_pause_steps();
   // After an explicit step: whether the crack has paused long enough to try a load step.

@@ -421,8 +421,6 @@ MixedSettings read_mixed(const Checker& ck, const json& j) {
     if (!(m.kinetic_fraction < 1.0)) ck.fail("mixed.kinetic_fraction", "must be below 1 (a fraction of the strain energy), got " + show(*v));
   }
   if (const json* v = ck.optional(j, "arrest_steps")) m.arrest_steps = ck.integer(*v, "mixed.arrest_steps", 1, 1000000000);
-  if (const json* v = ck.optional(j, "pause_tries"))
-    m.pause_tries = static_cast<int>(ck.integer(*v, "mixed.pause_tries", 0, 1000000));
   return m;
 }
 
@@ -472,7 +470,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
                     "dt_min", "dt_max", "linear_solver", "cg_max_iterations"}},
-      {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps", "pause_tries"}},
+      {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
                   "restart_every_steps", "precision", "compression", "fields", "gmsh", "parallel_frames"}},

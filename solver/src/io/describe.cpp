@@ -165,7 +165,6 @@ json describe_case() {
   keys["mixed.unstable_rounds"] = defaulted("integer", mx.unstable_rounds, {{"minimum", 1}, {"maximum", 100000000}});
   keys["mixed.kinetic_fraction"] = defaulted("number", mx.kinetic_fraction, {{"above", 0.0}, {"below", 1.0}});
   keys["mixed.arrest_steps"] = defaulted("integer", mx.arrest_steps, {{"minimum", 1}, {"maximum", 1000000000}});
-  keys["mixed.pause_tries"] = defaulted("integer", mx.pause_tries, {{"minimum", 0}, {"maximum", 1000000}});
   keys["output"] = required("object", {{"note", "exactly one of every_time and every_steps"}});
   keys["output.every_time"] = defaulted("number", value_or_null(o.every_time), {{"above", 0.0}, {"unit", "s"}});
   keys["output.every_steps"] = defaulted("integer", value_or_null(o.every_steps), {{"minimum", 1}});
