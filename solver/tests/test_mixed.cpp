@@ -36,6 +36,10 @@ pd::Model breakable_bar() {
 
 pd::Case mixed_case(const std::string& start = "quasi_static") {
   pd::Case c;
+  // The bar's material and horizon, as a run's case has them (the pause rule's δ/c).
+  const pd::Case bar = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  c.blocks = bar.blocks;
+  c.horizon = bar.horizon;
   c.time.end = kEnd;
   c.time.integrator = "mixed";
   c.quasi_static.dt_max = kEnd / 40;

@@ -33,26 +33,26 @@ void Mixed::configure(const Case& c, double dt_exact) {
   static_.configure(c, dt_exact);
   static_.limit(settings_.unstable_rounds, c.quasi_static.dt_min.value_or(10.0 * dt_explicit_));
   static_dt_ = static_.initial_dt().value_or(static_.dt_max());
-  set_pause_steps();
+  set_pause_steps(c);
 }
 
 // δ / c in explicit steps, rounded up, c = √(E/ρ) the bar wave speed of the slowest block (below the
 // P-wave speed of a 2D or 3D body: the longer wait). Measured on cases/traction (PMMA, c = 1640
 // m/s): δ/c = 0.92 µs, 4 steps of 0.274 µs at dx × 2 and 4 of 0.137 µs at dx = 0.25 mm. Off (0)
-// without a Young's modulus in every block or with an implicit home.
-void Mixed::set_pause_steps() {
+// without a Young's modulus in every block or with an implicit home. From the case, not the model:
+// a decomposed run's piece carries no block materials.
+void Mixed::set_pause_steps(const Case& c) {
   pause_steps_ = 0;
   if (home_ != kQuasiStatic || pause_tries_ == 0) return;
-  const Model& m = op_.model();
   double slowest = HUGE_VAL;
-  for (const BlockMaterial& block : m.block_materials) {
+  for (const BlockMaterial& block : c.blocks) {
     const std::optional<double> youngs = block.parameter("youngs_modulus");
     if (!youngs || !(*youngs > 0.0) || !(block.density > 0.0)) return;
     slowest = std::min(slowest, std::sqrt(*youngs / block.density));
   }
-  if (!std::isfinite(slowest) || !(m.horizon > 0.0)) return;
+  if (!std::isfinite(slowest) || !(c.horizon > 0.0)) return;
   // (less a round-off's worth, so that an exact ratio is not rounded up a step by its last bit)
-  pause_steps_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(m.horizon / (slowest * dt_explicit_) - 1e-9)));
+  pause_steps_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(c.horizon / (slowest * dt_explicit_) - 1e-9)));
 }
 
 bool Mixed::crack_paused() const {

@@ -158,8 +158,8 @@ class Mixed : public Integrator {
   int pause_failures_ = 0;
   static constexpr int kPauseTries = 3;
   int pause_tries_ = kPauseTries;
-  // Sets the above from the model (configure).
-  void set_pause_steps();
+  // Sets the above from the case (configure).
+  void set_pause_steps(const Case& c);
   // After an explicit step: whether the crack has paused long enough to try a load step.
   bool crack_paused() const;
   static constexpr std::uint64_t kPauseTag = 0x7061757365727531ULL;  // "pauseru1": the bytes of the pause rule follow
