@@ -28,15 +28,16 @@
 //   (kTentativeIterations Newton iterations, no halving, and no more than unstable_rounds breaking
 //   rounds) from the current state at the current load. If it converges the crack is stable under
 //   the load and the load steps go on (the first kProbationSteps tentative); if not, the bonds it
-//   broke heal and Verlet goes on until the next pause. kPauseTries failed tries since the last load step past its probation, and the
-//   rule is given up until then. Why: the explicit phase is undamped, and after the crack has run its
-//   released energy rings in the pieces for ever; a slowly loaded test (the benchmark's reference:
-//   Verlet with ζ = 0.1 of light damping) loses that ringing to damping, and the pieces do not
-//   crack again. Measured on cases/traction at dx × 2 (docs/accuracy.md, "The pause rule"): without
-//   it the middle piece between the two cracks, still held by a ligament at one edge, cracks a third
-//   time 52 steps after the cracks ran, 13 steps before the ligament breaks, so that no rule that
-//   waits for the cut can return before it; undamped Verlet at 0.0625 m/s does the same, damped
-//   Verlet does not.
+//   broke heal and Verlet goes on until the next pause. After kPauseTries failed tries (counted
+//   since the last load step past a probation) the rule rests until such a step. Why: the explicit
+//   phase is undamped, and after the crack has run its released energy rings in the pieces for
+//   ever; a slowly loaded test (the benchmark's reference: Verlet with ζ = 0.1 of light damping)
+//   loses that ringing to damping, and the pieces do not crack again. Measured on cases/traction at
+//   dx × 2 (docs/accuracy.md, "The pause rule"): without it the middle piece between the two
+//   cracks, still linked to the halves by ligaments at the specimen's edges, cracks a third time 52
+//   steps after the cracks ran and 48 steps before the ligaments break, so that no rule that waits
+//   for the cut can return before it; undamped Verlet at 0.0625 m/s does the same, damped Verlet
+//   does not.
 //
 // mixed.start: implicit puts generalized-α implicit dynamics (integrators/implicit.hpp) in the
 // place of the quasi-static load steps, for loads where inertia matters but is slow next to the
