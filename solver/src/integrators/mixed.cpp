@@ -100,7 +100,7 @@ void Mixed::to_explicit(State&, double t, const std::string& reason) {
                        " → explicit (" + reason + "); Verlet at dt " + message_number(dt_explicit_) + " s");
 }
 
-void Mixed::to_quasi_static(State& state, double t, double kinetic, double strain) {
+void Mixed::to_quasi_static(State&, double t, double kinetic, double strain) {
   mode_ = kQuasiStatic;
   ++switches_;
   if (pause_return_ || (separated_ && !separation_given_up_)) probation_steps_ = kProbationSteps;
@@ -109,7 +109,6 @@ void Mixed::to_quasi_static(State& state, double t, double kinetic, double strai
   // The next load step finds equilibrium and leaves only the mean velocity of the load step: the
   // kinetic energy now is given up, booked as damping work so that the balance closes, when that
   // step is accepted (Mixed::step: a tentative step that fails leaves the motion to Verlet).
-  (void)state;
   const std::string why =
       pause_return_ ? "the crack stopped running: no bond broke for " + std::to_string(quiet_steps_) +
                           " steps, a horizon's crossing time of a stress wave; a tentative load step asks whether it is stable"
@@ -215,10 +214,10 @@ void Mixed::step(State& state, double& t, double& dt) {
       std::string then;
       if (pause_rule) {
         // The crack had not stopped, or the pieces hold what Newton cannot meet in a few iterations:
-        // Verlet until bonds break and pause again (to_explicit), pause_tries failures in all.
+        // Verlet until bonds break and pause again (to_explicit), pause_tries_ failures in all.
         ++pause_failures_;
         then = pause_failures_ < pause_tries_ ? "; the next try when the crack pauses again"
-                                                       : "; no more tries on a pause of the crack";
+                                              : "; no more tries on a pause of the crack";
       } else if (tentative) {
         separation_given_up_ = true;
         then = "; no more returns on the separation, only when the motion has died down";
