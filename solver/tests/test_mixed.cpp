@@ -36,6 +36,10 @@ pd::Model breakable_bar() {
 
 pd::Case mixed_case(const std::string& start = "quasi_static") {
   pd::Case c;
+  // The bar's material and horizon, as a run's case has them (the pause rule's δ/c).
+  const pd::Case bar = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  c.blocks = bar.blocks;
+  c.horizon = bar.horizon;
   c.time.end = kEnd;
   c.time.integrator = "mixed";
   c.quasi_static.dt_max = kEnd / 40;
@@ -47,7 +51,8 @@ pd::Case mixed_case(const std::string& start = "quasi_static") {
   return c;
 }
 
-// One run of the bar: the model, its operator, the integrator and the state, stepped by hand.
+// One run of the bar: the model, its operator, the integrator and the state, stepped by hand. The
+// pause rule (mixed.hpp) is off unless asked for: the tests before it check the other rules.
 struct BarRun {
   pd::Model model = breakable_bar();
   pd::ForceOperator op{model};
@@ -55,7 +60,8 @@ struct BarRun {
   pd::State state{model.nodes.size()};
   double t = 0.0, dt = 0.0;
   std::vector<std::string> log;
-  explicit BarRun(const std::string& start = "quasi_static") {
+  explicit BarRun(const std::string& start = "quasi_static", int pause_tries = 0) {
+    mixed.set_pause_tries(pause_tries);
     mixed.configure(mixed_case(start));
     mixed.initialize(state, 0.0);
     dt = *mixed.initial_dt();
@@ -667,4 +673,141 @@ TEST(Mixed, LinkagesAreFoundAndPlacedAlikeForOneAndTwoThreads) {
   EXPECT_EQ(one.iterations, two.iterations);
   EXPECT_TRUE(same_bits(one.state.u, two.state.u));
   EXPECT_TRUE(same_bits(one.state.f, two.state.f));
+}
+
+namespace {
+// The snapped bar with the pause rule on (pause_tries 3), stepped to the end: after each step its
+// mode, the bonds it broke, and whether the run has decided that the next step is a load step.
+struct PausedRun {
+  BarRun run{"quasi_static", 3};
+  std::vector<int> modes, next_static;
+  std::vector<std::int64_t> broken;
+  PausedRun() {
+    while (run.t < kEnd * (1 - 1e-12) && modes.size() < 100000u) {
+      run.step();
+      modes.push_back(*run.mixed.step_mode());
+      broken.push_back(run.mixed.last_step().broken_now);
+      next_static.push_back(run.mixed.mode() == pd::Mixed::kQuasiStatic ? 1 : 0);
+    }
+  }
+  std::ptrdiff_t count(const std::string& what) const {
+    return std::count_if(run.log.begin(), run.log.end(), [&](const std::string& line) { return line.find(what) != std::string::npos; });
+  }
+};
+}  // namespace
+
+TEST(Mixed, TriesALoadStepWhenTheCrackPausesForAHorizonsCrossingTimeAndNotBefore) {
+  // pause_steps = ⌈δ/(c·Δt)⌉ with c = √(E/ρ) = 1000 m/s. The first try comes after the first run of
+  // that many explicit steps without a broken bond that follows a step that broke bonds, not one
+  // step earlier; on this bar (4×4 nodes across, the crack crosses it in bursts) it fails (unstable
+  // growth), the second succeeds with bonds broken in its rounds and the next load step of its
+  // probation fails, the third fails: three failures, then the rule is given up and the separation
+  // rule brings the run back.
+  PausedRun p;
+  const pd::Mixed& mixed = p.run.mixed;
+  const auto n = static_cast<std::int64_t>(std::ceil(3.015 * kDx / (1000.0 * mixed.explicit_dt())));
+  ASSERT_EQ(mixed.pause_steps(), n);
+  EXPECT_EQ(n, 4);
+  const auto first_explicit = std::find(p.modes.begin(), p.modes.end(), static_cast<int>(pd::Mixed::kExplicit)) - p.modes.begin();
+  ASSERT_LT(first_explicit, static_cast<std::ptrdiff_t>(p.modes.size()));
+  std::ptrdiff_t expected = -1;  // the explicit step after which the first try is decided
+  bool cracked = false;
+  for (std::ptrdiff_t k = first_explicit, quiet = 0; k < static_cast<std::ptrdiff_t>(p.modes.size()); ++k) {
+    ASSERT_EQ(p.modes[k], pd::Mixed::kExplicit) << "a load step before the first pause, step " << k;
+    if (p.broken[k] > 0) cracked = true, quiet = 0;
+    else ++quiet;
+    if (cracked && quiet == n) {
+      expected = k;
+      break;
+    }
+    EXPECT_EQ(p.next_static[k], 0) << "a try decided before the crack paused, step " << k;
+  }
+  ASSERT_GE(expected, 0) << "the crack never paused";
+  EXPECT_EQ(p.next_static[expected], 1);
+  EXPECT_EQ(p.count("explicit → quasi-static (the crack stopped running: no bond broke for 4 steps"), 3);
+  EXPECT_EQ(p.count("unstable crack growth; the next try when the crack pauses again"), 2);
+  EXPECT_EQ(p.count("unstable crack growth; no more tries on a pause of the crack"), 1);
+  EXPECT_EQ(p.count("back in load steps: equilibrium in"), 2);  // the second try, and the return on the cut
+  // After the third failure only the separation rule: its line comes after the last try's.
+  const auto last_try = std::find_if(p.run.log.rbegin(), p.run.log.rend(), [](const std::string& line) {
+    return line.find("the crack stopped running") != std::string::npos;
+  });
+  const auto cut_return = std::find_if(p.run.log.begin(), p.run.log.end(), [](const std::string& line) {
+    return line.find("(the cracks cut the load path between the prescribed motions 50 steps ago)") != std::string::npos;
+  });
+  ASSERT_NE(cut_return, p.run.log.end());
+  EXPECT_LT(std::distance(p.run.log.begin(), last_try.base()), std::distance(p.run.log.begin(), cut_return) + 1);
+  EXPECT_EQ(p.modes.back(), pd::Mixed::kQuasiStatic);
+  EXPECT_EQ(mixed.pause_failures(), 0);  // load steps past the probation since: counted anew
+}
+
+TEST(Mixed, AFailedTryLeavesTheExplicitRunAsIfItHadNotBeenMade) {
+  // A try that fails heals the bonds it broke and leaves the state alone (QuasiStatic::step works on
+  // a copy), so Verlet goes on bit for bit as in a run without the rule, up to the next try; the
+  // kinetic energy is booked as given up only by a try that succeeds.
+  BarRun with("quasi_static", 3), without;
+  bool tried = false;
+  for (int k = 0; k < 100000 && with.t < kEnd * (1 - 1e-12); ++k) {
+    const bool try_now = with.mixed.mode() == pd::Mixed::kQuasiStatic && *with.mixed.step_mode() == pd::Mixed::kExplicit &&
+                         k > 0;
+    if (tried && try_now) break;  // the second try: the runs part (it succeeds)
+    with.step(), without.step();
+    tried = tried || try_now;
+    ASSERT_EQ(*with.mixed.step_mode(), *without.mixed.step_mode()) << "step " << k;
+    ASSERT_TRUE(same_bits(with.state.u, without.state.u)) << "step " << k;
+    ASSERT_TRUE(same_bits(with.state.v, without.state.v)) << "step " << k;
+    ASSERT_EQ(with.model.bonds.broken, without.model.bonds.broken) << "step " << k;
+    ASSERT_EQ(with.state.damping_work, without.state.damping_work) << "step " << k;
+    ASSERT_EQ(with.t, without.t);
+  }
+  ASSERT_TRUE(tried);
+  EXPECT_EQ(with.mixed.pause_failures(), 1);
+}
+
+TEST(Mixed, ACheckpointWithATryPendingContinuesBitwiseAndAnOlderOneReads) {
+  // Saved after the explicit step that decided a try (the pause rule's bytes after the quasi-static
+  // state, closed by a tag): a fresh run restored from it makes the same try and goes on bitwise.
+  // A checkpoint without those bytes (written before the rule) reads as a run that has not paused.
+  BarRun a("quasi_static", 3);
+  while (!(a.mixed.mode() == pd::Mixed::kQuasiStatic && *a.mixed.step_mode() == pd::Mixed::kExplicit)) {
+    ASSERT_LT(a.t, kEnd * (1 - 1e-12)) << "no try";
+    a.step();
+  }
+  const std::vector<char> saved = a.mixed.save_state();
+  BarRun b("quasi_static", 3);
+  b.state = a.state;
+  b.model.bonds.broken = a.model.bonds.broken;
+  b.mixed.load_state(saved);
+  b.t = a.t, b.dt = a.dt;
+  EXPECT_EQ(b.mixed.mode(), pd::Mixed::kQuasiStatic);
+  for (int k = 0; k < 40; ++k) {
+    a.step(), b.step();
+    ASSERT_EQ(*a.mixed.step_mode(), *b.mixed.step_mode()) << "step " << k;
+    ASSERT_TRUE(same_bits(a.state.u, b.state.u)) << "step " << k;
+    ASSERT_EQ(a.mixed.pause_failures(), b.mixed.pause_failures()) << "step " << k;
+    ASSERT_EQ(a.t, b.t);
+  }
+  EXPECT_EQ(a.model.bonds.broken, b.model.bonds.broken);
+  EXPECT_GE(b.mixed.pause_failures(), 1);  // the restored run made the try, and it failed
+  const std::size_t tail = sizeof(std::int64_t) + sizeof(int) + 2 + sizeof(std::uint64_t);
+  BarRun c("quasi_static", 3);
+  c.state = a.state;
+  c.model.bonds.broken = a.model.bonds.broken;
+  const std::vector<char> current = a.mixed.save_state();
+  c.mixed.load_state(std::vector<char>(current.begin(), current.end() - static_cast<std::ptrdiff_t>(tail)));
+  EXPECT_EQ(c.mixed.pause_failures(), 0);
+  EXPECT_EQ(c.mixed.mode(), a.mixed.mode());
+}
+
+TEST(Mixed, ThePauseRuleGivesTheSameBitsForOneAndTwoThreads) {
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  PausedRun one;
+  omp_set_num_threads(2);
+  PausedRun two;
+  omp_set_num_threads(threads);
+  EXPECT_EQ(one.modes, two.modes);
+  EXPECT_EQ(one.run.log, two.run.log);
+  EXPECT_TRUE(same_bits(one.run.state.u, two.run.state.u));
+  EXPECT_EQ(one.run.model.bonds.broken, two.run.model.bonds.broken);
 }

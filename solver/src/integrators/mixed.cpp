@@ -3,6 +3,7 @@
 #include "integrators/mixed.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "core/error.hpp"
@@ -32,6 +33,30 @@ void Mixed::configure(const Case& c, double dt_exact) {
   static_.configure(c, dt_exact);
   static_.limit(settings_.unstable_rounds, c.quasi_static.dt_min.value_or(10.0 * dt_explicit_));
   static_dt_ = static_.initial_dt().value_or(static_.dt_max());
+  set_pause_steps(c);
+}
+
+// δ / c in explicit steps, rounded up, c = √(E/ρ) the bar wave speed of the slowest block (below the
+// P-wave speed of a 2D or 3D body: the longer wait). Measured on cases/traction (PMMA, c = 1640
+// m/s): δ/c = 0.92 µs, 4 steps of 0.274 µs at dx × 2 and 4 of 0.137 µs at dx = 0.25 mm. Off (0)
+// without a Young's modulus in every block or with an implicit home. From the case, not the model:
+// a decomposed run's piece carries no block materials.
+void Mixed::set_pause_steps(const Case& c) {
+  pause_steps_ = 0;
+  if (home_ != kQuasiStatic || pause_tries_ == 0) return;
+  double slowest = HUGE_VAL;
+  for (const BlockMaterial& block : c.blocks) {
+    const std::optional<double> youngs = block.parameter("youngs_modulus");
+    if (!youngs || !(*youngs > 0.0) || !(block.density > 0.0)) return;
+    slowest = std::min(slowest, std::sqrt(*youngs / block.density));
+  }
+  if (!std::isfinite(slowest) || !(c.horizon > 0.0)) return;
+  // (less a round-off's worth, so that an exact ratio is not rounded up a step by its last bit)
+  pause_steps_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(c.horizon / (slowest * dt_explicit_) - 1e-9)));
+}
+
+bool Mixed::crack_paused() const {
+  return pause_steps_ > 0 && cracked_ && quiet_steps_ >= pause_steps_ && pause_failures_ < pause_tries_;
 }
 
 void Mixed::initialize(State& state, double t) {
@@ -43,6 +68,9 @@ void Mixed::initialize(State& state, double t) {
   step_mode_ = home_;
   calm_steps_ = 0;
   breaking_steps_ = 0;
+  quiet_steps_ = 0;
+  pause_return_ = pause_probation_ = false;
+  pause_failures_ = 0;
   log_lines_.clear();
   // From the bond list with every bond, broken or not: the same before and after a restart.
   // On a decomposed run the piece holds only its own rows of the bond graph: the groups come from
@@ -66,28 +94,32 @@ void Mixed::to_explicit(State&, double t, const std::string& reason) {
   mode_ = kExplicit;
   calm_steps_ = 0;
   cracked_ = false;
+  quiet_steps_ = 0;
   ++switches_;
   log_lines_.push_back("mixed: t = " + message_number(t) + " s: " + (home_ == kImplicit ? "implicit" : "quasi-static") +
                        " → explicit (" + reason + "); Verlet at dt " + message_number(dt_explicit_) + " s");
 }
 
-void Mixed::to_quasi_static(State& state, double t, double kinetic, double strain) {
+void Mixed::to_quasi_static(State&, double t, double kinetic, double strain) {
   mode_ = kQuasiStatic;
   ++switches_;
-  if (separated_ && !separation_given_up_) probation_steps_ = kProbationSteps;
+  if (pause_return_ || (separated_ && !separation_given_up_)) probation_steps_ = kProbationSteps;
+  pause_probation_ = pause_return_;
   static_.forget_factorisation();  // bonds broke in the explicit steps
   // The next load step finds equilibrium and leaves only the mean velocity of the load step: the
-  // kinetic energy now is given up, booked as damping work so that the balance closes.
-  state.damping_work += kinetic;
+  // kinetic energy now is given up, booked as damping work so that the balance closes, when that
+  // step is accepted (Mixed::step: a tentative step that fails leaves the motion to Verlet).
   const std::string why =
-      separated_ && !separation_given_up_ ? "the cracks cut the load path between the prescribed motions " +
+      pause_return_ ? "the crack stopped running: no bond broke for " + std::to_string(quiet_steps_) +
+                          " steps, a horizon's crossing time of a stress wave; a tentative load step asks whether it is stable"
+      : separated_ && !separation_given_up_ ? "the cracks cut the load path between the prescribed motions " +
                        std::to_string(settings_.arrest_steps) + " steps ago"
                  : "the crack arrested: no bond broke and the kinetic energy stayed below " +
                        message_number(settings_.kinetic_fraction) + " × the strain energy for " +
                        std::to_string(settings_.arrest_steps) + " steps";
   log_lines_.push_back("mixed: t = " + message_number(t) + " s: explicit → quasi-static (" + why + "); kinetic energy " +
                        message_number(kinetic) + " J (" + message_number(strain > 0.0 ? kinetic / strain : 0.0) +
-                       " of the strain energy) given up, booked as damping work");
+                       " of the strain energy) given up, booked as damping work if the load step finds equilibrium");
 }
 
 void Mixed::to_implicit(const State& state, double t, double kinetic, double strain) {
@@ -140,19 +172,29 @@ void Mixed::step(State& state, double& t, double& dt) {
     // dx = 0.5 mm before hanging nodes were left out of the solve, integrators/hanging_nodes.hpp:
     // 6 attempts of 30 iterations, then explicit again); it then fails after kTentativeIterations,
     // and the rule is given up.
-    // So are the kProbationSteps - 1 after it (probation_steps_).
-    const bool returning = step_mode_ == kExplicit && separated_ && !separation_given_up_;
+    // So are the kProbationSteps - 1 after it (probation_steps_). A return on the pause rule is
+    // tentative too, and so are the load steps of its probation.
+    const bool from_explicit = step_mode_ == kExplicit;
+    const bool on_pause = from_explicit && pause_return_;
+    pause_return_ = false;
+    const bool returning = from_explicit && (on_pause || (separated_ && !separation_given_up_));
     const bool tentative = returning || probation_steps_ > 0;
     static_.load_path_cut(separated_ && !separation_given_up_);  // strands carry no load then (hanging_nodes.hpp)
+    const bool pause_rule = on_pause || (!from_explicit && probation_steps_ > 0 && pause_probation_);
+    // The motion the load step gives up, booked when it is accepted (to_quasi_static).
+    const double given_up = from_explicit ? op_.kinetic_energy(state) : 0.0;
     if (tentative) static_.try_once(kTentativeIterations);
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();
+      state.damping_work += given_up;
       if (tentative) probation_steps_ = std::max(probation_steps_ - 1, 0);
+      else pause_failures_ = 0;  // a load step past any probation: the pause rule's tries count anew
       if (returning)
         log_lines_.push_back("mixed: t = " + message_number(t) + " s: back in load steps: equilibrium in " +
-                             std::to_string(report_.iterations) + " Newton iterations (" +
-                             std::to_string(static_.hanging_nodes()) +
+                             std::to_string(report_.iterations) + " Newton iterations" +
+                             (report_.broken_now > 0 ? ", " + std::to_string(report_.broken_now) + " bonds broken on the way" : "") +
+                             " (" + std::to_string(static_.hanging_nodes()) +
                              " nodes hanging by collinear bonds left out of the solve and placed on their bonds' line, " +
                              std::to_string(static_.free_fragment_nodes()) + " nodes of free fragments left as they were)");
       step_mode_ = kQuasiStatic;
@@ -170,9 +212,20 @@ void Mixed::step(State& state, double& t, double& dt) {
       static_.forget_factorisation();
       evaluations = static_.last_step().force_evaluations;
       rejected = static_.last_step().rejected + 1;
-      if (tentative) separation_given_up_ = true, probation_steps_ = 0;
-      to_explicit(state, t, static_.failure_reason() +
-                                (tentative ? "; no more returns on the separation, only when the motion has died down" : ""));
+      std::string then;
+      if (pause_rule) {
+        // The crack had not stopped, or the pieces hold what Newton cannot meet in a few iterations:
+        // Verlet until bonds break and pause again (to_explicit), pause_tries_ failures in all.
+        ++pause_failures_;
+        then = pause_failures_ < pause_tries_ ? "; the next try when the crack pauses again"
+                                              : "; no more tries on a pause of the crack";
+      } else if (tentative) {
+        separation_given_up_ = true;
+        then = "; no more returns on the separation, only when the motion has died down";
+      }
+      probation_steps_ = 0;
+      pause_probation_ = false;
+      to_explicit(state, t, static_.failure_reason() + then);
     }
   }
   double h = std::min(dt, dt_explicit_);
@@ -198,7 +251,12 @@ void Mixed::step(State& state, double& t, double& dt) {
   const bool cut = separated_ && !separation_given_up_;
   if (cut || (cracked_ && report_.broken_now == 0 && kinetic < settings_.kinetic_fraction * strain)) ++calm_steps_;
   else calm_steps_ = 0;
-  if (calm_steps_ >= settings_.arrest_steps) {
+  quiet_steps_ = report_.broken_now > 0 ? 0 : quiet_steps_ + 1;
+  if (home_ == kQuasiStatic && crack_paused()) {
+    pause_return_ = true;
+    to_quasi_static(state, t, kinetic, strain);
+    report_.next_dt = std::min(std::max(static_dt_, static_.dt_min()), static_.dt_max());
+  } else if (calm_steps_ >= settings_.arrest_steps) {
     if (home_ == kImplicit) {
       to_implicit(state, t, kinetic, strain);
       report_.next_dt = std::min(std::max(static_dt_, implicit_.dt_min()), implicit_.dt_max());
@@ -225,6 +283,10 @@ std::vector<char> Mixed::save_state() const {
   else put(given_up);
   const std::vector<char> inner = home_ == kImplicit ? implicit_.save_state() : static_.save_state();
   bytes.insert(bytes.end(), inner.begin(), inner.end());
+  // The pause rule's state after the inner state, closed by a tag (a checkpoint written before the
+  // rule has none, and reads as a run that has not paused).
+  const std::uint8_t pause_return = pause_return_ ? 1 : 0, pause_probation = pause_probation_ ? 1 : 0;
+  put(quiet_steps_), put(pause_failures_), put(pause_return), put(pause_probation), put(kPauseTag);
   return bytes;
 }
 
@@ -244,7 +306,25 @@ void Mixed::load_state(const std::vector<char>& bytes) {
   cracked_ = cracked != 0;
   if (mode != kExplicit && mode != home_) throw std::runtime_error("integrator state: unknown mixed mode");
   mode_ = static_cast<Mode>(mode);
-  const std::vector<char> inner(bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes + own), bytes.end());
+  // The pause rule's bytes at the end, if the tag is there.
+  constexpr std::size_t pause_bytes = sizeof(std::int64_t) + sizeof(int) + 2 + sizeof(kPauseTag);
+  std::size_t end = bytes.size();
+  quiet_steps_ = 0, pause_failures_ = 0, pause_return_ = pause_probation_ = false;
+  std::uint64_t tag = 0;
+  if (bytes.size() >= kReportBytes + own + pause_bytes)
+    std::memcpy(&tag, bytes.data() + bytes.size() - sizeof tag, sizeof tag);
+  if (tag == kPauseTag) {
+    end -= pause_bytes;
+    const char* p = bytes.data() + end;
+    std::uint8_t pause_return = 0, pause_probation = 0;
+    std::memcpy(&quiet_steps_, p, sizeof quiet_steps_), p += sizeof quiet_steps_;
+    std::memcpy(&pause_failures_, p, sizeof pause_failures_), p += sizeof pause_failures_;
+    std::memcpy(&pause_return, p, 1), p += 1;
+    std::memcpy(&pause_probation, p, 1);
+    pause_return_ = pause_return != 0, pause_probation_ = pause_probation != 0;
+  }
+  const std::vector<char> inner(bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes + own),
+                                bytes.begin() + static_cast<std::ptrdiff_t>(end));
   if (home_ == kImplicit) {
     get(breaking_steps_);
     implicit_.load_state(inner);
@@ -280,7 +360,11 @@ std::vector<std::string> Mixed::describe(double dt_exact) const {
                   message_number(settings_.kinetic_fraction) + " × the strain energy" +
                   (load_path_ && load_path_->linked_uncut()
                        ? ", or that many steps after the cracks have cut the load path between the prescribed motions"
-                       : ""));
+                       : "") +
+                  (pause_steps_ > 0 ? "; and a tentative load step when the crack has stopped running (no bond broken for " +
+                                          std::to_string(pause_steps_) + " steps, δ/c; at most " +
+                                          std::to_string(pause_tries_) + " failed tries)"
+                                    : ""));
   return lines;
 }
 
