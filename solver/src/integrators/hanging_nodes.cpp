@@ -256,13 +256,31 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
           return w;
         };
         // The anchors: intact bonds to nodes in the body or placed in a later round.
+        const auto anchor = [&](std::int64_t k) {
+          const auto ku = static_cast<std::size_t>(k);
+          const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
+          return !bonds.broken[ku] && (round_[j] == 0.0 || round_[j] > now);
+        };
+        // Σ w_b target_b / Σ w_b over the anchors (w_b = axial_weight), target(j, out) their targets:
+        // where the anchors' axial forces balance, for each kind of node below.
+        const auto weighted_mean = [&](auto target, double mean[3]) {
+          double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0}, at[3];
+          for (std::int64_t k = first; k < last; ++k) {
+            if (!anchor(k)) continue;
+            const auto j = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(k)]);
+            const double w = axial_weight(k - first, i, j);
+            weight_sum += w;
+            target(j, at);
+            for (int c = 0; c < 3; ++c) sum[c] += w * at[c];
+          }
+          for (int c = 0; c < 3; ++c) mean[c] = sum[c] / weight_sum;
+        };
+        double* const place = &placed[3 * static_cast<std::size_t>(g)];
         std::int64_t nearest = -1, farthest = -1;
         double near_length = HUGE_VAL, far_length = -HUGE_VAL;
         for (std::int64_t k = first; k < last; ++k) {
-          const auto ku = static_cast<std::size_t>(k);
-          const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
-          if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
-          const double length = bond_length(X, i, j);
+          if (!anchor(k)) continue;
+          const double length = bond_length(X, i, static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(k)]));
           if (length < near_length) near_length = length, nearest = k;
           if (length > far_length) far_length = length, farthest = k;
         }
@@ -275,12 +293,16 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
           double e[3], along_low = HUGE_VAL, along_high = -HUGE_VAL;
           for (int c = 0; c < 3; ++c) e[c] = (X[static_cast<std::size_t>(c)][jn] - X[static_cast<std::size_t>(c)][i]) / near_length;
           std::size_t low = jn, high = jn;
-          for (std::int64_t k = first; k < last; ++k) {
-            const auto ku = static_cast<std::size_t>(k);
-            const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
-            if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+          // ξ_b·e of the anchor j: where it lies along the reference line.
+          const auto along_line = [&](std::size_t j) {
             double along = 0.0;
             for (int c = 0; c < 3; ++c) along += (X[static_cast<std::size_t>(c)][j] - X[static_cast<std::size_t>(c)][i]) * e[c];
+            return along;
+          };
+          for (std::int64_t k = first; k < last; ++k) {
+            if (!anchor(k)) continue;
+            const auto j = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(k)]);
+            const double along = along_line(j);
             if (along < along_low) along_low = along, low = j;
             if (along > along_high) along_high = along, high = j;
           }
@@ -291,18 +313,10 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
             norm = std::sqrt(norm);
             for (double& component : e_now) component /= norm;
           }
-          double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0};
-          for (std::int64_t k = first; k < last; ++k) {
-            const auto ku = static_cast<std::size_t>(k);
-            const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
-            if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
-            double along = 0.0;
-            for (int c = 0; c < 3; ++c) along += (X[static_cast<std::size_t>(c)][j] - X[static_cast<std::size_t>(c)][i]) * e[c];
-            const double w = axial_weight(k - first, i, j);
-            weight_sum += w;
-            for (int c = 0; c < 3; ++c) sum[c] += w * (position(j, c) - along * e_now[c]);
-          }
-          for (int c = 0; c < 3; ++c) placed[3 * static_cast<std::size_t>(g) + static_cast<std::size_t>(c)] = sum[c] / weight_sum;
+          weighted_mean([&](std::size_t j, double* at) {
+            const double along = along_line(j);
+            for (int c = 0; c < 3; ++c) at[c] = position(j, c) - along * e_now[c];
+          }, place);
           moved[static_cast<std::size_t>(g)] = 1;
           continue;
         }
@@ -310,17 +324,11 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
           // A link of a linkage: carried by its anchors' translation, at its reference place among
           // them (x_i = X_i + Σ w_b u_b / Σ w_b, w_b the axial stiffness as below): its bonds to
           // them unstretched while they translate together.
-          double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0};
-          for (std::int64_t k = first; k < last; ++k) {
-            const auto ku = static_cast<std::size_t>(k);
-            const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
-            if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
-            const double w = axial_weight(k - first, i, j);
-            weight_sum += w;
-            for (int c = 0; c < 3; ++c) sum[c] += w * u[static_cast<std::size_t>(c)][j];
-          }
-          for (int c = 0; c < 3; ++c)
-            placed[3 * static_cast<std::size_t>(g) + static_cast<std::size_t>(c)] = X[static_cast<std::size_t>(c)][i] + sum[c] / weight_sum;
+          double carried[3];
+          weighted_mean([&](std::size_t j, double* at) {
+            for (int c = 0; c < 3; ++c) at[c] = u[static_cast<std::size_t>(c)][j];
+          }, carried);
+          for (int c = 0; c < 3; ++c) place[c] = X[static_cast<std::size_t>(c)][i] + carried[c];
           moved[static_cast<std::size_t>(g)] = 1;
           continue;
         }
@@ -340,17 +348,10 @@ void HangingNodes::place(const Model& m, Vec3Array& u, const Decomposed* d) cons
           norm = std::sqrt(norm);
           for (double& component : line) component /= norm;
         }
-        double weight_sum = 0.0, sum[3] = {0.0, 0.0, 0.0};
-        for (std::int64_t k = first; k < last; ++k) {
-          const auto ku = static_cast<std::size_t>(k);
-          const auto j = static_cast<std::size_t>(bonds.neighbour[ku]);
-          if (bonds.broken[ku] || !(round_[j] == 0.0 || round_[j] > now)) continue;
+        weighted_mean([&](std::size_t j, double* at) {
           const double length = bond_length(X, i, j);
-          const double w = axial_weight(k - first, i, j);
-          weight_sum += w;
-          for (int c = 0; c < 3; ++c) sum[c] += w * (position(j, c) - length * line[c]);
-        }
-        for (int c = 0; c < 3; ++c) placed[3 * static_cast<std::size_t>(g) + static_cast<std::size_t>(c)] = sum[c] / weight_sum;
+          for (int c = 0; c < 3; ++c) at[c] = position(j, c) - length * line[c];
+        }, place);
         moved[static_cast<std::size_t>(g)] = 1;
       }
     }
