@@ -26,29 +26,8 @@ pd::Model lattice_model(double fracture_energy) {
   return pd::build_model(c, pdtest::cubic_lattice(kNx, kNy, kNz, kDx, 3));
 }
 
-// A smooth field with no symmetry, so that every row's sum has rounding to get wrong. amplitude
-// relative to dx.
-pd::Vec3Array wavy(const pd::Model& m, double amplitude) {
-  pd::Vec3Array u = pd::make_vec3(m.nodes.size());
-  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
-    const double x = m.nodes.x[0][i] / kDx, y = m.nodes.x[1][i] / kDx, z = m.nodes.x[2][i] / kDx;
-    u[0][i] = amplitude * kDx * std::sin(0.37 * x + 0.11 * y * z);
-    u[1][i] = amplitude * kDx * std::cos(0.23 * y - 0.05 * x * x);
-    u[2][i] = amplitude * kDx * std::sin(0.41 * z + 0.07 * x * y + 0.3);
-  }
-  return u;
-}
-
-// Pre-broken bonds: every bond crossing the plane x = 6.5 dx within y < 5 dx (a notch).
-void notch(pd::Model& m) {
-  for (std::size_t i = 0; i < m.nodes.size(); ++i)
-    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
-      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-      const double xi = m.nodes.x[0][i] / kDx, xj = m.nodes.x[0][j] / kDx;
-      if ((xi - 6.5) * (xj - 6.5) < 0 && m.nodes.x[1][i] < 5 * kDx && m.nodes.x[1][j] < 5 * kDx)
-        m.bonds.broken[static_cast<std::size_t>(k)] = 1;
-    }
-}
+pd::Vec3Array wavy(const pd::Model& m, double amplitude) { return pdtest::wavy(m, kDx, amplitude); }
+void notch(pd::Model& m) { pdtest::notch(m, kDx); }
 
 using pdtest::same_bits;
 

@@ -45,27 +45,12 @@ pd::Model lattice_model(const std::string& law) {
   pd::Model m = pd::build_model(c, pdtest::cubic_lattice(kNx, kNy, kNz, kDx, 3));
   // A notch (bonds across x = 6.5 dx with y < 5 dx start broken): a broken bond to a ghost still
   // makes its row a boundary row.
-  for (std::size_t i = 0; i < m.nodes.size(); ++i)
-    for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
-      const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
-      if ((m.nodes.x[0][i] - 6.5 * kDx) * (m.nodes.x[0][j] - 6.5 * kDx) < 0 && m.nodes.x[1][i] < 5 * kDx &&
-          m.nodes.x[1][j] < 5 * kDx)
-        m.bonds.broken[static_cast<std::size_t>(k)] = 1;
-    }
+  pdtest::notch(m, kDx);
   return m;
 }
 
 // A smooth field with no symmetry, small enough that no bond is near breaking.
-pd::Vec3Array wavy(const pd::Model& m, double amplitude) {
-  pd::Vec3Array u = pd::make_vec3(m.nodes.size());
-  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
-    const double x = m.nodes.x[0][i] / kDx, y = m.nodes.x[1][i] / kDx, z = m.nodes.x[2][i] / kDx;
-    u[0][i] = amplitude * kDx * std::sin(0.37 * x + 0.11 * y * z);
-    u[1][i] = amplitude * kDx * std::cos(0.23 * y - 0.05 * x * x);
-    u[2][i] = amplitude * kDx * std::sin(0.41 * z + 0.07 * x * y + 0.3);
-  }
-  return u;
-}
+pd::Vec3Array wavy(const pd::Model& m, double amplitude) { return pdtest::wavy(m, kDx, amplitude); }
 
 // This rank's u from the global field, the ghosts poisoned (NaN): only the exchange makes them right.
 pd::Vec3Array poisoned_local(const pd::LocalPiece& p, const pd::Vec3Array& u_global) {
