@@ -194,8 +194,9 @@ void Mixed::step(State& state, double& t, double& dt) {
         log_lines_.push_back("mixed: t = " + message_number(t) + " s: back in load steps: equilibrium in " +
                              std::to_string(report_.iterations) + " Newton iterations" +
                              (report_.broken_now > 0 ? ", " + std::to_string(report_.broken_now) + " bonds broken on the way" : "") +
-                             " (" + std::to_string(static_.hanging_nodes()) +
+                             " (" + std::to_string(static_.hanging_nodes() - static_.linkage_nodes()) +
                              " nodes hanging by collinear bonds left out of the solve and placed on their bonds' line, " +
+                             std::to_string(static_.linkage_nodes()) + " links of linkages and strands left out and placed among their anchors, " +
                              std::to_string(static_.free_fragment_nodes()) + " nodes of free fragments left as they were)");
       step_mode_ = kQuasiStatic;
       static_dt_ = report_.next_dt;

@@ -41,8 +41,7 @@ void ForceOperator::evaluate(State& s, double t) const {
     model_.bond_model->add_force(model_, s.u, s.f, s.w.data());
   } else {
     // The ghosts' u travel while the law sweeps the rows that read none (parallel/row_split.hpp).
-    decomposed_->begin_update_ghosts(s.u);
-    const GhostsInFlight u_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(s.u); });
+    const GhostsInFlight u_ghosts = decomposed_->send_ghosts(s.u);
     model_.bond_model->add_force_overlapped(model_, s.u, s.f, s.w.data(), u_ghosts);
     u_ghosts.wait();  // the terms below read the ghosts' u (a law waits before its boundary rows anyway)
   }
@@ -64,8 +63,7 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
     // exchange begins: one exchange at a time.
     if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
     // The ghosts' u travel while the law sweeps the rows that read none (parallel/row_split.hpp).
-    decomposed_->begin_update_ghosts(s.u);
-    const GhostsInFlight u_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(s.u); });
+    const GhostsInFlight u_ghosts = decomposed_->send_ghosts(s.u);
     lost_.assign(s.size(), 0.0);
     report = model_.bond_model->break_bonds_and_add_force_overlapped(model_, s.u, s.f, s.w.data(), true, lost_.data(),
                                                                       u_ghosts);
@@ -129,8 +127,7 @@ void ForceOperator::apply_jacobian(const State& s, double t, const Vec3Array& x,
   }
   // x's ghosts travel while the law sweeps the rows that read none (parallel/row_split.hpp).
   ghosted_x_ = x;
-  decomposed_->begin_update_ghosts(ghosted_x_);
-  const GhostsInFlight x_ghosts(decomposed_->row_split(), [&] { decomposed_->end_update_ghosts(ghosted_x_); });
+  const GhostsInFlight x_ghosts = decomposed_->send_ghosts(ghosted_x_);
   model_.bond_model->add_jacobian_product_overlapped(model_, s.u, ghosted_x_, y, x_ghosts);
   x_ghosts.wait();
   for (const auto& term : terms_) term->add_jacobian_product(s, t, ghosted_x_, y);

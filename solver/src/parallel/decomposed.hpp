@@ -45,6 +45,12 @@ class Decomposed {
   // The piece's owned rows split into those that read no ghost and the others, made once with the
   // piece (its rows never change).
   virtual const RowSplit& row_split() const = 0;
+  // begin_update_ghosts(a) and the handle a law's overlapped sweep waits on (row_split.hpp): its
+  // wait() ends this exchange, once. a must outlive the handle.
+  GhostsInFlight send_ghosts(Vec3Array& a) const {
+    begin_update_ghosts(a);
+    return GhostsInFlight(row_split(), [this, &a] { end_update_ghosts(a); });
+  }
   // start + Σ over owned local nodes of per_node[l], summed exactly (core/exact_sum.hpp) and rounded
   // once, the same on every rank: the bits do not depend on the rank or thread count, and equal
   // the serial exact sum (parallel/node_sum.hpp) of the whole model's terms. Entries of ghosts are
