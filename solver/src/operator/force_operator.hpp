@@ -47,8 +47,9 @@ class ForceOperator {
   BreakReport break_bonds_and_evaluate(State& s, double t);
   // Only the breaking: bonds over their critical stretch at s.u break (the implicit integrators
   // break after a converged solve, then solve again). Serial: the law's break_bonds, as before.
-  // Decomposed: the ghosts' u first, the count summed over the ranks and the energy in node order
-  // (as break_bonds_and_evaluate). Collective on a decomposed run.
+  // Decomposed: the pass of break_bonds_and_evaluate into scratch force arrays (the ghosts' u, and
+  // LAMMPS's s0, overlapped with the interior rows), the count summed over the ranks and the energy
+  // in node order. Collective on a decomposed run.
   BreakReport break_bonds(State& s);
   // Whether any bond of the whole model is broken (collective on a decomposed run).
   bool any_broken() const;
@@ -134,6 +135,10 @@ class ForceOperator {
   // report.broken and report.energy summed over the ranks from this rank's count and lost_, in one
   // reduction (decomposed only).
   void reduce_break_report(BreakReport& report);
+  // A decomposed run's breaking pass with the force into f and w (break_bonds_and_evaluate's s.f and
+  // s.w, break_bonds' scratch arrays): u's ghosts (and LAMMPS's s0) travel while the law sweeps the
+  // interior rows; the report summed over the ranks.
+  BreakReport break_on_piece(Vec3Array& u, Vec3Array& f, double* w);
 };
 
 }  // namespace pd

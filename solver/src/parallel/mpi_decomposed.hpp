@@ -37,12 +37,8 @@ class MpiDecomposed : public Decomposed {
   const LocalPiece& piece() const override { return piece_; }
   const HaloExchange& halo() const { return *halo_; }
 
-  void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
-  void update_ghosts(std::vector<double>& a) const override { halo_->exchange(a); }
-  void begin_update_ghosts(const Vec3Array& a) const override { halo_->begin(a); }
-  void end_update_ghosts(Vec3Array& a) const override { halo_->end(a); }
-  void begin_update_ghosts(const std::vector<double>& a) const override { halo_->begin(a); }
-  void end_update_ghosts(std::vector<double>& a) const override { halo_->end(a); }
+  void begin_update_ghosts(const NodeColumns& a) const override { halo_->begin(a); }
+  void end_update_ghosts(const NodeColumns& a) const override { halo_->end(a); }
   const RowSplit& row_split() const override { return row_split_; }
   double exact_sum(const std::vector<double>& per_node, double start = 0.0) const override;
   void reduce(ExactSum* sums, int count, std::int64_t* integers = nullptr, int integer_count = 0) const override;
