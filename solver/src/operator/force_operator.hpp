@@ -33,9 +33,9 @@ class ForceOperator {
 
   // A decomposed run (issue 15): the model is this rank's piece (parallel/local_model), and the
   // ghosts' displacements come from their owners while the law sweeps the rows that read no ghost
-  // (parallel/row_split.hpp: evaluate, break_bonds_and_evaluate, apply_jacobian); energies and
-  // break reports are reduced over the ranks in an order that does not depend on them. Null (the
-  // default): serial.
+  // (parallel/row_split.hpp: evaluate, break_bonds_and_evaluate, break_bonds, apply_jacobian);
+  // energies and break reports are reduced over the ranks in an order that does not depend on
+  // them. Null (the default): serial.
   void set_decomposed(const Decomposed* d);
   const Decomposed* decomposed() const { return decomposed_; }
 

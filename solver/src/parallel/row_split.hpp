@@ -1,7 +1,7 @@
 // Why a rank's rows are split in two: the halo exchange overlapped with the bond sweep (issue 15).
 //
-// A decomposed force evaluation needs its ghosts' values (u; LPS's P_j between its two sweeps) from
-// their owners. An owned row whose bond partners are all owned reads no ghost, so it can be swept
+// A decomposed force evaluation needs its ghosts' values (u; LAMMPS's s0 with u; LPS's P_j between
+// its two sweeps; x, then P_j and δP_j, for a J·x) from their owners. An owned row whose bond partners are all owned reads no ghost, so it can be swept
 // while those values are still on their way:
 //
 //   begin the exchange (MPI_Irecv / MPI_Isend, parallel/halo)
