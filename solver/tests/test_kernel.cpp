@@ -110,6 +110,39 @@ TEST(Kernel, FusedPassIsBitwiseTheSameWithOneAndTwoThreads) {
   }
 }
 
+// The kernel's path for one block of full volumes with the same V everywhere (PmbArrays::uniform:
+// no gather of V_j, no ν) gives the bits of the general path: forces, W, the flags it breaks, the
+// lost energy per node and the count, over rounds that mix old and new breaks.
+TEST(Kernel, UniformVolumePathIsBitwiseTheGeneralPath) {
+  EXPECT_FALSE(pd::pmb_arrays(brick(true), shaken(brick(true), 1)).uniform);              // two blocks
+  EXPECT_FALSE(pd::pmb_arrays(brick(false, "lammps"), shaken(brick(false), 1)).uniform);  // ν from |ξ|
+  pd::Model uniform = brick(false), general = brick(false);
+  const std::size_t n = uniform.nodes.size();
+  std::int64_t broke = 0;
+  for (unsigned round = 0; round < 3; ++round) {
+    const pd::Vec3Array u = shaken(uniform, 11 + round, (0.005 + 0.01 * round) * kDx);
+    pd::Vec3Array f[2] = {pd::make_vec3(n), pd::make_vec3(n)};
+    std::vector<double> w[2] = {std::vector<double>(n), std::vector<double>(n)};
+    std::vector<double> lost[2] = {std::vector<double>(n), std::vector<double>(n)};
+    std::int64_t count[2] = {0, 0};
+    for (int r = 0; r < 2; ++r) {
+      pd::Model& m = r == 0 ? uniform : general;
+      pd::PmbArrays a = pd::pmb_arrays(m, u);
+      ASSERT_TRUE(a.uniform);
+      a.uniform = r == 0;
+      const pd::PmbBreaking br{m.bonds.broken.data(), m.material.critical_pair.data(), m.no_fail.data(), lost[r].data()};
+      count[r] = pd::add_pmb_force_density(a, f[r][0].data(), f[r][1].data(), f[r][2].data(), w[r].data(), &br);
+    }
+    broke += count[0];
+    EXPECT_EQ(count[0], count[1]);
+    EXPECT_EQ(uniform.bonds.broken, general.bonds.broken);
+    for (std::size_t d = 0; d < 3; ++d) EXPECT_TRUE(same_bits(f[0][d], f[1][d])) << "component " << d;
+    EXPECT_TRUE(same_bits(w[0], w[1]));
+    EXPECT_TRUE(same_bits(lost[0], lost[1]));
+  }
+  EXPECT_GT(broke, 0) << "nothing broke: the rounds would not test the flags";
+}
+
 TEST(Kernel, MatchesTheTextbookFormulaBondByBond) {
   // f_i = Σ c s ν V_j (y_j − y_i)/|y_j − y_i|, s = (|y_j − y_i| − |ξ|)/|ξ| (thesis eqs. 1.9–1.10,
   // 2.1), W_i = Σ ¼ c s² |ξ| ν V_j, written the plain way with the partial-volume rule's own factor,

@@ -31,6 +31,9 @@ struct PmbArrays {
   const double* factor;        // surface-correction factor g_k per directed bond; null: none (g = 1)
   std::int64_t blocks;
   std::int64_t nodes;
+  // One block, no surface correction, full volumes (ν = 1) and the same V_i for every node: the
+  // kernel then reads no V_j and computes no ν (bitwise the same terms).
+  bool uniform = false;
 };
 
 PmbArrays pmb_arrays(const Model& model, const Vec3Array& u);
