@@ -38,10 +38,11 @@ def oversubscribed(ranks, threads):
     return ranks * threads > (os.cpu_count() or 1)
 
 
-def run_ours(exe, side, steps, ranks, threads):
-    """The per-rank rows pd_mpi_halo prints, as dicts."""
+def run_ours(exe, side, steps, ranks, threads, extra=()):
+    """The per-rank rows pd_mpi_halo prints, as dicts. extra: more of its options (--law lps,
+    --alpha A, --blocking)."""
     command = ["mpiexec", "--oversubscribe", "--bind-to", "none", "-np", str(ranks), exe, "--side", str(side),
-               "--steps", str(steps), "--threads", str(threads)]
+               "--steps", str(steps), "--threads", str(threads), *extra]
     env = dict(MPI_ENV, OMP_NUM_THREADS=str(threads))
     if oversubscribed(ranks, threads):
         env.setdefault("OMP_WAIT_POLICY", "passive")  # spinning threads would take the cores from the others

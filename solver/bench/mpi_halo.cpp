@@ -12,7 +12,12 @@
 // communication time, the halo exchanges' (packing, MPI calls, waits, unpacking) and of that their
 // waits (their second halves: what the sweep of the interior rows did not hide, parallel/row_split.hpp).
 //
-//   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T]
+// --law lps: the LPS law (ν = 0.25; each rank cuts its piece from the whole model, as pdsolve does
+// for LPS, whose m_i need whole rows); --alpha A: LAMMPS's breaking order and α rule (per-node s0,
+// whose ghosts travel with u); --blocking: every owned row a boundary row, so that every sweep
+// waits for its exchange first (the exchange without the overlap, in the same binary: a before/after).
+//
+//   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T] [--law pmb|lps] [--alpha A] [--blocking]
 #include <mpi.h>
 #include <omp.h>
 #include <sys/resource.h>
@@ -37,33 +42,57 @@ int main(int argc, char** argv) {
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   int side = 40, steps = 20, threads = 0, ranks = 1;
+  std::string law = "pmb";
+  double alpha = 0.0;
+  bool blocking = false;
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  for (int k = 1; k + 1 < argc; k += 2) {
+  for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
+    if (a == "--blocking") {
+      blocking = true;
+      continue;
+    }
+    if (k + 1 >= argc) break;
     if (a == "--side") side = std::atoi(argv[k + 1]);
     else if (a == "--steps") steps = std::atoi(argv[k + 1]);
     else if (a == "--threads") threads = std::atoi(argv[k + 1]);
+    else if (a == "--law") law = argv[k + 1];
+    else if (a == "--alpha") alpha = std::atof(argv[k + 1]);
+    ++k;
   }
   if (threads > 0) omp_set_num_threads(threads);
   threads = omp_get_max_threads();
   const double dx = 1e-3;
-  const pd::Case c = pdtest::lattice_case(3, "3d", dx, 3.0002 * dx, 72e9, 2440.0, 4.0);
+  pd::Case c = pdtest::lattice_case(3, "3d", dx, 3.0002 * dx, 72e9, 2440.0, 4.0);
+  if (law == "lps") {
+    c.blocks[0].model = "lps";
+    c.blocks[0].parameters["poisson_ratio"] = 0.25;
+  }
+  if (alpha > 0.0) {
+    c.breaking_order = "lammps";
+    c.blocks[0].parameters["critical_stretch_alpha"] = alpha;
+  }
   // One rank: the serial path (no decomposition), as pdsolve takes it. Several: each rank builds
   // only the rows of its own nodes, as pdsolve does for a pmb case (run/prepare whole_bonds_reason),
   // and holds the whole cloud's node data.
   std::unique_ptr<pd::MpiDecomposed> dec;
   pd::Model global;
   double dt0 = 0.0;
-  if (ranks > 1) {
+  if (ranks > 1 && law == "lps") {  // the whole model first: LPS's m_i need whole rows (LpsModel::for_piece)
+    global = pd::build_model(c, pdtest::cubic_lattice(side, side, side, dx, 3));
+    dec = std::make_unique<pd::MpiDecomposed>(MPI_COMM_WORLD, global);
+    dt0 = 0.8 * dec->minimum(pd::stable_time_step(dec->piece().model));
+  } else if (ranks > 1) {
     global = pd::build_model_without_bonds(c, pdtest::cubic_lattice(side, side, side, dx, 3));
     global.bonds.offsets = pd::count_bonds(global.nodes.x, pd::bond_search_cutoff(c));
-    global.bond_model = pd::material_registry().get("pmb").make(global);
+    global.bond_model = pd::material_registry().get(law).make(global);
     dec = std::make_unique<pd::MpiDecomposed>(MPI_COMM_WORLD, global, pd::bond_search_cutoff(c), c.cracks);
     dt0 = 0.8 * dec->minimum(pd::stable_time_step(dec->piece().model));
   } else {
     global = pd::build_model(c, pdtest::cubic_lattice(side, side, side, dx, 3));
     dt0 = 0.8 * pd::stable_time_step(global);
   }
+  if (dec && blocking) dec->split_rows_for_blocking();
   pd::Model& model = dec ? dec->piece().model : global;
   pd::ForceOperator op(model);
   if (dec) op.set_decomposed(dec.get());

@@ -37,6 +37,20 @@ def test_two_ranks_send_one_message_of_their_face_layers_and_two_reductions_per_
         assert float(r["peak_rss_mb"]) > 0.0
 
 
+@pytest.mark.parametrize("extra, messages", [(("--alpha", "0.25"), 1), (("--law", "lps"), 2)])
+def test_lammps_s0_travels_with_u_in_one_message_and_lps_sends_p_in_a_second(extra, messages):
+    """LAMMPS's α rule reads the s0 of a bond's ghost end: it travels with u, 4 doubles per ghost in
+    one message per step (432 × 4 × 8 bytes), not in a second message. LPS's force sweep needs P of
+    the ghosts, known only after the first sweep: a second message of 1 double per ghost. Either way
+    432 × 4 × 8 bytes a step, and with --blocking (every row a boundary row: no overlap) the same."""
+    from bench.mpi_ranks import run_ours
+    for blocking in ((), ("--blocking",)):
+        for r in run_ours(EXE, 12, 3, 2, 1, extra + blocking):
+            assert float(r["halo_messages_per_step"]) == messages
+            assert int(r["halo_bytes_per_step"]) == 432 * 4 * 8
+            assert float(r["reductions_per_step"]) == 2.0
+
+
 def test_the_bond_count_of_a_run_whose_ranks_build_only_their_rows_is_the_serial_one():
     """On 2 ranks each builds only its own rows (the whole list is only counted): the directed bonds
     the row reports, and so its bond updates per second, are still the whole brick's."""

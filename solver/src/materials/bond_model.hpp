@@ -98,6 +98,8 @@ class BondModel {
   // their way (parallel/row_split.hpp says why): the law sweeps u_ghosts.rows.interior, calls
   // u_ghosts.wait(), then sweeps u_ghosts.rows.boundary; the same f, w, flags and report as the
   // plain call after the exchange, bit for bit. By default: wait, then the plain call (no overlap).
+  // With LAMMPS's per-node s0 (Model::node_critical_stretch) the breaking call's u_ghosts carries
+  // the ghosts' s0 too, in the same exchange: its wait() fills both.
   virtual void add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                     const GhostsInFlight& u_ghosts) const {
     u_ghosts.wait();

@@ -53,23 +53,8 @@ void ForceOperator::evaluate(State& s, double t) const {
 BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
   for (auto& fc : s.f) std::fill(fc.begin(), fc.end(), 0.0);
   BreakReport report;
-  if (!decomposed_) {
-    report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
-  } else {
-    // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
-    // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
-    // LAMMPS's α rule: a bond's threshold min(s0_i, s0_j) reads its ghost end's s0, which the
-    // previous pass updated on the owner only (a ghost's empty row leaves +inf). Before u's
-    // exchange begins: one exchange at a time.
-    if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
-    // The ghosts' u travel while the law sweeps the rows that read none (parallel/row_split.hpp).
-    const GhostsInFlight u_ghosts = decomposed_->send_ghosts(s.u);
-    lost_.assign(s.size(), 0.0);
-    report = model_.bond_model->break_bonds_and_add_force_overlapped(model_, s.u, s.f, s.w.data(), true, lost_.data(),
-                                                                      u_ghosts);
-    u_ghosts.wait();
-    reduce_break_report(report);
-  }
+  if (!decomposed_) report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
+  else report = break_on_piece(s.u, s.f, s.w.data());
   s.contact_energy = 0.0;
   s.indenter_energy = 0.0;
   for (const auto& term : terms_) term->add_force(s, t);
@@ -80,11 +65,25 @@ BreakReport ForceOperator::break_bonds(State& s) {
   if (!decomposed_) return model_.bond_model->break_bonds(model_, s.u, true);
   // The breaking of break_bonds_and_evaluate into scratch force arrays: the same flags as the law's
   // break_bonds (bond_model.hpp), with each node's share of the lost energy kept for the exact sum.
-  decomposed_->update_ghosts(s.u);
   Vec3Array f = make_vec3(s.size());
   std::vector<double> w(s.size(), 0.0);
-  lost_.assign(s.size(), 0.0);
-  BreakReport report = model_.bond_model->break_bonds_and_add_force(model_, s.u, f, w.data(), true, lost_.data());
+  return break_on_piece(s.u, f, w.data());
+}
+
+BreakReport ForceOperator::break_on_piece(Vec3Array& u, Vec3Array& f, double* w) {
+  // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
+  // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
+  // LAMMPS's α rule: a bond's threshold min(s0_i, s0_j) reads its ghost end's s0, which the
+  // previous pass updated on the owner only (a ghost's empty row leaves +inf): it travels with u,
+  // in the same exchange (one message per neighbour), while the law sweeps the rows that read no
+  // ghost (parallel/row_split.hpp).
+  NodeColumns ghost_values(u);
+  if (!model_.node_critical_stretch.empty()) ghost_values.add(model_.node_critical_stretch);
+  const GhostsInFlight ghosts = decomposed_->send_ghosts(ghost_values);
+  lost_.assign(u[0].size(), 0.0);
+  BreakReport report =
+      model_.bond_model->break_bonds_and_add_force_overlapped(model_, u, f, w, true, lost_.data(), ghosts);
+  ghosts.wait();  // the terms read the ghosts' u (a law waits before its boundary rows anyway)
   reduce_break_report(report);
   return report;
 }

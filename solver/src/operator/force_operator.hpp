@@ -33,9 +33,9 @@ class ForceOperator {
 
   // A decomposed run (issue 15): the model is this rank's piece (parallel/local_model), and the
   // ghosts' displacements come from their owners while the law sweeps the rows that read no ghost
-  // (parallel/row_split.hpp: evaluate, break_bonds_and_evaluate, apply_jacobian); energies and
-  // break reports are reduced over the ranks in an order that does not depend on them. Null (the
-  // default): serial.
+  // (parallel/row_split.hpp: evaluate, break_bonds_and_evaluate, break_bonds, apply_jacobian);
+  // energies and break reports are reduced over the ranks in an order that does not depend on
+  // them. Null (the default): serial.
   void set_decomposed(const Decomposed* d);
   const Decomposed* decomposed() const { return decomposed_; }
 
@@ -47,8 +47,9 @@ class ForceOperator {
   BreakReport break_bonds_and_evaluate(State& s, double t);
   // Only the breaking: bonds over their critical stretch at s.u break (the implicit integrators
   // break after a converged solve, then solve again). Serial: the law's break_bonds, as before.
-  // Decomposed: the ghosts' u first, the count summed over the ranks and the energy in node order
-  // (as break_bonds_and_evaluate). Collective on a decomposed run.
+  // Decomposed: the pass of break_bonds_and_evaluate into scratch force arrays (the ghosts' u, and
+  // LAMMPS's s0, overlapped with the interior rows), the count summed over the ranks and the energy
+  // in node order. Collective on a decomposed run.
   BreakReport break_bonds(State& s);
   // Whether any bond of the whole model is broken (collective on a decomposed run).
   bool any_broken() const;
@@ -134,6 +135,10 @@ class ForceOperator {
   // report.broken and report.energy summed over the ranks from this rank's count and lost_, in one
   // reduction (decomposed only).
   void reduce_break_report(BreakReport& report);
+  // A decomposed run's breaking pass with the force into f and w (break_bonds_and_evaluate's s.f and
+  // s.w, break_bonds' scratch arrays): u's ghosts (and LAMMPS's s0) travel while the law sweeps the
+  // interior rows; the report summed over the ranks.
+  BreakReport break_on_piece(Vec3Array& u, Vec3Array& f, double* w);
 };
 
 }  // namespace pd

@@ -11,6 +11,7 @@
 #include "core/bonds.hpp"
 #include "core/exact_sum.hpp"
 #include "core/nodes.hpp"
+#include "parallel/node_columns.hpp"
 #include "parallel/row_split.hpp"
 
 namespace pd {
@@ -29,27 +30,28 @@ class NodeHalo {
 class Decomposed {
  public:
   virtual ~Decomposed() = default;
-  // Sets the ghost entries of a local per-node array (e.g. the displacement) to their owners'
-  // values: exact copies, so a row sums the same bits as on one rank.
-  virtual void update_ghosts(Vec3Array& a) const = 0;
-  // The same for a scalar per node (LPS's P_i between its two sweeps).
-  virtual void update_ghosts(std::vector<double>& a) const = 0;
+  // Sets the ghost entries of local per-node arrays (the displacement; LPS's P_i between its two
+  // sweeps; several at once: parallel/node_columns.hpp) to their owners' values: exact copies, so a
+  // row sums the same bits as on one rank. Collective.
+  void update_ghosts(const NodeColumns& a) const {
+    begin_update_ghosts(a);
+    end_update_ghosts(a);
+  }
   // update_ghosts in two halves, so that the rows that read no ghost are swept while the values
   // travel (parallel/row_split.hpp says why and how): begin sends a's owned entries to the ranks
-  // that hold them as ghosts and returns; end waits and sets a's ghost entries. Nothing may write
-  // a's owned entries or read its ghost entries in between, and one exchange runs at a time.
-  virtual void begin_update_ghosts(const Vec3Array& a) const = 0;
-  virtual void end_update_ghosts(Vec3Array& a) const = 0;
-  virtual void begin_update_ghosts(const std::vector<double>& a) const = 0;
-  virtual void end_update_ghosts(std::vector<double>& a) const = 0;
+  // that hold them as ghosts and returns; end (with the same arrays) waits and sets a's ghost
+  // entries. Nothing may write a's owned entries or read its ghost entries in between, and one
+  // exchange runs at a time.
+  virtual void begin_update_ghosts(const NodeColumns& a) const = 0;
+  virtual void end_update_ghosts(const NodeColumns& a) const = 0;
   // The piece's owned rows split into those that read no ghost and the others, made once with the
   // piece (its rows never change).
   virtual const RowSplit& row_split() const = 0;
-  // begin_update_ghosts(a) and the handle a law's overlapped sweep waits on (row_split.hpp): its
-  // wait() ends this exchange, once. a must outlive the handle.
-  GhostsInFlight send_ghosts(Vec3Array& a) const {
+  // begin_update_ghosts(a) and the handle an overlapped sweep waits on (row_split.hpp): its wait()
+  // ends this exchange, once. a's arrays must outlive the handle.
+  GhostsInFlight send_ghosts(const NodeColumns& a) const {
     begin_update_ghosts(a);
-    return GhostsInFlight(row_split(), [this, &a] { end_update_ghosts(a); });
+    return GhostsInFlight(row_split(), [this, a] { end_update_ghosts(a); });
   }
   // start + Σ over owned local nodes of per_node[l], summed exactly (core/exact_sum.hpp) and rounded
   // once, the same on every rank: the bits do not depend on the rank or thread count, and equal

@@ -61,10 +61,9 @@ HaloExchange::HaloExchange(MPI_Comm comm, const LocalPiece& piece, const std::ve
   requests_.resize(send_rank_.size() + recv_rank_.size());
 }
 
-// Tags: one per kind of array, though one exchange at a time runs anyway (begin refuses a second).
+// Tags: one per width, though one exchange at a time runs anyway (begin refuses a second).
 namespace {
-constexpr int kVectorTag = 15;  // issue 15
-constexpr int kScalarTag = 16;
+constexpr int kTagBase = 15;  // issue 15
 }  // namespace
 
 void HaloExchange::post(int width, int tag) const {
@@ -82,44 +81,29 @@ void HaloExchange::post(int width, int tag) const {
   requests_posted_ = q;
 }
 
-void HaloExchange::begin(const std::vector<double>& a) const {
-  if (in_flight_) throw std::logic_error("HaloExchange::begin: an exchange is already under way");
-  for (std::size_t k = 0; k < send_node_.size(); ++k) send_buffer_[k] = a[static_cast<std::size_t>(send_node_[k])];
-  post(1, kScalarTag);
-  in_flight_ = 1;
-}
-
-void HaloExchange::end(std::vector<double>& a) const {
-  if (in_flight_ != 1) throw std::logic_error("HaloExchange::end: no exchange of a scalar under way");
-  MPI_Waitall(static_cast<int>(requests_posted_), requests_.data(), MPI_STATUSES_IGNORE);
-  for (std::size_t k = 0; k < recv_node_.size(); ++k) a[static_cast<std::size_t>(recv_node_[k])] = recv_buffer_[k];
-  in_flight_ = 0;
-}
-
-void HaloExchange::exchange(std::vector<double>& a) const {
-  begin(a);
-  end(a);
-}
-
-void HaloExchange::begin(const Vec3Array& a) const {
+void HaloExchange::begin(const NodeColumns& a) const {
   if (in_flight_) throw std::logic_error("HaloExchange::begin: an exchange is already under way");
   const double start = MPI_Wtime();
-  // Node by node, three components together: one message per neighbour.
+  const auto width = static_cast<std::size_t>(a.width());
+  if (send_buffer_.size() < width * send_node_.size()) send_buffer_.resize(width * send_node_.size());
+  if (recv_buffer_.size() < width * recv_node_.size()) recv_buffer_.resize(width * recv_node_.size());
+  // Node by node, every array's entry together: one message per neighbour.
   for (std::size_t k = 0; k < send_node_.size(); ++k)
-    for (int d = 0; d < 3; ++d)
-      send_buffer_[3 * k + static_cast<std::size_t>(d)] = a[static_cast<std::size_t>(d)][static_cast<std::size_t>(send_node_[k])];
-  post(3, kVectorTag);
-  in_flight_ = 3;
+    for (std::size_t c = 0; c < width; ++c) send_buffer_[width * k + c] = a[static_cast<int>(c)][send_node_[k]];
+  post(a.width(), kTagBase + a.width());
+  in_flight_ = a.width();
+  messages_ += static_cast<std::int64_t>(send_rank_.size());
+  bytes_ += static_cast<std::int64_t>(width * send_node_.size() * sizeof(double));
   seconds_ += MPI_Wtime() - start;
 }
 
-void HaloExchange::end(Vec3Array& a) const {
-  if (in_flight_ != 3) throw std::logic_error("HaloExchange::end: no exchange of a Vec3Array under way");
+void HaloExchange::end(const NodeColumns& a) const {
+  if (in_flight_ != a.width()) throw std::logic_error("HaloExchange::end: no exchange of these arrays under way");
   const double start = MPI_Wtime();
+  const auto width = static_cast<std::size_t>(a.width());
   MPI_Waitall(static_cast<int>(requests_posted_), requests_.data(), MPI_STATUSES_IGNORE);
   for (std::size_t k = 0; k < recv_node_.size(); ++k)
-    for (int d = 0; d < 3; ++d)
-      a[static_cast<std::size_t>(d)][static_cast<std::size_t>(recv_node_[k])] = recv_buffer_[3 * k + static_cast<std::size_t>(d)];
+    for (std::size_t c = 0; c < width; ++c) a[static_cast<int>(c)][recv_node_[k]] = recv_buffer_[width * k + c];
   in_flight_ = 0;
   ++exchanges_;
   const double spent = MPI_Wtime() - start;
@@ -127,7 +111,7 @@ void HaloExchange::end(Vec3Array& a) const {
   wait_seconds_ += spent;
 }
 
-void HaloExchange::exchange(Vec3Array& a) const {
+void HaloExchange::exchange(const NodeColumns& a) const {
   begin(a);
   end(a);
 }

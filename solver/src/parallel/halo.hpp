@@ -5,8 +5,10 @@
 // order, so the owner packs and the receiver unpacks in one agreed order.
 //
 // An exchange runs whole (exchange) or in two halves (begin, end), so that a sweep of the rows
-// that read no ghost runs while the messages travel (parallel/row_split.hpp). One exchange at a
-// time: begin packs the owned values into one send buffer, end unpacks the one receive buffer.
+// that read no ghost runs while the messages travel (parallel/row_split.hpp). It carries one or
+// several per-node arrays (parallel/node_columns.hpp) node by node in one message per neighbour.
+// One exchange at a time: begin packs the owned values into one send buffer, end unpacks the one
+// receive buffer.
 #pragma once
 #include <mpi.h>
 
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "core/nodes.hpp"
+#include "parallel/node_columns.hpp"
 #include "parallel/local_model.hpp"
 
 namespace pd {
@@ -23,27 +26,27 @@ class HaloExchange {
   // Collective over comm. owner: the rank of every global node (parallel/decomposition).
   HaloExchange(MPI_Comm comm, const LocalPiece& piece, const std::vector<std::int32_t>& owner);
 
-  // a's ghost entries = their owners' entries (3 doubles per ghost). Collective over comm.
-  void exchange(Vec3Array& a) const;
-  // a's ghost entries = their owners' entries, for a scalar per node (1 double per ghost). Collective.
-  void exchange(std::vector<double>& a) const;
+  // The ghost entries of every array in a = their owners' entries (a.width() doubles per ghost, in
+  // one message per neighbour). Collective over comm.
+  void exchange(const NodeColumns& a) const;
   // exchange in two halves: begin posts the receives, packs a's owned entries and sends them
-  // (MPI_Irecv, MPI_Isend) and returns; end waits for the messages (MPI_Waitall) and writes a's
-  // ghost entries. Between them a's ghost entries are not yet their owners' values, and no other
-  // exchange of this halo may begin. Collective over the neighbours.
-  void begin(const Vec3Array& a) const;
-  void end(Vec3Array& a) const;
-  void begin(const std::vector<double>& a) const;
-  void end(std::vector<double>& a) const;
+  // (MPI_Irecv, MPI_Isend) and returns; end (with the same arrays) waits for the messages
+  // (MPI_Waitall) and writes a's ghost entries. Between them a's ghost entries are not yet their
+  // owners' values, and no other exchange of this halo may begin. Collective over the neighbours.
+  void begin(const NodeColumns& a) const;
+  void end(const NodeColumns& a) const;
 
-  // Per exchange, from this rank: messages sent and bytes sent (of payload).
+  // Per exchange, from this rank: messages sent and bytes sent (of payload) for a Vec3Array.
   std::int64_t messages_sent() const { return static_cast<std::int64_t>(send_rank_.size()); }
   std::int64_t bytes_sent() const { return static_cast<std::int64_t>(send_node_.size()) * 3 * 8; }
   std::int64_t ghosts() const { return static_cast<std::int64_t>(recv_node_.size()); }
-  // Exchanges of Vec3Arrays so far and the wall time spent in them (packing, MPI, unpacking;
-  // of a split exchange, in begin and end only: not the sweep between them), and of that the time
-  // in end (the wait for messages the sweep did not hide, and the unpacking).
+  // Exchanges so far (of any arrays), their messages and payload bytes sent, and the wall time
+  // spent in them (packing, MPI, unpacking; of a split exchange, in begin and end only: not the
+  // sweep between them), and of that the time in end (the wait for messages the sweep did not
+  // hide, and the unpacking).
   std::int64_t exchanges() const { return exchanges_; }
+  std::int64_t messages() const { return messages_; }
+  std::int64_t bytes() const { return bytes_; }
   double seconds() const { return seconds_; }
   double wait_seconds() const { return wait_seconds_; }
 
@@ -55,9 +58,9 @@ class HaloExchange {
   std::vector<std::int32_t> send_node_, recv_node_;
   mutable std::vector<double> send_buffer_, recv_buffer_;
   mutable std::vector<MPI_Request> requests_;
-  mutable std::int64_t exchanges_ = 0;
+  mutable std::int64_t exchanges_ = 0, messages_ = 0, bytes_ = 0;
   mutable double seconds_ = 0.0, wait_seconds_ = 0.0;
-  mutable int in_flight_ = 0;  // 0: none; 3: a Vec3Array's; 1: a scalar's (begin → end)
+  mutable int in_flight_ = 0;  // 0: none; else the width of the exchange under way (begin → end)
   mutable std::size_t requests_posted_ = 0;
   void post(int width, int tag) const;  // the receives, then the sends of the packed buffer
 };

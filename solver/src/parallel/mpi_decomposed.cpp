@@ -121,8 +121,8 @@ std::string MpiDecomposed::broadcast(const std::string& bytes) const {
 Decomposed::Traffic MpiDecomposed::traffic() const {
   Traffic t;
   t.halo_exchanges = halo_->exchanges();
-  t.halo_messages = halo_->exchanges() * halo_->messages_sent();
-  t.halo_bytes = halo_->exchanges() * halo_->bytes_sent();
+  t.halo_messages = halo_->messages();
+  t.halo_bytes = halo_->bytes();
   t.halo_seconds = halo_->seconds();
   t.halo_wait_seconds = halo_->wait_seconds();
   t.reductions = reductions_;

@@ -37,13 +37,16 @@ class MpiDecomposed : public Decomposed {
   const LocalPiece& piece() const override { return piece_; }
   const HaloExchange& halo() const { return *halo_; }
 
-  void update_ghosts(Vec3Array& a) const override { halo_->exchange(a); }
-  void update_ghosts(std::vector<double>& a) const override { halo_->exchange(a); }
-  void begin_update_ghosts(const Vec3Array& a) const override { halo_->begin(a); }
-  void end_update_ghosts(Vec3Array& a) const override { halo_->end(a); }
-  void begin_update_ghosts(const std::vector<double>& a) const override { halo_->begin(a); }
-  void end_update_ghosts(std::vector<double>& a) const override { halo_->end(a); }
+  void begin_update_ghosts(const NodeColumns& a) const override { halo_->begin(a); }
+  void end_update_ghosts(const NodeColumns& a) const override { halo_->end(a); }
   const RowSplit& row_split() const override { return row_split_; }
+  // Every owned row a boundary row: each overlapped sweep then waits for its exchange before any row
+  // (the blocking exchange), the same bits. For a before/after of the overlap in one binary
+  // (pd_mpi_halo --blocking); a run never calls it.
+  void split_rows_for_blocking() {
+    row_split_.boundary = piece_.owned_local;
+    row_split_.interior.clear();
+  }
   double exact_sum(const std::vector<double>& per_node, double start = 0.0) const override;
   void reduce(ExactSum* sums, int count, std::int64_t* integers = nullptr, int integer_count = 0) const override;
   std::int64_t total(std::int64_t local) const override;

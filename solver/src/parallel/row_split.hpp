@@ -1,7 +1,7 @@
 // Why a rank's rows are split in two: the halo exchange overlapped with the bond sweep (issue 15).
 //
-// A decomposed force evaluation needs its ghosts' values (u; LPS's P_j between its two sweeps) from
-// their owners. An owned row whose bond partners are all owned reads no ghost, so it can be swept
+// A decomposed force evaluation needs its ghosts' values (u; LAMMPS's s0 with u; LPS's P_j between
+// its two sweeps; x, then P_j and δP_j, for a J·x) from their owners. An owned row whose bond partners are all owned reads no ghost, so it can be swept
 // while those values are still on their way:
 //
 //   begin the exchange (MPI_Irecv / MPI_Isend, parallel/halo)
@@ -22,6 +22,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <type_traits>
 #include <vector>
 
 namespace pd {
@@ -49,9 +50,9 @@ struct RowSubset {
   std::int64_t at(std::int64_t r) const { return every ? r : row[r]; }
 };
 
-// An array's ghost values still on their way (Decomposed::begin_update_ghosts): what a law's
-// overlapped sweep (materials/bond_model.hpp) gets. It sweeps rows.interior, calls wait(), which
-// returns once every ghost entry holds its owner's value, then sweeps rows.boundary. wait() ends
+// Arrays' ghost values still on their way (Decomposed::send_ghosts): what a law's overlapped sweep
+// (materials/bond_model.hpp) gets. It sweeps rows.interior, calls wait(), which returns once every
+// ghost entry holds its owner's value, then sweeps rows.boundary (sweep_overlapped below). wait() ends
 // the exchange once; later calls do nothing, so the operator calls it again after the law, for a
 // law that did not need to.
 class GhostsInFlight {
@@ -71,5 +72,24 @@ class GhostsInFlight {
   std::function<void()> end_;
   mutable bool waited_ = false;
 };
+
+// The overlapped sweep in one place, for every law and every sweep that reads ghost values
+// (parallel/row_split.hpp above): sweep(interior rows) while the ghosts travel, ghosts.wait(), then
+// sweep(boundary rows). sweep takes a RowSubset; what it returns (a count of broken bonds) is added
+// over the two halves, or it returns nothing.
+template <class Sweep>
+auto sweep_overlapped(const GhostsInFlight& ghosts, Sweep&& sweep) {
+  using Result = decltype(sweep(RowSubset{}));
+  if constexpr (std::is_void_v<Result>) {
+    sweep(RowSubset::of(ghosts.rows.interior));
+    ghosts.wait();
+    sweep(RowSubset::of(ghosts.rows.boundary));
+  } else {
+    Result result = sweep(RowSubset::of(ghosts.rows.interior));
+    ghosts.wait();
+    result += sweep(RowSubset::of(ghosts.rows.boundary));
+    return result;
+  }
+}
 
 }  // namespace pd

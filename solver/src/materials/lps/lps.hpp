@@ -109,6 +109,10 @@ class LpsModel : public BondModel {
   void apply_reference_stiffness(const Model& model, const std::array<double, 3>& period, const Vec3Array& x,
                                  Vec3Array& y) const override;
   void add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const override;
+  // Both sweeps of J·x overlapped with the exchanges they need, x's and then P's with δP's
+  // (lps_kernel.cpp; parallel/row_split.hpp says why).
+  void add_jacobian_product_overlapped(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                       const GhostsInFlight& x_ghosts) const override;
   bool bond_tangent_row(const Model&, const Vec3Array&, std::size_t, double*, bool = false) const override {
     return false;  // state-based: f_i depends on the neighbours' neighbours; solvers stay matrix-free
   }

@@ -252,17 +252,13 @@ void force_sweep(const LpsKernel& k, const std::vector<double>& theta, const std
 // as the plain sweeps after blocking exchanges, bit for bit. Returns the bonds broken (each once).
 std::int64_t overlapped_sweeps(const LpsKernel& k, const Breaking* br, const Decomposed& d, const GhostsInFlight& u_ghosts,
                                Vec3Array& f, double* w) {
-  const RowSubset interior = RowSubset::of(u_ghosts.rows.interior), boundary = RowSubset::of(u_ghosts.rows.boundary);
   std::vector<double> theta, p;
-  std::int64_t broken = dilatation_sweep(k, br, theta, p, interior);
-  u_ghosts.wait();
-  broken += dilatation_sweep(k, br, theta, p, boundary);
+  const std::int64_t broken =
+      sweep_overlapped(u_ghosts, [&](RowSubset rows) { return dilatation_sweep(k, br, theta, p, rows); });
   // P_j of the ghosts, after their owners broke their rows: both ends of a crossing bond broke it
   // in this sweep (the same stretch from exact copies of u), so P_j is the serial one.
-  d.begin_update_ghosts(p);
-  force_sweep(k, theta, p, f, w, interior);
-  d.end_update_ghosts(p);
-  force_sweep(k, theta, p, f, w, boundary);
+  const GhostsInFlight p_ghosts = d.send_ghosts(p);
+  sweep_overlapped(p_ghosts, [&](RowSubset rows) { force_sweep(k, theta, p, f, w, rows); });
   return broken;
 }
 
@@ -356,12 +352,16 @@ std::vector<double> LpsModel::dilatation(const Model& model, const Vec3Array& u)
 //   δf_i += V_j { ω[|ξ|(δP_i + δP_j) + (a_i + a_j) n·δη] n + T (δη − n (n·δη))/y },
 // T = t_ij + t_ji (the rotation of a loaded bond). Bonds crushed to a point (y = 0) carry no force
 // and have no direction: left out, as the kernel leaves their force out.
-void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
-  const LpsKernel k(*this, model, u);
-  const auto n = static_cast<std::size_t>(k.nodes);
-  std::vector<double> p(n), dp(n);
+namespace {
+
+// J·x's sweep 1 over `rows`: P_i at u and δP_i = γ_i δθ_i (P is linear in θ at fixed m'), which
+// read u and x of the row's far ends. p and dp are sized to the nodes; only the rows' entries are set.
+void jacobian_dilatation_sweep(const LpsKernel& k, const Vec3Array& x, std::vector<double>& p, std::vector<double>& dp,
+                               RowSubset rows) {
+  const std::int64_t count = rows.size(k.nodes);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < k.nodes; ++i) {
+  for (std::int64_t r = 0; r < count; ++r) {
+    const std::int64_t i = rows.at(r);
     double st = 0.0, sd = 0.0, sm = 0.0;
     for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
       if (k.broken[q]) continue;
@@ -378,10 +378,15 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
     p[static_cast<std::size_t>(i)] = k.p_of(i, theta, sm);
     dp[static_cast<std::size_t>(i)] = k.p_of(i, k.theta_of(i, sd), sm);  // P is linear in θ at fixed m'
   }
-  // A decomposed run (issue 15): the ghosts' P and δP from their owners, for the second sweep.
-  if (decomposed_) decomposed_->update_ghosts(p), decomposed_->update_ghosts(dp);
+}
+
+// J·x's sweep 2 over `rows`: y_i += δf_i from the row's bonds and P, δP of both ends.
+void jacobian_force_sweep(const LpsKernel& k, const Vec3Array& x, const std::vector<double>& p,
+                          const std::vector<double>& dp, Vec3Array& y, RowSubset rows) {
+  const std::int64_t count = rows.size(k.nodes);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < k.nodes; ++i) {
+  for (std::int64_t r = 0; r < count; ++r) {
+    const std::int64_t i = rows.at(r);
     const auto iu = static_cast<std::size_t>(i);
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
     for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
@@ -405,6 +410,38 @@ void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, cons
     y[1][iu] += s1;
     y[2][iu] += s2;
   }
+}
+
+}  // namespace
+
+// δf = J(u)·x in the same two sweeps: δθ_i = (d/m_i) Σ ω|ξ| (n·δη) V_j, δP_i = γ_i δθ_i with
+// γ_i = P_i/θ_i (m'_i does not depend on u), and per bond, n = e/y, δη = x_j − x_i,
+//   δf_i += V_j { ω[|ξ|(δP_i + δP_j) + (a_i + a_j) n·δη] n + T (δη − n (n·δη))/y },
+// T = t_ij + t_ji (the rotation of a loaded bond). Bonds crushed to a point (y = 0) carry no force
+// and have no direction: left out, as the kernel leaves their force out.
+void LpsModel::add_jacobian_product(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y) const {
+  const LpsKernel k(*this, model, u);
+  const auto n = static_cast<std::size_t>(k.nodes);
+  std::vector<double> p(n), dp(n);
+  jacobian_dilatation_sweep(k, x, p, dp, RowSubset{});
+  // A decomposed run (issue 15): the ghosts' P and δP from their owners, in one exchange.
+  if (decomposed_) decomposed_->update_ghosts(NodeColumns(p).add(dp));
+  jacobian_force_sweep(k, x, p, dp, y, RowSubset{});
+}
+
+// Both sweeps overlapped with the exchanges they need (parallel/row_split.hpp), as the force's
+// (overlapped_sweeps): sweep 1 over the interior rows while x's ghosts travel, then the boundary
+// rows; P and δP of every owned node then travel together while sweep 2 goes over the interior
+// rows, then over the boundary rows. The same y as add_jacobian_product after blocking exchanges.
+void LpsModel::add_jacobian_product_overlapped(const Model& model, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
+                                               const GhostsInFlight& x_ghosts) const {
+  if (!decomposed_) return BondModel::add_jacobian_product_overlapped(model, u, x, y, x_ghosts);
+  const LpsKernel k(*this, model, u);
+  const auto n = static_cast<std::size_t>(k.nodes);
+  std::vector<double> p(n, 0.0), dp(n, 0.0);
+  sweep_overlapped(x_ghosts, [&](RowSubset rows) { jacobian_dilatation_sweep(k, x, p, dp, rows); });
+  const GhostsInFlight p_ghosts = decomposed_->send_ghosts(NodeColumns(p).add(dp));
+  sweep_overlapped(p_ghosts, [&](RowSubset rows) { jacobian_force_sweep(k, x, p, dp, y, rows); });
 }
 
 }  // namespace pd

@@ -56,7 +56,7 @@ bool LpsModel::jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, 
     b[3 * iu] = b0, b[3 * iu + 1] = b1, b[3 * iu + 2] = b2;
   }
   // A decomposed run (issue 15): the far ends' P and γ of the ghosts from their owners.
-  if (decomposed_) decomposed_->update_ghosts(p), decomposed_->update_ghosts(gamma);
+  if (decomposed_) decomposed_->update_ghosts(NodeColumns(p).add(gamma));  // one exchange
   // Sweep 2: the block of each node, from its own bonds and the γ, m, a, P of their far ends.
   blocks.assign(9 * n, 0.0);
 #pragma omp parallel for schedule(static)

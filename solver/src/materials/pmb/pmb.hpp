@@ -105,8 +105,13 @@ bool uses_lammps_rules(const Model& model);
 // decomposed run) gets each node's share instead, as break_bonds_and_add_pmb_force. Each row writes
 // only its own flags and s0: the same for any thread count. Returns the bonds broken now, each
 // counted once.
+// ghosts (a decomposed run): u's ghosts and, with per-node s0, node_critical_stretch's are still on
+// their way (one exchange, operator/force_operator): the pass sweeps the interior rows, waits, then
+// the boundary rows (parallel/row_split.hpp); the new s0 replace the old once both halves have
+// read them. The same bits as the pass over every row after the exchange.
 std::int64_t break_bonds_lammps_rules(Model& model, const Vec3Array& u, Vec3Array* f, double* energy_density,
-                                      double* broken_energy, double* lost_per_node = nullptr);
+                                      double* broken_energy, double* lost_per_node = nullptr,
+                                      const GhostsInFlight* ghosts = nullptr);
 
 // U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
 // summed serially in node order, so the value does not depend on the thread count.
@@ -132,8 +137,8 @@ class PmbModel : public BondModel {
   BreakReport break_bonds_and_add_force(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                         bool want_energy, double* lost_per_node = nullptr) const override;
   // The interior rows while u's ghosts travel, then the boundary rows (parallel/row_split.hpp).
-  // LAMMPS's rules (uses_lammps_rules) keep the plain order: their pass ends by replacing every
-  // node's s0 at once, after all rows have read the old one.
+  // LAMMPS's rules (uses_lammps_rules) too: their pass replaces every node's s0 at once after both
+  // halves have read the old one, whose ghost values travel with u's (u_ghosts).
   void add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                             const GhostsInFlight& u_ghosts) const override;
   BreakReport break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,

@@ -270,71 +270,88 @@ std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Arr
 bool uses_lammps_rules(const Model& m) { return m.break_after_force || !m.node_critical_stretch.empty(); }
 
 std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f, double* energy_density,
-                                      double* broken_energy, double* lost_per_node) {
+                                      double* broken_energy, double* lost_per_node, const GhostsInFlight* ghosts) {
   const PmbArrays a = pmb_arrays(m, u);
+  // Every row at once, or the interior rows while the ghosts travel and then the boundary rows.
+  const auto sweep = [&](auto&& pass) { return ghosts ? sweep_overlapped(*ghosts, pass) : pass(RowSubset{}); };
   if (!m.material.can_break()) {  // nothing can break: the force alone, as the thesis path
-    if (f) add_pmb_force_density(a, (*f)[0].data(), (*f)[1].data(), (*f)[2].data(), energy_density);
+    if (f)
+      sweep([&](RowSubset rows) {
+        return add_pmb_force_density(a, (*f)[0].data(), (*f)[1].data(), (*f)[2].data(), energy_density, nullptr, rows);
+      });
+    else if (ghosts) ghosts->wait();
     return 0;
   }
   const auto n = static_cast<std::size_t>(a.nodes);
   const bool node_rule = !m.node_critical_stretch.empty();
   const bool force_first = m.break_after_force;
   const double* s0_node = node_rule ? m.node_critical_stretch.data() : nullptr;
-  std::vector<double> s0_next(node_rule ? n : 0);
+  // A row not swept (a ghost's, on a decomposed run: its row is empty) keeps +inf, as a row without
+  // intact bonds gets in the sweep (LAMMPS's DBL_MAX).
+  std::vector<double> s0_next(node_rule ? n : 0, std::numeric_limits<double>::infinity());
   std::vector<double> lost(broken_energy && !lost_per_node ? n : 0, 0.0);
   double* lost_out = lost_per_node ? lost_per_node : (broken_energy ? lost.data() : nullptr);
   std::uint8_t* broken = m.bonds.broken.data();
   const double* s0_pair = m.material.critical_pair.data();
   const double* alpha_pair = m.material.alpha_pair.data();
   const std::uint8_t* no_fail = m.no_fail.data();
-  std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
+  // One pass over `rows`: each row reads the previous pass's s0 of both ends (s0_node, ghosts
+  // included) and writes only its own flags, s0_next, lost and force, so the rows may be swept in
+  // any order and in two halves (parallel/row_split.hpp): the same bits.
+  const auto pass = [&](RowSubset rows) {
+    std::int64_t newly = 0;  // integer sum: exact, so the reduction order does not matter
+    const std::int64_t count = rows.size(a.nodes);
 #pragma omp parallel for schedule(static) reduction(+ : newly)
-  for (std::int64_t i = 0; i < a.nodes; ++i) {
-    const auto iu = static_cast<std::size_t>(i);
-    RowSums r{0.0, 0.0, 0.0, 0.0, 0};
-    // LAMMPS order: the force of every bond intact at the start of the pass, those breaking now too.
-    if (f && force_first) r = a.factor ? pmb_row<false, false, true>(a, i, nullptr) : pmb_row<false, false>(a, i, nullptr);
-    const double* c_row = a.c_pair + a.block[i] * a.blocks;
-    const double* s0_row = s0_pair + a.block[i] * a.blocks;
-    const double* alpha_row = alpha_pair + a.block[i] * a.blocks;
-    const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
-    const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
-    double next = std::numeric_limits<double>::infinity();  // a node without intact bonds: LAMMPS's DBL_MAX
-    bool first = true;
-    double lost_i = 0.0;
-    for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
-      if (broken[k]) continue;
-      const std::int64_t j = a.neighbour[k];
-      const BondTerms b = bond_terms(a, xi, yi, j);
-      const std::int32_t bj = a.block[j];
-      if (node_rule) {  // s0_i for the next pass, from this pass's stretches (bonds breaking now too)
-        const double candidate = s0_row[bj] - alpha_row[bj] * b.s;
-        next = first ? candidate : std::max(next, candidate);
-        first = false;
+    for (std::int64_t r_at = 0; r_at < count; ++r_at) {
+      const std::int64_t i = rows.at(r_at);
+      const auto iu = static_cast<std::size_t>(i);
+      RowSums r{0.0, 0.0, 0.0, 0.0, 0};
+      // LAMMPS order: the force of every bond intact at the start of the pass, those breaking now too.
+      if (f && force_first) r = a.factor ? pmb_row<false, false, true>(a, i, nullptr) : pmb_row<false, false>(a, i, nullptr);
+      const double* c_row = a.c_pair + a.block[i] * a.blocks;
+      const double* s0_row = s0_pair + a.block[i] * a.blocks;
+      const double* alpha_row = alpha_pair + a.block[i] * a.blocks;
+      const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
+      const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
+      double next = std::numeric_limits<double>::infinity();  // a node without intact bonds: LAMMPS's DBL_MAX
+      bool first = true;
+      double lost_i = 0.0;
+      for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
+        if (broken[k]) continue;
+        const std::int64_t j = a.neighbour[k];
+        const BondTerms b = bond_terms(a, xi, yi, j);
+        const std::int32_t bj = a.block[j];
+        if (node_rule) {  // s0_i for the next pass, from this pass's stretches (bonds breaking now too)
+          const double candidate = s0_row[bj] - alpha_row[bj] * b.s;
+          next = first ? candidate : std::max(next, candidate);
+          first = false;
+        }
+        // The previous pass's s0 at both ends: both copies of the bond see the same threshold and
+        // bitwise the same stretch, so they break in the same pass.
+        const double s0 = node_rule ? std::min(s0_node[i], s0_node[j]) : s0_row[bj];
+        if (!(b.s > s0) || no_fail[i] || no_fail[j]) continue;
+        broken[k] = 1;
+        if (i < j) {
+          ++newly;
+          double e = broken_bond_energy(c_row[bj], s0, b.length, a.volume_weight(b.length), a.volume[i], a.volume[j]);
+          if (a.factor) e *= a.factor[k];  // the surface correction scales c of this bond
+          lost_i += e;
+        }
       }
-      // The previous pass's s0 at both ends: both copies of the bond see the same threshold and
-      // bitwise the same stretch, so they break in the same pass.
-      const double s0 = node_rule ? std::min(s0_node[i], s0_node[j]) : s0_row[bj];
-      if (!(b.s > s0) || no_fail[i] || no_fail[j]) continue;
-      broken[k] = 1;
-      if (i < j) {
-        ++newly;
-        double e = broken_bond_energy(c_row[bj], s0, b.length, a.volume_weight(b.length), a.volume[i], a.volume[j]);
-        if (a.factor) e *= a.factor[k];  // the surface correction scales c of this bond
-        lost_i += e;
+      if (node_rule) s0_next[iu] = next;
+      if (lost_out) lost_out[iu] = lost_i;
+      // Thesis order: the force from the flags after breaking (a bond over s0 adds no force).
+      if (f && !force_first) r = a.factor ? pmb_row<false, false, true>(a, i, nullptr) : pmb_row<false, false>(a, i, nullptr);
+      if (f) {
+        (*f)[0][iu] += r.f0;
+        (*f)[1][iu] += r.f1;
+        (*f)[2][iu] += r.f2;
+        if (energy_density) energy_density[iu] = r.w;
       }
     }
-    if (node_rule) s0_next[iu] = next;
-    if (lost_out) lost_out[iu] = lost_i;
-    // Thesis order: the force from the flags after breaking (a bond over s0 adds no force).
-    if (f && !force_first) r = a.factor ? pmb_row<false, false, true>(a, i, nullptr) : pmb_row<false, false>(a, i, nullptr);
-    if (f) {
-      (*f)[0][iu] += r.f0;
-      (*f)[1][iu] += r.f1;
-      (*f)[2][iu] += r.f2;
-      if (energy_density) energy_density[iu] = r.w;
-    }
-  }
+    return newly;
+  };
+  const std::int64_t newly = sweep(pass);
   if (node_rule) m.node_critical_stretch.swap(s0_next);  // every row read the previous s0 above
   if (broken_energy && !lost_per_node && newly > 0)
     *broken_energy += exact_sum(lost);  // exact, as update_broken_bonds

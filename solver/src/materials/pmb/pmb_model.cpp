@@ -23,9 +23,7 @@ BreakReport PmbModel::break_bonds_and_add_force(Model& model, const Vec3Array& u
 
 void PmbModel::add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                     const GhostsInFlight& u_ghosts) const {
-  add_pmb_force(model, u, f, w, RowSubset::of(u_ghosts.rows.interior));
-  u_ghosts.wait();
-  add_pmb_force(model, u, f, w, RowSubset::of(u_ghosts.rows.boundary));
+  sweep_overlapped(u_ghosts, [&](RowSubset rows) { add_pmb_force(model, u, f, w, rows); });
 }
 
 BreakReport PmbModel::break_bonds_and_add_force_overlapped(Model& model, const Vec3Array& u, Vec3Array& f, double* w,
@@ -33,14 +31,19 @@ BreakReport PmbModel::break_bonds_and_add_force_overlapped(Model& model, const V
                                                            const GhostsInFlight& u_ghosts) const {
   // Without lost_per_node the energy of the broken bonds is summed over every row at once:
   // not a split sweep's (a decomposed run always passes it, operator/force_operator).
-  if (uses_lammps_rules(model) || !lost_per_node)
+  if (!lost_per_node)
     return BondModel::break_bonds_and_add_force_overlapped(model, u, f, w, want_energy, lost_per_node, u_ghosts);
+  BreakReport r;
+  // LAMMPS's rules: the pass splits itself around the wait (break_bonds_lammps_rules).
+  if (uses_lammps_rules(model)) {
+    r.broken = break_bonds_lammps_rules(model, u, &f, w, nullptr, lost_per_node, &u_ghosts);
+    return r;
+  }
   // A row breaks only its own copies of its bonds (both copies of a crossing bond see the same
   // stretch), so the interior rows may break theirs before the boundary rows have u's ghosts.
-  BreakReport r;
-  r.broken = break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, RowSubset::of(u_ghosts.rows.interior));
-  u_ghosts.wait();
-  r.broken += break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, RowSubset::of(u_ghosts.rows.boundary));
+  r.broken = sweep_overlapped(u_ghosts, [&](RowSubset rows) {
+    return break_bonds_and_add_pmb_force(model, u, f, w, nullptr, lost_per_node, rows);
+  });
   return r;
 }
 
@@ -189,9 +192,7 @@ void PmbModel::add_jacobian_product(const Model& m, const Vec3Array& u, const Ve
 
 void PmbModel::add_jacobian_product_overlapped(const Model& m, const Vec3Array& u, const Vec3Array& x, Vec3Array& y,
                                                const GhostsInFlight& x_ghosts) const {
-  add_jacobian_rows(m, u, x, y, RowSubset::of(x_ghosts.rows.interior));
-  x_ghosts.wait();
-  add_jacobian_rows(m, u, x, y, RowSubset::of(x_ghosts.rows.boundary));
+  sweep_overlapped(x_ghosts, [&](RowSubset rows) { add_jacobian_rows(m, u, x, y, rows); });
 }
 
 bool PmbModel::bond_tangent_row(const Model& m, const Vec3Array& u, std::size_t i, double* blocks,
