@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -328,7 +327,6 @@ bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool sh
     at_start_.swapped = true;
   }
   have_factor_ = factor_->factorize(K);
-  if (std::getenv("PD_DEBUG_CUT")) std::fprintf(stderr, "factorise t1=%.9g u-step %d\n", t1, (int)at_start_.swapped);
   if (!have_factor_) return false;
   ++factorisations_;
   factor_u_ = s.u;
@@ -660,6 +658,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     ~Off() { active = false; }
   } off{at_start_.active};
   int cuts = 0;
+  cut_to_ = 0.0;
   std::optional<StretchRatio> start_ratio;
   for (;;) {
     const double t1 = t + h;
@@ -704,8 +703,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       // Nothing was broken in the trial; its factorisation (or hierarchy), if it made one, is put back.
       restore_solver();
       ++cuts, ++cuts_;
-      if (std::getenv("PD_DEBUG_CUT")) std::fprintf(stderr, "cut t=%.9g h=%.9g -> %.9g\n", t, h, cut_to);
-      h = cut_to;
+      h = cut_to_ = cut_to;
       continue;
     }
     if (converged) {

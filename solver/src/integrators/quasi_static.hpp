@@ -111,6 +111,9 @@ class QuasiStatic : public Integrator {
   int amg_setups() const { return amg_setups_; }  // since configure (not checkpointed)
   // Load steps cut to the first bond failure (see the head of this file), since configure (not checkpointed).
   int cuts() const { return cuts_; }
+  // The length the last step() was cut to, 0 if it was not cut: after a failure, the load step the
+  // body was found to fail in (mixed takes it as the first load step after a return from Verlet).
+  double cut_to() const { return cut_to_; }
   // The largest overshoot of the ratio s/s0 a load step keeps without a cut, and the cut's targets
   // 1 ∓ kCutMargin/2 (the head of this file).
   static constexpr double kCutMargin = 1e-3;
@@ -249,6 +252,7 @@ class QuasiStatic : public Integrator {
   double cut_step(State& start, State& end, double h, std::optional<StretchRatio>& start_ratio);
   void restore_solver();
   int cuts_ = 0;
+  double cut_to_ = 0.0;
 };
 
 }  // namespace pd
