@@ -681,7 +681,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       total += iterations;
       if (!converged) break;
       // Not from an explicit step's state: it is no equilibrium, so r is not linear in the load from it.
-      if (rounds == 0 && cuts < 2 && guess_from_velocity_ && h > dt_min_ * (1.0 + 1e-12)) cut_to = cut_step(state, s, h, start_ratio);
+      if (settings_.cut_to_first_failure && rounds == 0 && cuts < 2 && guess_from_velocity_ && h > dt_min_ * (1.0 + 1e-12))
+        cut_to = cut_step(state, s, h, start_ratio);
       if (cut_to > 0.0) break;
       const BreakReport broke = op_.break_bonds(s);
       if (broke.broken == 0) break;
@@ -791,6 +792,7 @@ std::vector<std::string> QuasiStatic::describe(double) const {
                    : std::string("; tangent factorised by CHOLMOD (direct, ")) +
           solver_reason_ + ")" + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
           " s, dt_max " + message_number(dt_max_) + " s" +
+          (settings_.cut_to_first_failure ? "; a load step past the first bond failure is cut back to it" : "") +
           (bond_based_ ? "; once bonds have broken, nodes hanging by bonds on one line and one side are left out of "
                          "each solve and placed on their bonds' line after it, and free fragments stay where they are"
                        : std::string())};

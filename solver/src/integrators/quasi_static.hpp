@@ -40,6 +40,7 @@
 // and the redone step. Nothing of the trial survives: no bond was broken, and a factorisation (or
 // an AMG hierarchy) made in it is made again where the one in use at the start of the step was
 // made (as load_state does), so the redone step is bitwise the step asked for directly.
+// quasi_static.cut_to_first_failure: false turns the cut off (the steps as before it).
 //
 // quasi_static.linear_solver: cg replaces the factorisation by matrix-free preconditioned CG
 // (linalg/pcg.hpp) on K Δu = V f, K x = −V ∂f/∂u·x from ForceOperator::apply_jacobian, with the
