@@ -681,7 +681,11 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       total += iterations;
       if (!converged) break;
       // Not from an explicit step's state: it is no equilibrium, so r is not linear in the load from it.
-      if (settings_.cut_to_first_failure && rounds == 0 && cuts < 2 && guess_from_velocity_ && h > dt_min_ * (1.0 + 1e-12))
+      // Only before any bond has broken (the first failure): once a crack grows, a load step cut to
+      // its next bond left the traction quasi_static run (full resolution) in loads where Newton
+      // found no equilibrium down to dt_min, where the uncut step had let the crack run through.
+      if (settings_.cut_to_first_failure && !broken_since_start_ && rounds == 0 && cuts < 2 && guess_from_velocity_ &&
+          h > dt_min_ * (1.0 + 1e-12))
         cut_to = cut_step(state, s, h, start_ratio);
       if (cut_to > 0.0) break;
       const BreakReport broke = op_.break_bonds(s);

@@ -27,7 +27,8 @@
 // and the step fails by breaking (unstable crack growth, where mixed switches to Verlet from the
 // start of the step, all of whose elastic range it then runs explicitly). So after the first
 // equilibrium of a load step t → t + h that started from the last load step's equilibrium (not from
-// an explicit step's state in mixed, which is none) with no bond over its critical stretch, if
+// an explicit step's state in mixed, which is none) with no bond over its critical stretch and none
+// broken yet (the first failure only: see step()), if
 // bonds are over it at the end (the law's own criterion: materials/bond_model.hpp StretchRatio) by
 // more than kCutMargin in the largest ratio r = s/s0, the step is redone to the load where r reaches
 // the target: below the first failure PMB's equilibrium is linear in the load (the displacements of
