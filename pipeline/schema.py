@@ -258,6 +258,11 @@ CASE = {
         max_breaking_rounds=Key("integer", "re-solves at one load while bonds keep breaking; more "
                                 "means unstable crack growth, and the run stops", default=100,
                                 minimum=1, maximum=100000000),
+        cut_to_first_failure=Key("boolean", "a load step that ends with bonds over their critical "
+                                 "stretch, from a start with none, is redone to the load at which the "
+                                 "largest stretch ratio reaches 1 (linear between the two), so that "
+                                 "the first bonds break at their load and not all at once past it",
+                                 default=True),
         linear_solver=Key("string", "the linear solve of each Newton iteration: direct (CHOLMOD "
                           "factorisation of the assembled tangent), cg (matrix-free conjugate "
                           "gradients with a block-Jacobi preconditioner, solved only as far as "

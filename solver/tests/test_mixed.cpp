@@ -34,8 +34,12 @@ pd::Model breakable_bar() {
   return pd::build_model(c, std::move(nodes));
 }
 
-pd::Case mixed_case(const std::string& start = "quasi_static") {
+pd::Case mixed_case(const std::string& start = "quasi_static", bool cut = false) {
   pd::Case c;
+  // The switching rules are tested on the bar as it snaps at a load step that overshoots the first
+  // bond failure (the step of kEnd/40 carries it past it): without the cut to the first failure
+  // (quasi_static.hpp), which the last tests here turn on.
+  c.quasi_static.cut_to_first_failure = cut;
   // The bar's material and horizon, as a run's case has them (the pause rule's δ/c).
   const pd::Case bar = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
   c.blocks = bar.blocks;
@@ -60,9 +64,9 @@ struct BarRun {
   pd::State state{model.nodes.size()};
   double t = 0.0, dt = 0.0;
   std::vector<std::string> log;
-  explicit BarRun(const std::string& start = "quasi_static", int pause_tries = 0) {
+  explicit BarRun(const std::string& start = "quasi_static", int pause_tries = 0, bool cut = false) {
     mixed.set_pause_tries(pause_tries);
-    mixed.configure(mixed_case(start));
+    mixed.configure(mixed_case(start, cut));
     mixed.initialize(state, 0.0);
     dt = *mixed.initial_dt();
   }
@@ -810,4 +814,47 @@ TEST(Mixed, ThePauseRuleGivesTheSameBitsForOneAndTwoThreads) {
   EXPECT_EQ(one.run.log, two.run.log);
   EXPECT_TRUE(same_bits(one.run.state.u, two.run.state.u));
   EXPECT_EQ(one.run.model.bonds.broken, two.run.model.bonds.broken);
+}
+
+TEST(Mixed, WithTheCutTheFirstBondsBreakFromTheLoadOfTheFirstFailureAndARestartContinuesBitwise) {
+  // With quasi_static.cut_to_first_failure (the default), the load step that overshoots the first
+  // bond failure is cut back to just below it, the next one to just past it: the first bonds break
+  // in a load step that starts within kCutMargin of the first failure (largest stretch ratio), not
+  // from the load step before the overshoot, which is further below without the cut. A run saved
+  // at its first explicit step continues bitwise.
+  const auto ratio_before_first_break = [](bool cut) {
+    BarRun run("quasi_static", 0, cut);
+    double before = 0.0;
+    const auto broken = [&run] { return std::count(run.model.bonds.broken.begin(), run.model.bonds.broken.end(), 1); };
+    while (run.t < kEnd * (1 - 1e-12)) {
+      before = run.op.stretch_ratio(run.state).largest;
+      run.step();
+      if (broken() > 0) break;
+    }
+    EXPECT_GT(broken(), 0);
+    EXPECT_EQ(run.mixed.cuts_in_use() > 0, cut);
+    return before;
+  };
+  const double with_cut = ratio_before_first_break(true), without = ratio_before_first_break(false);
+  EXPECT_GT(with_cut, 1.0 - pd::QuasiStatic::kCutMargin);
+  EXPECT_LE(with_cut, 1.0);
+  EXPECT_LT(without, 1.0 - pd::QuasiStatic::kCutMargin);
+  std::printf("largest stretch ratio where the first bonds break from: %.6f with the cut, %.6f without\n", with_cut, without);
+
+  // Saved at the first explicit step; a fresh run restored there goes on bitwise with the original.
+  BarRun a("quasi_static", 0, true), b("quasi_static", 0, true);
+  while (a.t < kEnd * (1 - 1e-12)) {
+    a.step();
+    if (*a.mixed.step_mode() == pd::Mixed::kExplicit) break;
+  }
+  ASSERT_GT(a.mixed.cuts_in_use(), 0);
+  b.state = a.state, b.t = a.t, b.dt = a.dt;
+  b.model.bonds.broken = a.model.bonds.broken;
+  b.mixed.load_state(a.mixed.save_state());
+  for (int k = 0; k < 40; ++k) {
+    a.step(), b.step();
+    ASSERT_EQ(*a.mixed.step_mode(), *b.mixed.step_mode()) << "step " << k;
+    ASSERT_TRUE(same_bits(a.state.u, b.state.u)) << "step " << k;
+    ASSERT_EQ(a.t, b.t);
+  }
 }

@@ -163,6 +163,20 @@ def test_case_json_compared_byte_for_byte_but_its_source_line(tmp_path):
     assert case_sha256(cases[0]) != case_sha256(cases[2])      # another speed
 
 
+def test_a_verlet_case_is_compared_without_the_load_steps_it_never_reads(tmp_path):
+    # mixed.yaml's quasi_static block rides along in the explicit cases: a Verlet run's hash leaves it
+    # out, a mixed run's does not; anything else still counts.
+    from bench.explicit_reuse import case_sha256
+
+    def case(name, integrator, dt_max, speed=0.5):
+        return qs.write(str(tmp_path / name), "run", {"time": {"integrator": integrator, "end": 1.0},
+                                                       "quasi_static": {"dt_initial": dt_max, "dt_max": dt_max},
+                                                       "speed": speed})
+    assert case_sha256(case("a", "verlet", 1e-4)) == case_sha256(case("b", "verlet", 1e-3))
+    assert case_sha256(case("c", "verlet", 1e-4)) != case_sha256(case("d", "verlet", 1e-4, 0.25))
+    assert case_sha256(case("e", "mixed", 1e-4)) != case_sha256(case("f", "mixed", 1e-3))
+
+
 def test_results_compare_without_the_energy_sums_but_with_every_column_the_benchmark_reads(tmp_path):
     # Two runs whose histories differ only in an energy sum's last digit (as after the exact sums
     # of 3 Dec 2026) have the same digests; a reaction that differs does not.

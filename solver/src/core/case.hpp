@@ -53,6 +53,8 @@ struct QuasiStaticSettings {
   double p = 2.0;              // exponent of eq. 2.8
   int max_iterations = 30;     // Newton iterations before the load step is cut
   int max_breaking_rounds = 100;  // re-solves at one load while bonds keep breaking, then unstable
+  // A load step that overshoots the first bond failure is redone to it (integrators/quasi_static.hpp).
+  bool cut_to_first_failure = true;
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-6, end/10
   // The linear solve of each Newton iteration (integrators/quasi_static.hpp): "direct" (CHOLMOD),
   // "cg" (matrix-free preconditioned CG, an inexact Newton–Krylov iteration) or "auto" (cg when the

@@ -107,6 +107,8 @@ class Mixed : public Integrator {
   // Failed tries before the pause rule is given up (kPauseTries; 0 switches the rule off: the tests
   // of the other rules). Before configure().
   void set_pause_tries(int tries) { pause_tries_ = tries; }
+  // Load steps cut to the first bond failure (quasi_static.hpp), since configure.
+  int cuts_in_use() const { return home_ == kImplicit ? 0 : static_.cuts(); }
   int factorisations_in_use() const { return home_ == kImplicit ? implicit_.factorisations() : static_.factorisations(); }
   Mode home() const { return home_; }  // mixed.start: the scheme away from a running crack
 

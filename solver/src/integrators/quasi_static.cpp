@@ -151,6 +151,10 @@ void QuasiStatic::choose_preconditioner(const Case& c, std::size_t free, bool as
 
 void QuasiStatic::set_up_amg(const State& s, double t1) {
   const auto start = std::chrono::steady_clock::now();
+  if (at_start_.active && !at_start_.amg_u_saved && at_start_.amg_ready) {  // the step's start's, for restore_solver
+    at_start_.amg_u = amg_u_;
+    at_start_.amg_u_saved = true;
+  }
   // The definite variant, shifted: positive definite even with compressed bonds and loose nodes.
   SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, true);
   amg_shift_ = shift_diagonal(K);
@@ -315,7 +319,14 @@ bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool sh
     throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
                      "have; use time.integrator: verlet");
   if (shifted) shift_diagonal(K);
-  have_factor_ = factor_.factorize(K);
+  if (at_start_.active && !at_start_.swapped && at_start_.have_factor) {
+    // The step's first new factorisation: into the spare, the start's factor kept for restore_solver.
+    if (!spare_factor_) spare_factor_ = std::make_unique<SparseCholesky>();
+    std::swap(factor_, spare_factor_);
+    std::swap(factor_u_, at_start_.factor_u);
+    at_start_.swapped = true;
+  }
+  have_factor_ = factor_->factorize(K);
   if (!have_factor_) return false;
   ++factorisations_;
   factor_u_ = s.u;
@@ -498,7 +509,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
       if (!factorised) {
         have_factor_ = false;
         if (!std::isfinite(previous) && !broken_since_start_) {  // nothing broken: the body is not held
-          throw StepFailed("the tangent stiffness is singular or indefinite (" + factor_.failure() +
+          throw StepFailed("the tangent stiffness is singular or indefinite (" + factor_->failure() +
                            "): the body can move freely or a part of it has come loose; quasi_static needs "
                            "displacement conditions that hold every body in every direction, or use "
                            "time.integrator: verlet");
@@ -531,7 +542,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
       if (!solve_krylov(s, t1, eta, floor)) return false;
     } else {
       const auto solve_start = std::chrono::steady_clock::now();
-      factor_.solve(rhs_, correction_);
+      factor_->solve(rhs_, correction_);
       solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
       ++solves_;
     }
@@ -584,6 +595,52 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
   return residual_norm(s) <= settings_.residual_tol * force_scale(s, t1) && omega <= settings_.tol;
 }
 
+void QuasiStatic::remember_solver() {
+  at_start_.active = true;
+  at_start_.have_factor = have_factor_;
+  at_start_.definite = factor_definite_;
+  at_start_.shifted = factor_shifted_;
+  at_start_.factor_t = factor_t_;
+  at_start_.swapped = false;
+  at_start_.amg_ready = amg_.ready();
+  at_start_.amg_t = amg_t_;
+  at_start_.amg_rate = amg_rate_;
+  at_start_.amg_setups = amg_setups_;
+  at_start_.amg_u_saved = false;
+}
+
+// After a cut trial: the factorisation (and the hierarchy) the step started with, in use again, so
+// that the redone step sees what a step asked for directly would. A factor the trial made is
+// dropped (without one at the start, a direct step would factorise at its own first iterate). A
+// hierarchy is set up again where it was: the bonds have not changed since (every breaking forgets
+// it), so the same hanging nodes are masked and hypre's serial set-up gives the same one (as
+// load_state).
+void QuasiStatic::restore_solver() {
+  const std::size_t n = op_.size();
+  if (at_start_.swapped) {
+    std::swap(factor_, spare_factor_);
+    std::swap(factor_u_, at_start_.factor_u);
+    at_start_.swapped = false;
+  }
+  have_factor_ = at_start_.have_factor;
+  factor_t_ = at_start_.factor_t;
+  factor_definite_ = at_start_.definite;
+  factor_shifted_ = at_start_.shifted;
+  if (use_cg_ && use_amg_ && (amg_setups_ != at_start_.amg_setups || amg_.ready() != at_start_.amg_ready)) {
+    amg_.clear();
+    if (at_start_.amg_ready) {
+      find_hanging();
+      MaskedBonds masked(hanging_, op_.model().bonds, hanging_.count() > 0);
+      State s(n);
+      s.u = at_start_.amg_u_saved ? at_start_.amg_u : amg_u_;
+      set_up_amg(s, at_start_.amg_t);
+    }
+  }
+  amg_rate_ = at_start_.amg_rate;
+  at_start_.amg_setups = amg_setups_;  // the start's hierarchy is the one in use again
+  at_start_.amg_u_saved = false;
+}
+
 void QuasiStatic::step(State& state, double& t, double& dt) {
   report_ = StepReport{};
   failure_reason_.clear();
@@ -594,6 +651,15 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   // shifts its tangent exactly as the uninterrupted run does.
   if (!broken_since_start_) broken_since_start_ = op_.any_broken();
   double h = std::min(dt, dt_max_);
+  // The cut to the first bond failure (quasi_static.hpp): at most two per step, r0 from the start.
+  remember_solver();
+  struct Off {  // the snapshot is for this step only, however it ends
+    bool& active;
+    ~Off() { active = false; }
+  } off{at_start_.active};
+  int cuts = 0;
+  cut_to_ = 0.0;
+  std::optional<StretchRatio> start_ratio;
   for (;;) {
     const double t1 = t + h;
     State s = state;
@@ -609,10 +675,19 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     double omega = 0.0;
     bool converged = true;
     BreakReport broke_total;
+    double cut_to = 0.0;  // > 0: redo the step with this h (the cut)
     for (;;) {
       converged = solve_equilibrium(s, t1, state.u, iterations, omega);
       total += iterations;
       if (!converged) break;
+      // Not from an explicit step's state: it is no equilibrium, so r is not linear in the load from it.
+      // Only before any bond has broken (the first failure): once a crack grows, a load step cut to
+      // its next bond left the traction quasi_static run (full resolution) in loads where Newton
+      // found no equilibrium down to dt_min, where the uncut step had let the crack run through.
+      if (settings_.cut_to_first_failure && !broken_since_start_ && rounds == 0 && cuts < 2 && guess_from_velocity_ &&
+          h > dt_min_ * (1.0 + 1e-12))
+        cut_to = cut_step(state, s, h, start_ratio);
+      if (cut_to > 0.0) break;
       const BreakReport broke = op_.break_bonds(s);
       if (broke.broken == 0) break;
       broke_total.broken += broke.broken;
@@ -628,6 +703,13 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
                          " bonds): the crack grows unstably, which a quasi-static solve cannot follow; use "
                          "time.integrator: verlet (or raise quasi_static.max_breaking_rounds)");
       }
+    }
+    if (converged && cut_to > 0.0) {
+      // Nothing was broken in the trial; its factorisation (or hierarchy), if it made one, is put back.
+      restore_solver();
+      ++cuts, ++cuts_;
+      h = cut_to_ = cut_to;
+      continue;
     }
     if (converged) {
       // Accepted: the mean velocity over the load step, the force and the work at t1.
@@ -673,11 +755,26 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   }
 }
 
+double QuasiStatic::cut_step(State& start, State& end, double h, std::optional<StretchRatio>& start_ratio) {
+  const StretchRatio r1 = op_.stretch_ratio(end);
+  if (r1.over == 0 || !(r1.largest > 1.0 + kCutMargin)) return 0.0;  // no bond over, or within the margin
+  if (!start_ratio) start_ratio = op_.stretch_ratio(start);
+  const StretchRatio& r0 = *start_ratio;
+  // Only from a start with no bond over (else bonds are breaking anyway: the current behaviour).
+  if (r0.over > 0 || !(r0.largest < 1.0) || !(r1.largest > r0.largest)) return 0.0;
+  const double target = r0.largest < 1.0 - kCutMargin ? 1.0 - 0.5 * kCutMargin : 1.0 + 0.5 * kCutMargin;
+  // r linear in the load between the start and this equilibrium (quasi_static.hpp).
+  const double cut = std::max(h * ((target - r0.largest) / (r1.largest - r0.largest)), dt_min_);
+  return cut < h ? cut : 0.0;
+}
+
 std::string QuasiStatic::linear_algebra_summary() const {
   char buffer[160];
   std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s", factorisations_,
                 factorise_seconds_, static_cast<long long>(solves_), solve_seconds_);
-  if (!use_cg_) return buffer;
+  std::string cut_text;
+  if (cuts_ > 0) cut_text = ", " + std::to_string(cuts_) + " load steps cut to the first bond failure";
+  if (!use_cg_) return buffer + cut_text;
   // On the matrix-free path every CG iteration is one J·x product, about one force evaluation.
   std::string text = std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +
                      std::to_string(cg_iterations_) + " iterations (J·x products)";
@@ -686,7 +783,7 @@ std::string QuasiStatic::linear_algebra_summary() const {
                   amg_setups_, amg_seconds_, amg_.levels(), amg_.operator_complexity());
     text += buffer;
   }
-  return text;
+  return text + cut_text;
 }
 
 std::vector<std::string> QuasiStatic::describe(double) const {
@@ -699,6 +796,7 @@ std::vector<std::string> QuasiStatic::describe(double) const {
                    : std::string("; tangent factorised by CHOLMOD (direct, ")) +
           solver_reason_ + ")" + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
           " s, dt_max " + message_number(dt_max_) + " s" +
+          (settings_.cut_to_first_failure ? "; a load step past the first bond failure is cut back to it" : "") +
           (bond_based_ ? "; once bonds have broken, nodes hanging by bonds on one line and one side are left out of "
                          "each solve and placed on their bonds' line after it, and free fragments stay where they are"
                        : std::string())};

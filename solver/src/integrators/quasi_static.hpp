@@ -22,6 +22,27 @@
 // in which bonds broke; a step that does not converge is redone from t with Δt/2. Velocities are
 // the mean over the load step, (u_{n+1} − u_n)/Δt, so the work ledger integrates the reactions.
 //
+// The cut to the first bond failure. A long load step can carry the body far past the load at which
+// its first bond reaches its critical stretch: many bonds are then over s0 at once, break together
+// and the step fails by breaking (unstable crack growth, where mixed switches to Verlet from the
+// start of the step, all of whose elastic range it then runs explicitly). So after the first
+// equilibrium of a load step t → t + h that started from the last load step's equilibrium (not from
+// an explicit step's state in mixed, which is none) with no bond over its critical stretch and none
+// broken yet (the first failure only: see step()), if
+// bonds are over it at the end (the law's own criterion: materials/bond_model.hpp StretchRatio) by
+// more than kCutMargin in the largest ratio r = s/s0, the step is redone to the load where r reaches
+// the target: below the first failure PMB's equilibrium is linear in the load (the displacements of
+// K u = load, thesis eq. 2.3 linearised), so r(t + τ) ≈ r0 + (r1 − r0) τ/h from r0 at the start and
+// r1 at the end, τ = h (target − r0)/(r1 − r0). The target is 1 − kCutMargin/2 when the step
+// started further than kCutMargin below failure (the step ends on the elastic equilibrium just
+// before the first failure, nothing broken, so that a crack that then runs unstably starts from
+// there), else 1 + kCutMargin/2 (the first bonds cross by at most about the margin). If the
+// redone step still overshoots by more than the margin, one more such secant cut, through the start
+// and the redone step. Nothing of the trial survives: no bond was broken, and a factorisation (or
+// an AMG hierarchy) made in it is made again where the one in use at the start of the step was
+// made (as load_state does), so the redone step is bitwise the step asked for directly.
+// quasi_static.cut_to_first_failure: false turns the cut off (the steps as before it).
+//
 // quasi_static.linear_solver: cg replaces the factorisation by matrix-free preconditioned CG
 // (linalg/pcg.hpp) on K Δu = V f, K x = −V ∂f/∂u·x from ForceOperator::apply_jacobian, with the
 // block-Jacobi preconditioner of K's 3×3 node blocks: an inexact Newton–Krylov iteration. Each
@@ -50,6 +71,7 @@
 #pragma once
 #include <algorithm>
 #include <memory>
+#include <optional>
 
 #include "integrators/hanging_nodes.hpp"
 #include "integrators/integrator.hpp"
@@ -89,6 +111,14 @@ class QuasiStatic : public Integrator {
   bool uses_cg() const { return use_cg_; }
   bool uses_amg() const { return use_cg_ && use_amg_; }
   int amg_setups() const { return amg_setups_; }  // since configure (not checkpointed)
+  // Load steps cut to the first bond failure (see the head of this file), since configure (not checkpointed).
+  int cuts() const { return cuts_; }
+  // The length the last step() was cut to, 0 if it was not cut: after a failure, the load step the
+  // body was found to fail in (mixed takes it as the first load step after a return from Verlet).
+  double cut_to() const { return cut_to_; }
+  // The largest overshoot of the ratio s/s0 a load step keeps without a cut, and the cut's targets
+  // 1 ∓ kCutMargin/2 (the head of this file).
+  static constexpr double kCutMargin = 1e-3;
   std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
   int cg_solves() const { return cg_solves_; }
   // Auto picks cg at or above this many free dofs in 3D (measured: see the .cpp).
@@ -158,7 +188,9 @@ class QuasiStatic : public Integrator {
   FreeDofs dofs_;
   DofSums sums_;  // the norms and CG's dot products over dofs_ (every rank's on a decomposed run)
   mutable std::vector<double> terms_, motion_terms_;  // per-dof terms of those sums
-  SparseCholesky factor_;
+  // The factorisation in use, and a spare CHOLMOD object that a cut trial factorises into so that
+  // the start's factor survives it (restore_solver swaps them back; each keeps its symbolic analysis).
+  std::unique_ptr<SparseCholesky> factor_ = std::make_unique<SparseCholesky>(), spare_factor_;
   bool have_factor_ = false;
   int factorisations_ = 0;
   std::int64_t solves_ = 0;
@@ -199,6 +231,30 @@ class QuasiStatic : public Integrator {
   int cg_solves_ = 0;
   State trial_;
   std::vector<double> rhs_, correction_;
+  // The cut (see the head of this file): what the linear solver held at the start of the step, to
+  // be put back after a trial that is cut. The first factorisation of the step goes into the spare
+  // object (factorize_at swaps them, and u of the start's factor into factor_u), so the start's
+  // factor is kept as it is; an AMG hierarchy is set up again where it was (u copied by set_up_amg).
+  struct SolverAtStart {
+    bool active = false;
+    bool have_factor = false, definite = false, shifted = false;
+    double factor_t = 0.0;
+    bool swapped = false;  // factor_ is the spare now, and factor_u the start's factor's u
+    Vec3Array factor_u;
+    bool amg_ready = false;
+    double amg_t = 0.0, amg_rate = 0.0;
+    int amg_setups = 0;
+    bool amg_u_saved = false;
+    Vec3Array amg_u;
+  };
+  SolverAtStart at_start_;
+  void remember_solver();
+  // After the first equilibrium `end` of a load step of length h from `start`: the h of the cut
+  // (quasi_static.hpp), or 0 for none. start_ratio: the start's StretchRatio, computed once. Collective.
+  double cut_step(State& start, State& end, double h, std::optional<StretchRatio>& start_ratio);
+  void restore_solver();
+  int cuts_ = 0;
+  double cut_to_ = 0.0;
 };
 
 }  // namespace pd

@@ -360,6 +360,10 @@ QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
     q.max_iterations = static_cast<int>(ck.integer(*v, "quasi_static.max_iterations", 1, 100000));
   if (const json* v = ck.optional(j, "max_breaking_rounds"))
     q.max_breaking_rounds = static_cast<int>(ck.integer(*v, "quasi_static.max_breaking_rounds", 1, 100000000));
+  if (const json* v = ck.optional(j, "cut_to_first_failure")) {
+    if (!v->is_boolean()) ck.fail("quasi_static.cut_to_first_failure", "must be true or false, got " + show(*v));
+    q.cut_to_first_failure = v->get<bool>();
+  }
   for (auto [name, slot] : {std::pair<const char*, std::optional<double>*>{"dt_initial", &q.dt_initial},
                             {"dt_min", &q.dt_min}, {"dt_max", &q.dt_max}})
     if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("quasi_static.") + name);
@@ -466,7 +470,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"cracks[]", {"from", "to"}},
       {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
       {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
-      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "linear_solver", "preconditioner", "cg_max_iterations", "dt_initial", "dt_min",
+      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "cut_to_first_failure", "linear_solver", "preconditioner", "cg_max_iterations", "dt_initial", "dt_min",
                         "dt_max"}},
       {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
                     "dt_min", "dt_max", "linear_solver", "cg_max_iterations"}},

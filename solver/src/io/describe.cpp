@@ -136,6 +136,7 @@ json describe_case() {
   keys["quasi_static.max_iterations"] = defaulted("integer", q.max_iterations, {{"minimum", 1}, {"maximum", 100000}});
   keys["quasi_static.max_breaking_rounds"] =
       defaulted("integer", q.max_breaking_rounds, {{"minimum", 1}, {"maximum", 100000000}});
+  keys["quasi_static.cut_to_first_failure"] = defaulted("boolean", q.cut_to_first_failure);
   keys["quasi_static.linear_solver"] = defaulted("string", q.linear_solver, {{"choices", {"auto", "direct", "cg"}}});
   keys["quasi_static.preconditioner"] =
       defaulted("string", q.preconditioner, {{"choices", {"auto", "block_jacobi", "amg"}}});

@@ -78,6 +78,18 @@ struct BreakReport {
   double energy = 0.0;
 };
 
+// How far the intact bonds that can break are from breaking at some u: the largest stretch ratio
+// s/s_c over them (s_c the threshold the law's breaking criterion compares s with; 0 when there is
+// none) and how many bonds the law's break_bonds would break at this u (each counted once: the
+// same count as its BreakReport::broken). `over` is decided by the criterion itself, not by
+// largest > 1, so the two agree exactly; largest is for interpolating the load at which the first
+// bond breaks (integrators/quasi_static.cpp, the cut of a load step). A maximum and an integer
+// count: exact and independent of the order of the bonds, threads and ranks.
+struct StretchRatio {
+  double largest = 0.0;
+  std::int64_t over = 0;
+};
+
 class BondModel {
  public:
   virtual ~BondModel() = default;
@@ -113,6 +125,10 @@ class BondModel {
   }
   // Only the breaking of break_bonds_and_add_force.
   virtual BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const = 0;
+  // The largest stretch ratio over the intact bonds with no no-fail end and how many of them are
+  // over their critical stretch at u (StretchRatio), by the same criterion break_bonds applies; reads
+  // only (no flag, no per-node threshold changes). Rows in any order: a maximum and a count.
+  virtual StretchRatio stretch_ratio(const Model& model, const Vec3Array& u) const = 0;
   // W_i per node at u [J/m³].
   virtual std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const = 0;
   // Damage φ_i ∈ [0, 1] per node (0 intact, 1 every bond broken).

@@ -100,6 +100,17 @@ void ForceOperator::reduce_break_report(BreakReport& report) {
   report.energy = broken > 0 ? energy.value() : 0.0;
 }
 
+StretchRatio ForceOperator::stretch_ratio(State& s) const {
+  if (!decomposed_) return model_.bond_model->stretch_ratio(model_, s.u);
+  // A bond's threshold by LAMMPS's α rule reads its ghost end's s0 (see break_bonds_and_evaluate).
+  if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
+  decomposed_->update_ghosts(s.u);
+  StretchRatio r = model_.bond_model->stretch_ratio(model_, s.u);  // a ghost's row is empty: owned rows only
+  r.largest = -decomposed_->minimum(-r.largest);  // the maximum over the ranks, exactly
+  r.over = decomposed_->total(r.over);             // each bond counted on one rank (its i < j copy)
+  return r;
+}
+
 bool ForceOperator::any_broken() const {
   const auto& broken = model_.bonds.broken;
   const bool here = std::any_of(broken.begin(), broken.end(), [](std::uint8_t b) { return b != 0; });

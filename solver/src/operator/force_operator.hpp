@@ -51,6 +51,11 @@ class ForceOperator {
   // LAMMPS's s0, overlapped with the interior rows), the count summed over the ranks and the energy
   // in node order. Collective on a decomposed run.
   BreakReport break_bonds(State& s);
+  // The largest stretch ratio over the intact bonds that can break at s.u and how many bonds
+  // break_bonds(s) would break there (materials/bond_model.hpp StretchRatio); changes no flag.
+  // Decomposed: the ghosts' u (and LAMMPS's per-node s0) first, as break_bonds, then a maximum and a
+  // total over the ranks — both exact, so the same value on any number of ranks. Collective then.
+  StretchRatio stretch_ratio(State& s) const;
   // Whether any bond of the whole model is broken (collective on a decomposed run).
   bool any_broken() const;
   // The free dofs of the implicit solves (linalg/sparse_matrix.hpp FreeDofs) over the nodes this

@@ -159,6 +159,39 @@ TEST_P(Decomposed, BondsCrossingRanksBreakOnBothEndsInTheSameStepAsSerially) {
   EXPECT_TRUE(same_bits(op.strain_energy(local), serial_op.strain_energy(serial)));
 }
 
+TEST_P(Decomposed, StretchRatioIsTheSerialOneOnAnyNumberOfRanks) {
+  // The reduction of the quasi-static cut (materials/bond_model.hpp StretchRatio): the largest
+  // stretch ratio, a maximum over the ranks, and the count of bonds over s0, each counted on one
+  // rank, equal the serial ones bit for bit; the count is what the breaking pass then breaks.
+  omp_set_num_threads(GetParam());
+  pd::Model global = lattice_model(0.5);
+  notch(global);
+  const double s0 = global.material.block[0].critical_stretch;
+  pd::Vec3Array u = wavy(global, 0.2 * s0);
+  for (std::size_t i = 0; i < global.nodes.size(); ++i)
+    if (global.nodes.x[0][i] > 6.5 * kDx) u[0][i] += 2.0 * s0 * kDx;
+  pd::ForceOperator serial_op(global);
+  pd::State serial(global.nodes.size());
+  serial.u = u;
+  const pd::StretchRatio expected = serial_op.stretch_ratio(serial);
+  ASSERT_GT(expected.over, 0);
+  ASSERT_GT(expected.largest, 1.0);
+
+  pd::Model piece_of = lattice_model(0.5);
+  notch(piece_of);
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, piece_of);
+  pd::ForceOperator op(dec.piece().model);
+  op.set_decomposed(&dec);
+  pd::State local = local_state(dec, u, pd::make_vec3(global.nodes.size()));  // ghosts NaN: the exchange fills them
+  const pd::StretchRatio got = op.stretch_ratio(local);
+  EXPECT_TRUE(same_bits(got.largest, expected.largest)) << got.largest << " vs " << expected.largest;
+  EXPECT_EQ(got.over, expected.over);
+  // Each rank's own rows see only part of the bonds over s0 (the reduction is needed).
+  const pd::StretchRatio mine = dec.piece().model.bond_model->stretch_ratio(dec.piece().model, local.u);
+  if (rank_count() > 1) EXPECT_LT(mine.over, expected.over);
+  EXPECT_EQ(op.break_bonds(local).broken, expected.over);
+}
+
 INSTANTIATE_TEST_SUITE_P(Threads, Decomposed, ::testing::Values(1, 2));
 
 TEST(Halo, MessagesGoOnlyToRanksThatShareBonds) {

@@ -100,6 +100,8 @@ class LpsModel : public BondModel {
                                                    bool want_energy, double* lost_per_node,
                                                    const GhostsInFlight& u_ghosts) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
+  // PMB's criterion on y − |ξ| > s0 |ξ| (LpsKernel::Bond::over), the ratio (y − |ξ|)/(s0 |ξ|).
+  StretchRatio stretch_ratio(const Model& model, const Vec3Array& u) const override;
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override;
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;

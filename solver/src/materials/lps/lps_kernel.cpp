@@ -4,6 +4,7 @@
 // summing its bonds in row order: bitwise the same for any thread count.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/exact_sum.hpp"
 #include "materials/lps/lps_kernel.hpp"
@@ -326,6 +327,32 @@ BreakReport LpsModel::break_bonds(Model& model, const Vec3Array& u, bool want_en
   if (r.broken > 0)
     r.energy += exact_sum(lost);
   return r;
+}
+
+StretchRatio LpsModel::stretch_ratio(const Model& model, const Vec3Array& u) const {
+  StretchRatio out;
+  if (!model.material.can_break()) return out;
+  const LpsKernel k(*this, model, u);
+  const Breaking br = breaking_of(const_cast<Model&>(model), nullptr);  // read only: no flag is set here
+  double largest = 0.0;
+  std::int64_t over = 0;  // a maximum and an integer sum: exact in any order of rows and threads
+#pragma omp parallel for schedule(static) reduction(max : largest) reduction(+ : over)
+  for (std::int64_t i = 0; i < k.nodes; ++i) {
+    if (br.no_fail[i]) continue;  // as dilatation_row: a no-fail node breaks nothing
+    const double* s0_row = br.s0_pair + br.block[i] * br.blocks;
+    for (std::int64_t q = k.offsets[i]; q < k.offsets[i + 1]; ++q) {
+      const std::int64_t j = k.neighbour[q];
+      if (k.broken[q] || br.no_fail[j]) continue;
+      const LpsKernel::Bond t = k.bond(i, q);
+      const double s0 = s0_row[br.block[j]];
+      // The stretch (y − |ξ|)/|ξ| over s0, and the criterion itself (Bond::over) for the count.
+      if (s0 > 0.0 && s0 < std::numeric_limits<double>::infinity()) largest = std::max(largest, t.raw / (s0 * t.length));
+      if (i < j && t.over(s0)) ++over;
+    }
+  }
+  out.largest = largest;
+  out.over = over;
+  return out;
 }
 
 std::vector<double> LpsModel::strain_energy_density(const Model& model, const Vec3Array& u) const {

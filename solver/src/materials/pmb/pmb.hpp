@@ -113,6 +113,11 @@ std::int64_t break_bonds_lammps_rules(Model& model, const Vec3Array& u, Vec3Arra
                                       double* broken_energy, double* lost_per_node = nullptr,
                                       const GhostsInFlight* ghosts = nullptr);
 
+// The largest s/s0 over the intact bonds without a no-fail end at u, and how many of them break_bonds
+// would break there (each once), by the same criterion and thresholds (materials/bond_model.hpp
+// StretchRatio; the thesis rule's pair s0, or LAMMPS's per-node s0 when its α rule is on). Reads only.
+StretchRatio pmb_stretch_ratio(const Model& model, const Vec3Array& u);
+
 // U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
 // summed serially in node order, so the value does not depend on the thread count.
 double strain_energy(const Model& model, const Vec3Array& u);
@@ -145,6 +150,7 @@ class PmbModel : public BondModel {
                                                    bool want_energy, double* lost_per_node,
                                                    const GhostsInFlight& u_ghosts) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
+  StretchRatio stretch_ratio(const Model& model, const Vec3Array& u) const override { return pmb_stretch_ratio(model, u); }
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override { return bond_damage(model); }
   double bond_stiffness(const Model& model, std::size_t i, std::size_t j, double length) const override;

@@ -64,6 +64,18 @@ inline BondTerms bond_terms(const PmbArrays& a, const double xi[3], const double
 // would keep the force loop from vectorising).
 inline bool over_critical(bool intact, double s, double s0) { return intact & (s > s0); }
 
+// The breaking criterion, in one place (every pass that breaks or asks whether a bond would break
+// calls these two): bond i→j is compared with s0 of its block pair, or by LAMMPS's α rule with
+// min(s0_i, s0_j) of the previous pass (s0_node not null, validation.md F5); it breaks when intact,
+// over that threshold and with no end in a no-fail set.
+inline double critical_stretch_of(const double* s0_row, std::int32_t bj, const double* s0_node, std::int64_t i,
+                                  std::int64_t j) {
+  return s0_node ? std::min(s0_node[i], s0_node[j]) : s0_row[bj];
+}
+inline bool bond_breaks(bool intact, double s, double s0, bool no_fail_end) {
+  return over_critical(intact, s, s0) && !no_fail_end;
+}
+
 // The energy a bond takes with it when it breaks: ½ c s0² |ξ| ν V_i V_j, the two ¼-shares that W_i
 // and W_j held (validation.md C4), at the critical stretch s0 it crossed, not at the stretch s > s0
 // it has after the step that broke it. A bond passes s0 somewhere inside that step; its post-step
@@ -88,8 +100,8 @@ std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i
   for (std::int64_t k = a.offsets[i]; k < end; ++k) {
     const std::int64_t j = a.neighbour[k];
     const BondTerms b = bond_terms(a, xi, yi, j);
-    const double s0 = s0_row[a.block[j]];
-    if (!over_critical(a.broken[k] == 0, b.s, s0) || br.no_fail[j]) continue;
+    const double s0 = critical_stretch_of(s0_row, a.block[j], nullptr, i, j);
+    if (!bond_breaks(a.broken[k] == 0, b.s, s0, br.no_fail[j] != 0)) continue;
     br.broken[k] = 1;
     ++set;
     if (i < j) {
@@ -328,8 +340,8 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
         }
         // The previous pass's s0 at both ends: both copies of the bond see the same threshold and
         // bitwise the same stretch, so they break in the same pass.
-        const double s0 = node_rule ? std::min(s0_node[i], s0_node[j]) : s0_row[bj];
-        if (!(b.s > s0) || no_fail[i] || no_fail[j]) continue;
+        const double s0 = critical_stretch_of(s0_row, bj, s0_node, i, j);
+        if (!bond_breaks(true, b.s, s0, no_fail[i] || no_fail[j])) continue;
         broken[k] = 1;
         if (i < j) {
           ++newly;
@@ -356,6 +368,37 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
   if (broken_energy && !lost_per_node && newly > 0)
     *broken_energy += exact_sum(lost);  // exact, as update_broken_bonds
   return newly;
+}
+
+StretchRatio pmb_stretch_ratio(const Model& m, const Vec3Array& u) {
+  StretchRatio out;
+  if (!m.material.can_break()) return out;  // no threshold anywhere: nothing can break
+  const PmbArrays a = pmb_arrays(m, u);
+  // The thresholds break_bonds compares with: LAMMPS's per-node s0 of the previous pass when its α
+  // rule is on (break_bonds_lammps_rules), else the pair table's (break_row).
+  const double* s0_node = m.node_critical_stretch.empty() ? nullptr : m.node_critical_stretch.data();
+  const double* s0_pair = m.material.critical_pair.data();
+  const std::uint8_t* no_fail = m.no_fail.data();
+  double largest = 0.0;
+  std::int64_t over = 0;  // a maximum and an integer sum: exact in any order of rows and threads
+#pragma omp parallel for schedule(static) reduction(max : largest) reduction(+ : over)
+  for (std::int64_t i = 0; i < a.nodes; ++i) {
+    if (no_fail[i]) continue;  // a no-fail node's bonds never break, whatever their stretch
+    const double* s0_row = s0_pair + a.block[i] * a.blocks;
+    const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
+    const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
+    for (std::int64_t k = a.offsets[i]; k < a.offsets[i + 1]; ++k) {
+      const std::int64_t j = a.neighbour[k];
+      if (a.broken[k] || no_fail[j]) continue;
+      const BondTerms b = bond_terms(a, xi, yi, j);  // the stretch every pass computes, bit for bit
+      const double s0 = critical_stretch_of(s0_row, a.block[j], s0_node, i, j);
+      if (s0 > 0.0 && s0 < std::numeric_limits<double>::infinity()) largest = std::max(largest, b.s / s0);
+      if (i < j && bond_breaks(true, b.s, s0, false)) ++over;  // each bond once, as BreakReport counts
+    }
+  }
+  out.largest = largest;
+  out.over = over;
+  return out;
 }
 
 std::vector<double> strain_energy_density(const Model& m, const Vec3Array& u) {
