@@ -77,9 +77,7 @@ BreakReport ForceOperator::break_on_piece(Vec3Array& u, Vec3Array& f, double* w)
   // previous pass updated on the owner only (a ghost's empty row leaves +inf): it travels with u,
   // in the same exchange (one message per neighbour), while the law sweeps the rows that read no
   // ghost (parallel/row_split.hpp).
-  NodeColumns ghost_values(u);
-  if (!model_.node_critical_stretch.empty()) ghost_values.add(model_.node_critical_stretch);
-  const GhostsInFlight ghosts = decomposed_->send_ghosts(ghost_values);
+  const GhostsInFlight ghosts = decomposed_->send_ghosts(breaking_ghost_values(u));
   lost_.assign(u[0].size(), 0.0);
   BreakReport report =
       model_.bond_model->break_bonds_and_add_force_overlapped(model_, u, f, w, true, lost_.data(), ghosts);
@@ -100,11 +98,16 @@ void ForceOperator::reduce_break_report(BreakReport& report) {
   report.energy = broken > 0 ? energy.value() : 0.0;
 }
 
+NodeColumns ForceOperator::breaking_ghost_values(Vec3Array& u) const {
+  NodeColumns values(u);
+  if (!model_.node_critical_stretch.empty()) values.add(model_.node_critical_stretch);
+  return values;
+}
+
 StretchRatio ForceOperator::stretch_ratio(State& s) const {
   if (!decomposed_) return model_.bond_model->stretch_ratio(model_, s.u);
-  // A bond's threshold by LAMMPS's α rule reads its ghost end's s0 (see break_bonds_and_evaluate).
-  if (!model_.node_critical_stretch.empty()) decomposed_->update_ghosts(model_.node_critical_stretch);
-  decomposed_->update_ghosts(s.u);
+  // The ratio reads what the breaking test reads of a ghost (break_on_piece): u and LAMMPS's s0.
+  decomposed_->update_ghosts(breaking_ghost_values(s.u));
   StretchRatio r = model_.bond_model->stretch_ratio(model_, s.u);  // a ghost's row is empty: owned rows only
   r.largest = -decomposed_->minimum(-r.largest);  // the maximum over the ranks, exactly
   r.over = decomposed_->total(r.over);             // each bond counted on one rank (its i < j copy)

@@ -144,6 +144,9 @@ class ForceOperator {
   // s.w, break_bonds' scratch arrays): u's ghosts (and LAMMPS's s0) travel while the law sweeps the
   // interior rows; the report summed over the ranks.
   BreakReport break_on_piece(Vec3Array& u, Vec3Array& f, double* w);
+  // u and, under LAMMPS's α rule, the per-node s0: what a breaking test reads of a ghost, in one
+  // halo exchange (one message per neighbour).
+  NodeColumns breaking_ghost_values(Vec3Array& u) const;
 };
 
 }  // namespace pd
