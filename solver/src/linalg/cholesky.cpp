@@ -2,12 +2,36 @@
 #include "linalg/cholesky.hpp"
 
 #include <cholmod.h>
+#include <omp.h>
 
 #include <cstring>
 
 #include "core/error.hpp"
 
 namespace pd {
+
+namespace {
+
+// CHOLMOD 3 (SuiteSparse 5.12, Debian 12) opens its parallel loops with
+// num_threads(CHOLMOD_OMP_NUM_THREADS), a compile-time 4 (cholmod_core.h) that ignores --threads:
+// 4 threads on this 2-core machine, whose wake-ups and futex waits took 60 % of the factorisation
+// time of plate_with_hole-mixed at dx × 2 with --threads 1 (docs/accuracy.md, "CHOLMOD's
+// threads"). With the dynamic adjustment on, libgomp gives a team at most nthreads-var (our
+// --threads) threads, fewer when the machine's load average says the cores are busy. Only the
+// calls into CHOLMOD run with it: our own loops keep exactly --threads. CHOLMOD's loops write
+// disjoint entries, so the factor is the same bits for any team size (the hash runs check it).
+class AtMostOurThreads {
+ public:
+  AtMostOurThreads() : was_dynamic_(omp_get_dynamic()) { omp_set_dynamic(1); }
+  ~AtMostOurThreads() { omp_set_dynamic(was_dynamic_); }
+  AtMostOurThreads(const AtMostOurThreads&) = delete;
+  AtMostOurThreads& operator=(const AtMostOurThreads&) = delete;
+
+ private:
+  int was_dynamic_;
+};
+
+}  // namespace
 
 struct SparseCholesky::Impl {
   cholmod_common common;
@@ -29,6 +53,7 @@ SparseCholesky::~SparseCholesky() = default;
 
 bool SparseCholesky::factorize(const SparseMatrix& K) {
   cholmod_common* cm = &impl_->common;
+  const AtMostOurThreads cap;
   failure_.clear();
   // A CSR matrix stored whole is its own CSC transpose: hand CHOLMOD the arrays as they are and
   // let it read the upper triangle (stype = 1).
@@ -74,6 +99,7 @@ bool SparseCholesky::factorize(const SparseMatrix& K) {
 
 void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const {
   cholmod_common* cm = &impl_->common;
+  const AtMostOurThreads cap;
   cholmod_dense B;
   std::memset(&B, 0, sizeof B);
   B.nrow = b.size();
