@@ -31,7 +31,7 @@ void Mixed::configure(const Case& c, double dt_exact) {
     return;
   }
   static_.configure(c, dt_exact);
-  static_.limit(settings_.unstable_rounds, c.quasi_static.dt_min.value_or(10.0 * dt_explicit_));
+  static_.limit(settings_.unstable_rounds, c.quasi_static.dt_min.value_or(10.0 * dt_explicit_), steady_breaking_rule_);
   static_dt_ = static_.initial_dt().value_or(static_.dt_max());
   set_pause_steps(c);
 }

@@ -110,6 +110,11 @@ class Mixed : public Integrator {
   // Load steps cut to the first bond failure (quasi_static.hpp), since configure.
   int cuts_in_use() const { return home_ == kImplicit ? 0 : static_.cuts(); }
   int factorisations_in_use() const { return home_ == kImplicit ? implicit_.factorisations() : static_.factorisations(); }
+  int refused_factorisations() const { return home_ == kImplicit ? 0 : static_.refused_factorisations(); }
+  int analyses_in_use() const { return home_ == kImplicit ? 0 : static_.analyses(); }  // CHOLMOD's symbolic analyses
+  // The early verdict of unstable crack growth (a re-solve breaking no fewer bonds than the one
+  // before it, QuasiStatic::limit); on by default, off only to compare (the tests). Before configure().
+  void set_steady_breaking_rule(bool on) { steady_breaking_rule_ = on; }
   Mode home() const { return home_; }  // mixed.start: the scheme away from a running crack
 
  private:
@@ -164,6 +169,7 @@ class Mixed : public Integrator {
   // 214 s without the rule); every try that succeeded in the measurements was the first.
   static constexpr int kPauseTries = 1;
   int pause_tries_ = kPauseTries;
+  bool steady_breaking_rule_ = true;
   // Sets the above from the case (configure).
   void set_pause_steps(const Case& c);
   // After an explicit step: whether the crack has paused long enough to try a load step.

@@ -327,7 +327,7 @@ bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool sh
     at_start_.swapped = true;
   }
   have_factor_ = factor_->factorize(K);
-  if (!have_factor_) return false;
+  if (!have_factor_) return ++refused_, false;
   ++factorisations_;
   factor_u_ = s.u;
   factor_t_ = t1;
@@ -336,8 +336,9 @@ bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool sh
   return true;
 }
 
-void QuasiStatic::limit(int max_breaking_rounds, double dt_min) {
+void QuasiStatic::limit(int max_breaking_rounds, double dt_min, bool fail_on_steady_breaking) {
   settings_.max_breaking_rounds = max_breaking_rounds;
+  fail_on_steady_breaking_ = fail_on_steady_breaking;
   dt_min_ = std::min(dt_min, dt_max_);
 }
 
@@ -499,7 +500,13 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
       // is singular although the residual does not drive it. A shift of the diagonal by
       // kDiagonalShift × its largest entry lets it be factorised; the residual, not K, decides
       // convergence, so the equilibrium found is unchanged (a modified Newton iteration).
-      bool factorised = factorize_at(s, t1, false, broken_since_start_);
+      // From an explicit step's state (mixed's return) the first tangent is the definite variant at
+      // once: the ringing state's compressed bonds make the full tangent indefinite (measured on
+      // plate_with_hole and traction at dx × 2: the full one failed to factorise at every return),
+      // and a failed factorisation costs as much as one that succeeds.
+      const bool definite_now = definite_first_ && broken_since_start_;
+      definite_first_ = false;
+      bool factorised = !definite_now && factorize_at(s, t1, false, broken_since_start_);
       if (!factorised && broken_since_start_) {
         // Indefinite after damage (compressed bonds lose their stiffness across their line, a node
         // may hang by collinear bonds): the definite variant, shifted, still leads Newton to the
@@ -652,7 +659,11 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   if (!broken_since_start_) broken_since_start_ = op_.any_broken();
   double h = std::min(dt, dt_max_);
   // The cut to the first bond failure (quasi_static.hpp): at most two per step, r0 from the start.
-  remember_solver();
+  // The solver at the start is kept for a cut trial only when a cut can happen in this step (see
+  // its condition below): otherwise a new factorisation is made in place, on the symbolic analysis
+  // already there (the spare would need one of its own: 0.27 s of plate_with_hole-mixed's 4.3 s
+  // at dx × 2, in the step where the crack starts to grow).
+  if (settings_.cut_to_first_failure && !broken_since_start_ && guess_from_velocity_) remember_solver();
   struct Off {  // the snapshot is for this step only, however it ends
     bool& active;
     ~Off() { active = false; }
@@ -672,6 +683,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
         for (std::size_t i = 0; i < s.size(); ++i)
           if (!op_.fixed()[d][i]) s.u[d][i] = state.u[d][i] + h * state.v[d][i];
     int iterations = 0, total = 0, rounds = 0;
+    std::int64_t last_broken = 0;  // bonds broken by the last breaking round
+    definite_first_ = !guess_from_velocity_;
     double omega = 0.0;
     bool converged = true;
     BreakReport broke_total;
@@ -690,14 +703,22 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       if (cut_to > 0.0) break;
       const BreakReport broke = op_.break_bonds(s);
       if (broke.broken == 0) break;
+      at_start_.active = false;  // no cut can follow (one needs no bond broken in the run)
+      // Unstable crack growth, seen early (limit()): a re-solve that broke at least as many bonds
+      // as the one before it. The energy released by the crack's advance at a fixed load is not
+      // falling, so the rounds would not end (the plate's: 4, 4, 8 bonds; traction's: 4, 8, 12).
+      const bool not_slowing = fail_on_steady_breaking_ && rounds > 0 && broke.broken >= last_broken;
+      last_broken = broke.broken;
       broke_total.broken += broke.broken;
       broke_total.energy += broke.energy;
       have_factor_ = false;  // the tangent lost bonds
       amg_.clear();          // and the hierarchy too (rule (1) of quasi_static.hpp)
       broken_since_start_ = true;
-      if (++rounds >= settings_.max_breaking_rounds) {
+      if (++rounds >= settings_.max_breaking_rounds || not_slowing) {
         failure_reason_ = "bonds kept breaking through " + std::to_string(rounds) + " re-solves at one load (" +
-                          std::to_string(broke_total.broken) + " bonds): unstable crack growth";
+                          std::to_string(broke_total.broken) + " bonds" +
+                          (not_slowing ? ", the last re-solve " + std::to_string(broke.broken) + ", no fewer than the one before" : "") +
+                          "): unstable crack growth";
         throw StepFailed("bonds kept breaking at t = " + message_number(t1) + " s through " + std::to_string(rounds) +
                          " re-solves at the same load (" + std::to_string(broke_total.broken) +
                          " bonds): the crack grows unstably, which a quasi-static solve cannot follow; use "
@@ -773,7 +794,13 @@ std::string QuasiStatic::linear_algebra_summary() const {
   std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s", factorisations_,
                 factorise_seconds_, static_cast<long long>(solves_), solve_seconds_);
   std::string cut_text;
-  if (cuts_ > 0) cut_text = ", " + std::to_string(cuts_) + " load steps cut to the first bond failure";
+  if (!use_cg_ && analyses() > 0) {
+    char analyses_text[96];
+    std::snprintf(analyses_text, sizeof analyses_text, ", %d symbolic %s in %.3f s", analyses(),
+                  analyses() == 1 ? "analysis" : "analyses", analysis_seconds());
+    cut_text = analyses_text;
+  }
+  if (cuts_ > 0) cut_text += ", " + std::to_string(cuts_) + " load steps cut to the first bond failure";
   if (!use_cg_) return buffer + cut_text;
   // On the matrix-free path every CG iteration is one J·x product, about one force evaluation.
   std::string text = std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +

@@ -105,6 +105,14 @@ class QuasiStatic : public Integrator {
 
   // Work of the whole run, for run.log and the tests.
   int factorisations() const { return factorisations_; }
+  // CHOLMOD's symbolic analyses (orderings) behind them, and their wall time: one per CHOLMOD object
+  // in use while the tangent's pattern stays (it keeps every bond, broken or not).
+  // Factorisations CHOLMOD refused (the tangent not positive definite), since configure.
+  int refused_factorisations() const { return refused_; }
+  int analyses() const { return factor_->analyses() + (spare_factor_ ? spare_factor_->analyses() : 0); }
+  double analysis_seconds() const {
+    return factor_->analysis_seconds() + (spare_factor_ ? spare_factor_->analysis_seconds() : 0.0);
+  }
   // "N factorisations in X s, M solves in Y s" (wall time of assembling and factorising the tangent,
   // and of the solves with its factor; this process's only: a restarted run counts from the restart).
   std::string linear_algebra_summary() const override;
@@ -131,8 +139,10 @@ class QuasiStatic : public Integrator {
   const QuasiStaticSettings& settings() const { return settings_; }
 
   // ---- For the mixed integrator (integrators/mixed.hpp), which hands unstable steps to Verlet.
-  // A step needing more than max_breaking_rounds re-solves, or not converging at dt_min, fails.
-  void limit(int max_breaking_rounds, double dt_min);
+  // A step needing more than max_breaking_rounds re-solves, or not converging at dt_min, fails;
+  // with fail_on_steady_breaking also one whose re-solve broke at least as many bonds as the
+  // re-solve before it (the crack's growth at this load is not slowing down: unstable).
+  void limit(int max_breaking_rounds, double dt_min, bool fail_on_steady_breaking = false);
   // Whether the next step's Newton starts from u_n + Δt·v_n (see step()); false after an explicit
   // step, whose velocity is the motion of the vibrating body, not the rate of the load path.
   void guess_from_velocity(bool use) { guess_from_velocity_ = use; }
@@ -179,6 +189,8 @@ class QuasiStatic : public Integrator {
   bool guess_from_velocity_ = true;
   bool started_cold_ = false;  // the last accepted step started without the predictor (checkpointed)
   int try_once_iterations_ = 0;  // the cap of try_once (0: none)
+  bool fail_on_steady_breaking_ = false;  // see limit()
+  bool definite_first_ = false;  // the step's first factorisation is the definite variant (see newton())
   int iteration_cap_ = 0;        // the step in progress's (0: none)
 
   ForceOperator& op_;
@@ -192,7 +204,7 @@ class QuasiStatic : public Integrator {
   // the start's factor survives it (restore_solver swaps them back; each keeps its symbolic analysis).
   std::unique_ptr<SparseCholesky> factor_ = std::make_unique<SparseCholesky>(), spare_factor_;
   bool have_factor_ = false;
-  int factorisations_ = 0;
+  int factorisations_ = 0, refused_ = 0;
   std::int64_t solves_ = 0;
   double factorise_seconds_ = 0.0, solve_seconds_ = 0.0;  // wall time, for linear_algebra_summary()
   // Where the factorisation in use was assembled (for save_state): u, t, and whether the definite

@@ -4,6 +4,7 @@
 #include <cholmod.h>
 #include <omp.h>
 
+#include <chrono>
 #include <cstring>
 
 #include "core/error.hpp"
@@ -72,8 +73,10 @@ bool SparseCholesky::factorize(const SparseMatrix& K) {
   A.packed = 1;
   const bool same_pattern = impl_->factor && impl_->row_start == K.row_start && impl_->column == K.column;
   if (!same_pattern) {
+    const auto start = std::chrono::steady_clock::now();
     if (impl_->factor) cholmod_l_free_factor(&impl_->factor, cm);
     impl_->factor = cholmod_l_analyze(&A, cm);
+    analysis_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!impl_->factor) throw Error("CHOLMOD could not analyse the tangent matrix (status " + std::to_string(cm->status) + ")");
     impl_->row_start = K.row_start;
     impl_->column = K.column;

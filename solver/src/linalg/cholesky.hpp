@@ -30,6 +30,7 @@ class SparseCholesky {
 
   const std::string& failure() const { return failure_; }
   int analyses() const { return analyses_; }            // symbolic analyses so far (orderings)
+  double analysis_seconds() const { return analysis_seconds_; }  // wall time of those analyses
   double factor_nonzeros() const { return factor_nonzeros_; }  // entries of L
 
  private:
@@ -37,6 +38,7 @@ class SparseCholesky {
   std::unique_ptr<Impl> impl_;
   std::string failure_;
   int analyses_ = 0;
+  double analysis_seconds_ = 0.0;
   double factor_nonzeros_ = 0.0;
 };
 
