@@ -357,6 +357,57 @@ TEST(LoadPath, SeparatedOnlyWhenEveryBondBetweenTheGripsIsCut) {
   EXPECT_FALSE(one.separated(cantilever.bonds));
 }
 
+TEST(LoadPath, TheVerdictAfterBondsBreakOneByOneIsTheUnionFindsWhateverTheOrderAndWithAHeal) {
+  // The bar's bonds across a plane broken one directed bond at a time in a shuffled order (some
+  // with their reverse still intact), with bonds far from the plane broken on the way and one
+  // heal: after every change the kept LoadPath (the local check, union–find only when it cannot
+  // tell) says what a fresh one (union–find) says; and the union–find runs on far fewer calls.
+  pd::Model bar = breakable_bar();
+  const pd::LoadPath kept(bar);
+  const auto& x = bar.nodes.x[0];
+  const double cut = 5.5 * kDx;
+  std::vector<std::size_t> across, far;
+  for (std::size_t i = 0; i < bar.bonds.nodes(); ++i)
+    for (std::int64_t k = bar.bonds.offsets[i]; k < bar.bonds.offsets[i + 1]; ++k) {
+      const auto j = static_cast<std::size_t>(bar.bonds.neighbour[static_cast<std::size_t>(k)]);
+      const double lo = std::min(x[i], x[j]), hi = std::max(x[i], x[j]);
+      if (lo < cut && hi > cut) across.push_back(static_cast<std::size_t>(k));
+      else if (hi < 3.5 * kDx) far.push_back(static_cast<std::size_t>(k));
+    }
+  // A fixed shuffle (a linear congruential sequence: the same order on every machine).
+  std::uint64_t seed = 12345;
+  const auto shuffle = [&seed](std::vector<std::size_t>& v) {
+    for (std::size_t i = v.size(); i > 1; --i) {
+      seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+      std::swap(v[i - 1], v[static_cast<std::size_t>((seed >> 33) % i)]);
+    }
+  };
+  shuffle(across), shuffle(far);
+  int calls = 0, separated = 0;
+  const auto check = [&](const char* what, std::size_t step) {
+    ++calls;
+    const bool fresh = pd::LoadPath(bar).separated(bar.bonds);
+    ASSERT_EQ(kept.separated(bar.bonds), fresh) << what << " " << step;
+    separated += fresh;
+  };
+  check("start", 0);
+  for (std::size_t n = 0; n < across.size(); ++n) {
+    bar.bonds.broken[across[n]] = 1;
+    if (n < far.size() / 4) bar.bonds.broken[far[n]] = 1;
+    if (n == across.size() / 2) {  // a heal: a bond broken earlier intact again
+      bar.bonds.broken[across[0]] = 0;
+      check("heal", n);
+      bar.bonds.broken[across[0]] = 1;
+    }
+    check("across", n);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+  EXPECT_TRUE(kept.separated(bar.bonds));  // every bond across the plane is broken
+  EXPECT_GT(separated, 0);
+  EXPECT_LT(kept.full_counts(), calls / 4) << kept.full_counts() << " union-finds in " << calls << " calls";
+  EXPECT_GE(kept.full_counts(), 2);  // the first call, and the heal at least
+}
+
 TEST(Mixed, ReturnsToQuasiStaticOnceTheBarHasSeparatedWhateverItsRinging) {
   // The snapped halves ring undamped (no kinetic-energy rule would ever end the explicit phase);
   // arrest_steps steps after the cracks have cut the bar, the load steps finish the run.

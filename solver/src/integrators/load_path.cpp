@@ -61,8 +61,66 @@ std::int64_t LoadPath::linked_pairs(const BondList& bonds, bool use_broken) cons
   return pairs;
 }
 
+namespace {
+
+// Whether the directed bond b → a (the reverse of a → b) is intact; a row's neighbours ascend.
+bool reverse_intact(const BondList& bonds, std::int32_t a, std::int32_t b) {
+  const auto first = bonds.neighbour.begin() + bonds.offsets[static_cast<std::size_t>(b)];
+  const auto last = bonds.neighbour.begin() + bonds.offsets[static_cast<std::size_t>(b) + 1];
+  const auto at = std::lower_bound(first, last, a);
+  return at != last && *at == a && bonds.broken[static_cast<std::size_t>(at - bonds.neighbour.begin())] == 0;
+}
+
+}  // namespace
+
+bool LoadPath::joined_nearby(const BondList& bonds, std::int32_t a, std::int32_t b) const {
+  if (mark_.size() != bonds.nodes()) mark_.assign(bonds.nodes(), 0), generation_ = 0;
+  if (++generation_ == 0) std::fill(mark_.begin(), mark_.end(), 0), generation_ = 1;
+  queue_.clear();
+  queue_.push_back(a);
+  mark_[static_cast<std::size_t>(a)] = generation_;
+  for (std::size_t head = 0; head < queue_.size(); ++head) {
+    const std::int32_t u = queue_[head];
+    for (std::int64_t k = bonds.offsets[static_cast<std::size_t>(u)]; k < bonds.offsets[static_cast<std::size_t>(u) + 1]; ++k) {
+      const auto q = static_cast<std::size_t>(k);
+      const std::int32_t v = bonds.neighbour[q];
+      if (reached(v) || (bonds.broken[q] != 0 && !reverse_intact(bonds, u, v))) continue;
+      if (v == b) return true;
+      if (static_cast<int>(queue_.size()) >= kLocalNodes) return false;
+      mark_[static_cast<std::size_t>(v)] = generation_;
+      queue_.push_back(v);
+    }
+  }
+  return false;
+}
+
 bool LoadPath::separated(const BondList& bonds) const {
-  return linked_uncut_ && linked_pairs(bonds, false) < uncut_pairs_;
+  if (!linked_uncut_) return false;
+  bool same = counted_ && seen_broken_.size() == bonds.broken.size();
+  if (same) {
+    // The bonds broken since the last count (and none healed: else count again).
+    const std::size_t n = bonds.nodes();
+    for (std::size_t i = 0; i < n && same; ++i) {
+      const auto first = static_cast<std::size_t>(bonds.offsets[i]), last = static_cast<std::size_t>(bonds.offsets[i + 1]);
+      if (std::equal(bonds.broken.begin() + first, bonds.broken.begin() + last, seen_broken_.begin() + first)) continue;
+      for (std::size_t q = first; q < last && same; ++q) {
+        const bool now = bonds.broken[q] != 0, then = seen_broken_[q] != 0;
+        if (now == then) continue;
+        if (!now) same = false;  // healed
+        // Lost: i and its neighbour must still be joined (directly by the reverse bond, or nearby).
+        else if (!reverse_intact(bonds, static_cast<std::int32_t>(i), bonds.neighbour[q]) &&
+                 !joined_nearby(bonds, static_cast<std::int32_t>(i), bonds.neighbour[q]))
+          same = false;
+      }
+    }
+  }
+  if (!same) {
+    pairs_ = linked_pairs(bonds, false);
+    counted_ = true;
+    ++full_counts_;
+  }
+  seen_broken_ = bonds.broken;
+  return pairs_ < uncut_pairs_;
 }
 
 }  // namespace pd
