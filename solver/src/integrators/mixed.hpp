@@ -4,9 +4,10 @@
 // PeriLab by hand):
 //
 // - quasi-static → explicit, when a load step fails: bonds keep breaking through more than
-//   mixed.unstable_rounds re-solves at one load (the crack grows unstably: the released energy
-//   becomes motion, which equilibrium cannot describe), or Newton does not converge down to the
-//   smallest load step. The bonds that broke in the failed attempt are restored and Verlet goes on
+//   mixed.unstable_rounds re-solves at one load, or a re-solve breaks no fewer bonds than the one
+//   before it (the crack grows unstably: the released energy becomes motion, which equilibrium
+//   cannot describe; QuasiStatic::limit), or Newton does not converge down to the smallest load
+//   step. The bonds that broke in the failed attempt are restored and Verlet goes on
 //   from the last equilibrium, with its velocities (the loading rate) and the same time: time is
 //   physical here, so the boundary-condition tables must be loading rates.
 // - explicit → quasi-static, when the crack has arrested: bonds have broken in the explicit phase

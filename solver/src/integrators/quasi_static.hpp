@@ -6,7 +6,9 @@
 // full step does not lower the residual (backtracking line search). A factorisation is reused for
 // later iterations and load steps while it keeps the residual falling by 4× per iteration (below
 // the first bond failure PMB is nearly linear, so one factorisation serves many steps); otherwise
-// the tangent is assembled and factorised again.
+// the tangent is assembled and factorised again, on the symbolic analysis (CHOLMOD's ordering) of
+// the first: the pattern keeps every bond, broken or not. After bonds have broken, the first tangent
+// of a step that starts from an explicit step's state (mixed's return) is the definite variant.
 //
 // Newton starts from u_n + Δt·v_n at the free components, v_n the mean velocity of the last load
 // step: the linear extrapolation of the load path, which is the
@@ -17,7 +19,8 @@
 // ‖V f‖ ≤ residual_tol × the load (‖reactions‖ + ‖body forces‖) or the residual has stopped falling
 // (the round-off floor of the stretches, ~1e-16/strain of the load, above residual_tol at small strain). Then bonds over their critical
 // stretch break (thesis §2.2 rule) and the same load is solved again, until none breaks
-// (max_breaking_rounds: more is unstable crack growth, and the step fails). The next step is
+// (max_breaking_rounds: more is unstable crack growth, and the step fails; mixed also fails it when
+// a re-solve breaks no fewer bonds than the one before, see limit()). The next step is
 // Φ_K·Δt with Φ_K of eq. 2.8 (control/zohdi.hpp) from the last correction, not larger after a step
 // in which bonds broke; a step that does not converge is redone from t with Δt/2. Velocities are
 // the mean over the load step, (u_{n+1} − u_n)/Δt, so the work ledger integrates the reactions.
