@@ -62,4 +62,12 @@ void clamp_left_pull_right(pd::Case& c, double pull, double end, bool right_held
     for (int d = 1; d < 3; ++d) c.boundary_conditions.push_back({"right", "displacement", d, {0.0}, {0.0}});
 }
 
+pd::Model held_at_left(pd::Case c, pd::Nodes nodes, double dx) {
+  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)};
+  for (std::size_t i = 0; i < nodes.size(); ++i) left.member[i] = nodes.x[0][i] < 1.5 * dx;
+  nodes.sets = {left};
+  for (int d = 0; d < c.dimension; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
+  return pd::build_model(c, std::move(nodes));
+}
+
 }  // namespace pdtest

@@ -23,6 +23,10 @@ pd::Nodes bar_with_grips(int nx, int ny, int nz, double dx);
 // well when `right_held_across`.
 void clamp_left_pull_right(pd::Case& c, double pull, double end, bool right_held_across);
 
+// The model of c on `nodes` with the node set "left" (the first two layers in x, x < 1.5 dx) held
+// in every direction of c's dimension.
+pd::Model held_at_left(pd::Case c, pd::Nodes nodes, double dx);
+
 // Index of lattice node (i, j, k).
 inline std::size_t node_index(int i, int j, int k, int nx, int ny) {
   return static_cast<std::size_t>((k * ny + j) * nx + i);

@@ -26,13 +26,8 @@ int process_threads() {
 // A 2D lattice of 70 × 70 nodes, δ = 3.015 dx (the plate's horizon), its first two columns held:
 // 9 520 free dofs, whose factor has supernodes large enough for CHOLMOD's parallel loops.
 pd::Model held_plate() {
-  pd::Case c = pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0);
-  pd::Nodes nodes = pdtest::cubic_lattice(70, 70, 1, kDx, 2);
-  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)};
-  for (std::size_t i = 0; i < nodes.size(); ++i) left.member[i] = nodes.x[0][i] < 1.5 * kDx;
-  nodes.sets = {left};
-  for (int d = 0; d < 2; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
-  return pd::build_model(c, std::move(nodes));
+  return pdtest::held_at_left(pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0),
+                              pdtest::cubic_lattice(70, 70, 1, kDx, 2), kDx);
 }
 
 }  // namespace

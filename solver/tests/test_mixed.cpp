@@ -64,9 +64,13 @@ struct BarRun {
   pd::State state{model.nodes.size()};
   double t = 0.0, dt = 0.0;
   std::vector<std::string> log;
-  explicit BarRun(const std::string& start = "quasi_static", int pause_tries = 0, bool cut = false) {
+  explicit BarRun(const std::string& start = "quasi_static", int pause_tries = 0, bool cut = false)
+      : BarRun(mixed_case(start, cut), pause_tries, true) {}
+  // The bar with a case of the caller's and the rule of unstable growth on or off.
+  BarRun(const pd::Case& c, int pause_tries, bool steady_breaking_rule) {
     mixed.set_pause_tries(pause_tries);
-    mixed.configure(mixed_case(start, cut));
+    mixed.set_steady_breaking_rule(steady_breaking_rule);
+    mixed.configure(c);
     mixed.initialize(state, 0.0);
     dt = *mixed.initial_dt();
   }
@@ -932,35 +936,18 @@ TEST(Mixed, TheEarlyVerdictOfUnstableGrowthFailsTheSameLoadStepAndChangesNoResul
   // bits). With a limit of 20 the rule still ends it at the third: the failed step's bonds heal
   // and Verlet goes on from the last equilibrium, every state the same bits as with the limit of 3.
   // Without the rule that step goes on breaking.
-  struct Run {
-    pd::Model model = breakable_bar();
-    pd::ForceOperator op{model};
-    pd::Mixed mixed{op};
-    pd::State state{model.nodes.size()};
-    double t = 0.0, dt = 0.0;
-    std::vector<std::string> log;
-    Run(bool rule, int rounds) {
-      mixed.set_pause_tries(1);
-      mixed.set_steady_breaking_rule(rule);
-      pd::Case c = mixed_case("quasi_static", true);
-      c.mixed.unstable_rounds = rounds;
-      mixed.configure(c);
-      mixed.initialize(state, 0.0);
-      dt = *mixed.initial_dt();
-    }
-    void step() {
-      double h = std::min(dt, kEnd - t);
-      mixed.step(state, t, h);
-      dt = mixed.last_step().next_dt;
-      for (auto& line : mixed.take_log_lines()) log.push_back(line);
-    }
+  const auto with_rounds = [](int rounds) {
+    pd::Case c = mixed_case("quasi_static", true);
+    c.mixed.unstable_rounds = rounds;
+    return c;
   };
-  Run rule3(true, 3), plain3(false, 3), rule20(true, 20), plain20(false, 20);
+  BarRun rule3(with_rounds(3), 1, true), plain3(with_rounds(3), 1, false), rule20(with_rounds(20), 1, true),
+      plain20(with_rounds(20), 1, false);
   int switched_at = -1;
   for (int k = 0; k < 100000 && rule3.t < kEnd * (1 - 1e-12); ++k) {
     rule3.step(), plain3.step(), rule20.step();
     if (switched_at < 0) plain20.step();
-    for (const Run* other : {&plain3, &rule20}) {
+    for (const BarRun* other : {&plain3, &rule20}) {
       ASSERT_EQ(*rule3.mixed.step_mode(), *other->mixed.step_mode()) << "step " << k;
       ASSERT_EQ(rule3.t, other->t) << "step " << k;
       ASSERT_TRUE(same_bits(rule3.state.u, other->state.u)) << "step " << k;
@@ -971,7 +958,7 @@ TEST(Mixed, TheEarlyVerdictOfUnstableGrowthFailsTheSameLoadStepAndChangesNoResul
       // Without the rule and with 20 rounds allowed, the same load step went on breaking and ended
       // in equilibrium: the rule, not the round limit, ended rule20's (which healed its bonds).
       EXPECT_EQ(*plain20.mixed.step_mode(), pd::Mixed::kQuasiStatic);
-      const auto broken = [](const Run& r) { return std::count(r.model.bonds.broken.begin(), r.model.bonds.broken.end(), 1); };
+      const auto broken = [](const BarRun& r) { return std::count(r.model.bonds.broken.begin(), r.model.bonds.broken.end(), 1); };
       EXPECT_GT(broken(plain20), broken(rule20));
     }
   }

@@ -21,13 +21,8 @@ constexpr double kDx = 1e-3;
 
 // A 10×5×5 lattice, δ = 3.015dx, its first two x-layers held in every direction.
 pd::Model held_block() {
-  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0);
-  pd::Nodes nodes = pdtest::cubic_lattice(10, 5, 5, kDx, 3);
-  pd::NodeSet left{"left", std::vector<std::uint8_t>(nodes.size(), 0)};
-  for (std::size_t i = 0; i < nodes.size(); ++i) left.member[i] = nodes.x[0][i] < 1.5 * kDx;
-  nodes.sets = {left};
-  for (int d = 0; d < 3; ++d) c.boundary_conditions.push_back({"left", "displacement", d, {0.0}, {0.0}});
-  return pd::build_model(c, std::move(nodes));
+  return pdtest::held_at_left(pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0),
+                              pdtest::cubic_lattice(10, 5, 5, kDx, 3), kDx);
 }
 
 // The 3×3 diagonal blocks of a CSR matrix over node-numbered dofs (groups as BlockJacobi wants).
