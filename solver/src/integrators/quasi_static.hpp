@@ -108,10 +108,10 @@ class QuasiStatic : public Integrator {
 
   // Work of the whole run, for run.log and the tests.
   int factorisations() const { return factorisations_; }
-  // CHOLMOD's symbolic analyses (orderings) behind them, and their wall time: one per CHOLMOD object
-  // in use while the tangent's pattern stays (it keeps every bond, broken or not).
   // Factorisations CHOLMOD refused (the tangent not positive definite), since configure.
   int refused_factorisations() const { return refused_; }
+  // CHOLMOD's symbolic analyses (orderings) behind the factorisations, and their wall time: one per
+  // CHOLMOD object in use while the tangent's pattern stays (it keeps every bond, broken or not).
   int analyses() const { return factor_->analyses() + (spare_factor_ ? spare_factor_->analyses() : 0); }
   double analysis_seconds() const {
     return factor_->analysis_seconds() + (spare_factor_ ? spare_factor_->analysis_seconds() : 0.0);
