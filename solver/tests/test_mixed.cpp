@@ -969,3 +969,56 @@ TEST(Mixed, TheEarlyVerdictOfUnstableGrowthFailsTheSameLoadStepAndChangesNoResul
   EXPECT_EQ(plain3.log.front().find("no fewer than the one before"), std::string::npos) << plain3.log.front();
   EXPECT_EQ(rule20.mixed.factorisations_in_use(), rule3.mixed.factorisations_in_use());
 }
+
+namespace {
+
+// The bar with the pause rule (3 tries) and a cap on a try's new factorisations, run to the end:
+// per try, the factorisations it made and the log lines it wrote; and the state after the first try.
+struct CappedTries {
+  BarRun run{"quasi_static", 3};
+  std::vector<int> made;
+  std::vector<std::string> said;
+  pd::Vec3Array u_after_first, v_after_first;
+  std::vector<std::uint8_t> broken_after_first;
+  explicit CappedTries(int cap) {
+    run.mixed.set_pause_factorisations(cap);
+    for (int k = 0; run.t < kEnd * (1 - 1e-12) && k < 100000; ++k) {
+      const bool try_now = k > 0 && run.mixed.mode() == pd::Mixed::kQuasiStatic && *run.mixed.step_mode() == pd::Mixed::kExplicit;
+      const int before = run.mixed.factorisations_in_use();
+      const std::size_t lines = run.log.size();
+      run.step();
+      if (!try_now) continue;
+      made.push_back(run.mixed.factorisations_in_use() - before);
+      std::string text;
+      for (std::size_t q = lines; q < run.log.size(); ++q) text += run.log[q];
+      said.push_back(text);
+      if (made.size() == 1) u_after_first = run.state.u, v_after_first = run.state.v, broken_after_first = run.model.bonds.broken;
+    }
+  }
+};
+
+}  // namespace
+
+TEST(Mixed, ATryOnThePauseRuleFailsOnceItWouldNeedMoreNewTangentsThanItsCap) {
+  // Without a cap the bar's first try re-solves through 3 breaking rounds, each on a new
+  // factorisation, and fails on unstable growth. Capped at 2 it fails when it would need a third,
+  // and says so; a failed try leaves the state as it was, so the explicit step after it is the
+  // uncapped run's bit for bit. The default cap (4) is above what any try on the bar needs: the
+  // whole run is the uncapped one.
+  CappedTries uncapped(0), capped(2), by_default(pd::Mixed::kPauseFactorisations);
+  ASSERT_GE(uncapped.made.size(), 2u);
+  EXPECT_EQ(uncapped.made[0], 3);
+  EXPECT_NE(uncapped.said[0].find("unstable crack growth"), std::string::npos) << uncapped.said[0];
+  ASSERT_FALSE(capped.made.empty());
+  EXPECT_EQ(capped.made[0], 2);
+  EXPECT_NE(capped.said[0].find("the tentative load step reached no equilibrium in 2 factorisations of the tangent and "),
+            std::string::npos)
+      << capped.said[0];
+  EXPECT_EQ(*capped.run.mixed.step_mode(), pd::Mixed::kQuasiStatic);  // a return on the separation, later
+  EXPECT_TRUE(same_bits(capped.u_after_first, uncapped.u_after_first));
+  EXPECT_TRUE(same_bits(capped.v_after_first, uncapped.v_after_first));
+  EXPECT_EQ(capped.broken_after_first, uncapped.broken_after_first);
+  EXPECT_EQ(by_default.made, uncapped.made);
+  EXPECT_TRUE(same_bits(by_default.run.state.u, uncapped.run.state.u));
+  EXPECT_EQ(by_default.run.model.bonds.broken, uncapped.run.model.bonds.broken);
+}

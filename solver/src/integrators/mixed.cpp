@@ -183,7 +183,7 @@ void Mixed::step(State& state, double& t, double& dt) {
     const bool pause_rule = on_pause || (!from_explicit && probation_steps_ > 0 && pause_probation_);
     // The motion the load step gives up, booked when it is accepted (to_quasi_static).
     const double given_up = from_explicit ? op_.kinetic_energy(state) : 0.0;
-    if (tentative) static_.try_once(kTentativeIterations);
+    if (tentative) static_.try_once(kTentativeIterations, pause_rule ? pause_factorisations_ : 0);
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();

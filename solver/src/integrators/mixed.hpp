@@ -26,8 +26,9 @@
 //   horizon (δ/c, c = √(E/ρ) of the slowest block): a running crack tip breaks bonds at least that
 //   often, since what loads the bonds ahead of it travels at most at the wave speed. Whether the
 //   crack has stopped for good is then asked of the equilibrium itself: one tentative load step
-//   (kTentativeIterations Newton iterations, no halving, and no more than unstable_rounds breaking
-//   rounds) from the current state at the current load. If it converges the crack is stable under
+//   (kTentativeIterations Newton iterations on at most kPauseFactorisations new tangents, no
+//   halving, and no more than unstable_rounds breaking rounds) from the current state at the
+//   current load. If it converges the crack is stable under
 //   the load and the load steps go on (the first kProbationSteps tentative); if not, the bonds it
 //   broke heal and Verlet goes on until the next pause. After kPauseTries failed tries (counted
 //   since the last load step past a probation) the rule rests until such a step. Why: the explicit
@@ -108,6 +109,18 @@ class Mixed : public Integrator {
   // Failed tries before the pause rule is given up (kPauseTries; 0 switches the rule off: the tests
   // of the other rules). Before configure().
   void set_pause_tries(int tries) { pause_tries_ = tries; }
+  // A try on the pause rule is a guess that the crack has stopped. Its Newton iterations
+  // refactorise whenever the residual falls less than 4× (quasi_static.cpp), and each breaking
+  // round on a new tangent: a try that needs a fifth is still far from equilibrium and fails there,
+  // not after kTentativeIterations (the tries on test_mixed.cpp's bar need at most 3).
+  // Measured (bench/quasi_static_cases.py's mixed case, 1 thread): the try that succeeded on
+  // plate_with_hole at dx × 2 used 3 factorisations in 8 iterations; the one that failed at the
+  // case's own dx used 13 in 15 iterations, 23.8 s of the run's 50.3 s (a factorisation 1.86 s
+  // there, an explicit step 10 ms), its residual still 6.8·10⁻⁴ against 4.9·10⁻⁷ wanted.
+  static constexpr int kPauseFactorisations = 4;
+  // New factorisations a try may make before it fails (kPauseFactorisations; 0: no cap, only
+  // kTentativeIterations). Before the step that tries.
+  void set_pause_factorisations(int factorisations) { pause_factorisations_ = factorisations; }
   // Load steps cut to the first bond failure (quasi_static.hpp), since configure.
   int cuts_in_use() const { return home_ == kImplicit ? 0 : static_.cuts(); }
   int factorisations_in_use() const { return home_ == kImplicit ? implicit_.factorisations() : static_.factorisations(); }
@@ -181,6 +194,7 @@ class Mixed : public Integrator {
   // residual not yet below its tolerance); with 10 the rule was given up and the run stayed explicit
   // to its end: 2 693 steps against 774 (bench/result_hashes.py's input, 1 thread, 3 Dec 2026).
   static constexpr int kTentativeIterations = 15;
+  int pause_factorisations_ = kPauseFactorisations;
   static constexpr int kProbationSteps = 3;
   std::vector<std::uint8_t> broken_before_;  // the bonds' state before a quasi-static attempt
   std::vector<double> critical_before_;      // and the per-node s0 of LAMMPS's α rule

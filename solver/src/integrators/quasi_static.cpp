@@ -496,6 +496,12 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew (also
     // when only ω is above TOL: an old factor then reduces ω only linearly).
     if (!use_cg_ && (!have_factor_ || residual > 0.25 * previous)) {
+      // A tentative step that has used its factorisations fails here: Newton that needs yet another
+      // tangent is still far from an equilibrium (try_once).
+      if (factorisation_cap_ > 0 && factorisations_ - factorisations_at_step_ >= factorisation_cap_) {
+        factorisation_cap_hit_ = true;
+        return false;
+      }
       // Once bonds have broken, a node or a fragment may hang by nothing: its rows are zero and K
       // is singular although the residual does not drive it. A shift of the diagonal by
       // kDiagonalShift × its largest entry lets it be factorised; the residual, not K, decides
@@ -652,7 +658,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   report_ = StepReport{};
   failure_reason_.clear();
   iteration_cap_ = try_once_iterations_;  // this step only
-  try_once_iterations_ = 0;
+  factorisation_cap_ = try_once_factorisations_;
+  try_once_iterations_ = try_once_factorisations_ = 0;
+  factorisations_at_step_ = factorisations_;
   report_.force_evaluations = 0;
   // From the bonds themselves, not a flag carried along: a restarted run (or a pre-cracked body)
   // shifts its tangent exactly as the uninterrupted run does.
@@ -757,10 +765,15 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     have_factor_ = false;
     if (iteration_cap_ > 0) {
-      failure_reason_ = "the tentative load step reached no equilibrium in " + std::to_string(iteration_cap_) +
-                        " Newton iterations (last correction ω = " + message_number(omega) + ")";
+      const std::string spent = factorisation_cap_hit_
+                                    ? std::to_string(factorisation_cap_) + " factorisations of the tangent and " +
+                                          std::to_string(total) + " Newton iterations"
+                                    : std::to_string(iteration_cap_) + " Newton iterations";
+      factorisation_cap_hit_ = false;
+      failure_reason_ = "the tentative load step reached no equilibrium in " + spent + " (last correction ω = " +
+                        message_number(omega) + ")";
       throw StepFailed("the tentative quasi-static load step at t = " + message_number(t1) + " s reached no equilibrium in " +
-                       std::to_string(iteration_cap_) + " Newton iterations");
+                       spent);
     }
     if (h <= dt_min_ * (1.0 + 1e-12)) {
       failure_reason_ = "no equilibrium at the smallest load step " + message_number(dt_min_) + " s (last correction ω = " +

@@ -149,9 +149,14 @@ class QuasiStatic : public Integrator {
   // Whether the next step's Newton starts from u_n + Δt·v_n (see step()); false after an explicit
   // step, whose velocity is the motion of the vibrating body, not the rate of the load path.
   void guess_from_velocity(bool use) { guess_from_velocity_ = use; }
-  // For the next step only: a single attempt at the step asked for (no halving) and at most
-  // max_iterations Newton iterations: a tentative step, which fails fast.
-  void try_once(int max_iterations) { try_once_iterations_ = max_iterations; }
+  // For the next step only: a single attempt at the step asked for (no halving), at most
+  // max_iterations Newton iterations and, when max_factorisations > 0, at most that many new
+  // factorisations of the tangent: a tentative step, which fails fast (and cheaply: on a large 2D
+  // lattice one factorisation costs some 200 explicit steps, see mixed.hpp kPauseFactorisations).
+  void try_once(int max_iterations, int max_factorisations = 0) {
+    try_once_iterations_ = max_iterations;
+    try_once_factorisations_ = max_factorisations;
+  }
   // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
   void forget_factorisation() { have_factor_ = false, amg_.clear(); }
   // Why the last step() threw StepFailed, in a few words for run.log.
@@ -191,10 +196,14 @@ class QuasiStatic : public Integrator {
   bool broken_since_start_ = false;  // a bond has broken in this run (then K is shifted, see .cpp)
   bool guess_from_velocity_ = true;
   bool started_cold_ = false;  // the last accepted step started without the predictor (checkpointed)
-  int try_once_iterations_ = 0;  // the cap of try_once (0: none)
+  int try_once_iterations_ = 0;  // the caps of try_once (0: none)
+  int try_once_factorisations_ = 0;
   bool fail_on_steady_breaking_ = false;  // see limit()
   bool definite_first_ = false;  // the step's first factorisation is the definite variant (see newton())
   int iteration_cap_ = 0;        // the step in progress's (0: none)
+  int factorisation_cap_ = 0;    // the step in progress's new factorisations at most (0: no cap)
+  int factorisations_at_step_ = 0;  // factorisations_ when the step in progress began
+  bool factorisation_cap_hit_ = false;  // the step in progress failed on factorisation_cap_
 
   ForceOperator& op_;
   QuasiStaticSettings settings_;
