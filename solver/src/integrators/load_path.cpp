@@ -61,6 +61,22 @@ std::int64_t LoadPath::linked_pairs(const BondList& bonds, bool use_broken) cons
   return pairs;
 }
 
+std::vector<std::int32_t> LoadPath::held_by_one_group(const BondList& bonds) const {
+  const std::vector<std::int32_t> root = components(bonds, false);
+  const std::size_t n = root.size();
+  constexpr std::int32_t kNone = -1, kSeveral = -2;
+  std::vector<std::int32_t> of_root(n, kNone);  // per root: the one group in its component, or none, or several
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t g = group_[i];
+    std::int32_t& held = of_root[static_cast<std::size_t>(root[i])];
+    if (g < 0 || held == kSeveral || held == g) continue;
+    held = held == kNone ? g : kSeveral;
+  }
+  std::vector<std::int32_t> group(n);
+  for (std::size_t i = 0; i < n; ++i) group[i] = std::max(of_root[static_cast<std::size_t>(root[i])], kNone);
+  return group;
+}
+
 namespace {
 
 // Whether the directed bond b → a (the reverse of a → b) is intact; a row's neighbours ascend.

@@ -28,6 +28,11 @@ class LoadPath {
   // that broke a bond: 1 ms each on plate_with_hole at dx × 2, 5 % of its run).
   bool separated(const BondList& bonds) const;
   static constexpr int kLocalNodes = 512;
+  // Per node, the group whose prescribed motion alone holds its piece: g when the intact bonds join
+  // the node to nodes of group g and of no other group; −1 when they join it to none (a free
+  // fragment) or to several (a piece still loaded between two prescribed motions). O(bonds).
+  std::vector<std::int32_t> held_by_one_group(const BondList& bonds) const;
+  std::int32_t groups() const { return groups_; }
   // Calls answered by the union–find (for the tests).
   std::int64_t full_counts() const { return full_counts_; }
 

@@ -9,6 +9,8 @@
 #include "core/error.hpp"
 #include "core/time_step_rule.hpp"
 #include "integrators/messages.hpp"
+#include "parallel/decomposed.hpp"
+#include "parallel/local_model.hpp"
 
 namespace pd {
 
@@ -88,6 +90,27 @@ bool Mixed::load_path_cut() const {
   dec->gather_broken(op_.model().bonds, whole_->bonds);
   const bool cut = dec->rank() == 0 && load_path_->separated(whole_->bonds);
   return dec->minimum(cut ? 0.0 : 1.0) == 0.0;
+}
+
+// Per local node, the group of prescribed motions that alone holds its piece (LoadPath::
+// held_by_one_group). Decomposed: judged on rank 0 from the gathered broken flags, broadcast in
+// global numbering and taken at the piece's nodes. Collective.
+std::vector<std::int32_t> Mixed::pieces_held_by_one_group() const {
+  const Decomposed* dec = op_.decomposed();
+  if (!dec || !whole_) return load_path_->held_by_one_group(op_.model().bonds);
+  dec->gather_broken(op_.model().bonds, whole_->bonds);
+  std::vector<double> group;  // as doubles, for the broadcast (exact: small integers)
+  if (dec->rank() == 0) {
+    const std::vector<std::int32_t> held = load_path_->held_by_one_group(whole_->bonds);
+    group.assign(held.begin(), held.end());
+  } else {
+    group.assign(static_cast<std::size_t>(dec->piece().global_nodes), 0.0);
+  }
+  dec->broadcast(group);
+  const std::vector<double> local = to_local(dec->piece(), group);
+  std::vector<std::int32_t> out(local.size());
+  for (std::size_t l = 0; l < local.size(); ++l) out[l] = static_cast<std::int32_t>(local[l]);
+  return out;
 }
 
 void Mixed::to_explicit(State&, double t, const std::string& reason) {
@@ -184,6 +207,10 @@ void Mixed::step(State& state, double& t, double& dt) {
     // The motion the load step gives up, booked when it is accepted (to_quasi_static).
     const double given_up = from_explicit ? op_.kinetic_energy(state) : 0.0;
     if (tentative) static_.try_once(kTentativeIterations, pause_rule ? pause_factorisations_ : 0);
+    // Once separated, every load step starts from the pieces each carried by the one grip that holds
+    // it (QuasiStatic::carry_rigidly): unstrained, their equilibrium, which Newton then accepts
+    // without a factorisation (measured in the header).
+    if (separated_ && !separation_given_up_) static_.carry_pieces(pieces_held_by_one_group(), load_path_->groups());
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();
@@ -191,8 +218,10 @@ void Mixed::step(State& state, double& t, double& dt) {
       if (tentative) probation_steps_ = std::max(probation_steps_ - 1, 0);
       else pause_failures_ = 0;  // a load step past any probation: the pause rule's tries count anew
       if (returning)
-        log_lines_.push_back("mixed: t = " + message_number(t) + " s: back in load steps: equilibrium in " +
-                             std::to_string(report_.iterations) + " Newton iterations" +
+        log_lines_.push_back("mixed: t = " + message_number(t) + " s: back in load steps: " +
+                             (static_.accepted_as_carried()
+                                  ? std::string("each piece carried by the one grip that holds it is in equilibrium (no correction, no tangent)")
+                                  : "equilibrium in " + std::to_string(report_.iterations) + " Newton iterations") +
                              (report_.broken_now > 0 ? ", " + std::to_string(report_.broken_now) + " bonds broken on the way" : "") +
                              " (" + std::to_string(static_.hanging_nodes() - static_.linkage_nodes()) +
                              " nodes hanging by collinear bonds left out of the solve and placed on their bonds' line, " +

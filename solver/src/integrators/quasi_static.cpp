@@ -12,6 +12,7 @@
 
 #include "control/zohdi.hpp"
 #include "core/error.hpp"
+#include "parallel/decomposed.hpp"
 #include "parallel/node_sum.hpp"
 #include "integrators/messages.hpp"
 #include "integrators/newton_krylov.hpp"
@@ -492,6 +493,12 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     // stretches (about 1e-16/strain of the load), and no further iteration changes u.
     if (k > 1 && omega <= settings_.tol && (residual <= settings_.residual_tol * load || residual >= 0.5 * previous))
       return true;
+    // The separated pieces carried rigidly by their grips are unstrained: when that already meets the
+    // residual test, it is the equilibrium, and no tangent is needed (carry_rigidly).
+    if (k == 1 && started_carried_ && residual <= settings_.residual_tol * load) {
+      accepted_carried_ = true;
+      return omega = 0.0, true;
+    }
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew (also
     // when only ω is above TOL: an old factor then reduces ω only linearly).
@@ -654,6 +661,47 @@ void QuasiStatic::restore_solver() {
   at_start_.amg_u_saved = false;
 }
 
+// Each node whose piece is held by one group of prescribed motions alone (carried_) takes that
+// motion's displacement at t1 in its free components, when every node the group prescribes in every
+// component has the same one (a translation): the piece is then unstrained, which is its
+// equilibrium when nothing else loads it. Newton checks: the residual test decides, and needs no
+// factorisation when it passes. A group that prescribes only some components, or moves its nodes
+// apart, carries nothing: its pieces keep the state they had. On a decomposed run the least and the
+// largest displacement of a group are taken over the ranks, so every rank carries alike.
+void QuasiStatic::carry_rigidly(State& s) const {
+  const auto dim = static_cast<std::size_t>(op_.model().nodes.dimension);
+  const auto& fixed = op_.fixed();
+  const auto held_in_full = [&](std::size_t i) {
+    for (std::size_t d = 0; d < dim; ++d)
+      if (!fixed[d][i]) return false;
+    return true;
+  };
+  const auto groups = static_cast<std::size_t>(carried_groups_);
+  std::vector<double> low(3 * groups, HUGE_VAL), high(3 * groups, -HUGE_VAL);
+  // Owned nodes only: a ghost's prescribed components are its owner's to advance (not yet at t1 here).
+  const Decomposed* dec = op_.decomposed();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::int32_t g = carried_[i];
+    if (g < 0 || !held_in_full(i) || (dec && !dec->piece().owned[i])) continue;
+    for (std::size_t d = 0; d < dim; ++d) {
+      low[3 * static_cast<std::size_t>(g) + d] = std::min(low[3 * static_cast<std::size_t>(g) + d], s.u[d][i]);
+      high[3 * static_cast<std::size_t>(g) + d] = std::max(high[3 * static_cast<std::size_t>(g) + d], s.u[d][i]);
+    }
+  }
+  if (dec)
+    for (std::size_t q = 0; q < low.size(); ++q) low[q] = dec->minimum(low[q]), high[q] = -dec->minimum(-high[q]);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::int32_t g = carried_[i];
+    if (g < 0) continue;
+    const double* at = &low[3 * static_cast<std::size_t>(g)];
+    bool translation = true;
+    for (std::size_t d = 0; d < dim; ++d) translation = translation && at[d] == high[3 * static_cast<std::size_t>(g) + d];
+    if (!translation) continue;  // no node held in full (±inf), or two that move apart
+    for (std::size_t d = 0; d < dim; ++d)
+      if (!fixed[d][i]) s.u[d][i] = at[d];
+  }
+}
+
 void QuasiStatic::step(State& state, double& t, double& dt) {
   report_ = StepReport{};
   failure_reason_.clear();
@@ -661,6 +709,11 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   factorisation_cap_ = try_once_factorisations_;
   try_once_iterations_ = try_once_factorisations_ = 0;
   factorisations_at_step_ = factorisations_;
+  // The carried pieces are for this step only; a step that fails and is halved redoes it from them.
+  struct Drop {
+    std::vector<std::int32_t>& carried;
+    ~Drop() { carried.clear(); }
+  } drop{carried_};
   report_.force_evaluations = 0;
   // From the bonds themselves, not a flag carried along: a restarted run (or a pre-cracked body)
   // shifts its tangent exactly as the uninterrupted run does.
@@ -690,6 +743,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       for (std::size_t d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < s.size(); ++i)
           if (!op_.fixed()[d][i]) s.u[d][i] = state.u[d][i] + h * state.v[d][i];
+    started_carried_ = !carried_.empty();
+    accepted_carried_ = false;
+    if (started_carried_) carry_rigidly(s);
     int iterations = 0, total = 0, rounds = 0;
     std::int64_t last_broken = 0;  // bonds broken by the last breaking round
     definite_first_ = !guess_from_velocity_;

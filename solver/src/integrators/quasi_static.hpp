@@ -157,6 +157,16 @@ class QuasiStatic : public Integrator {
     try_once_iterations_ = max_iterations;
     try_once_factorisations_ = max_factorisations;
   }
+  // For the next step only: the pieces the cracks have separated, carried by their grips. Per local
+  // node the group of prescribed motions that alone holds its piece, −1 for none or several
+  // (LoadPath::held_by_one_group), and the number of groups (the same on every rank). See
+  // carry_rigidly().
+  void carry_pieces(std::vector<std::int32_t> group_of_node, std::int32_t groups) {
+    carried_ = std::move(group_of_node);
+    carried_groups_ = groups;
+  }
+  // Whether the last step's equilibrium was the carried state itself (no correction, no tangent).
+  bool accepted_as_carried() const { return accepted_carried_; }
   // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
   void forget_factorisation() { have_factor_ = false, amg_.clear(); }
   // Why the last step() threw StepFailed, in a few words for run.log.
@@ -196,6 +206,13 @@ class QuasiStatic : public Integrator {
   bool broken_since_start_ = false;  // a bond has broken in this run (then K is shifted, see .cpp)
   bool guess_from_velocity_ = true;
   bool started_cold_ = false;  // the last accepted step started without the predictor (checkpointed)
+  // The next step's pieces carried by their grips (carry_pieces; empty: none), and whether the step
+  // in progress started from them.
+  std::vector<std::int32_t> carried_;
+  std::int32_t carried_groups_ = 0;
+  bool started_carried_ = false;
+  bool accepted_carried_ = false;  // the last step's equilibrium was the carried state itself
+  void carry_rigidly(State& s) const;
   int try_once_iterations_ = 0;  // the caps of try_once (0: none)
   int try_once_factorisations_ = 0;
   bool fail_on_steady_breaking_ = false;  // see limit()
