@@ -495,7 +495,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
       return true;
     // The separated pieces carried rigidly by their grips are unstrained: when that already meets the
     // residual test, it is the equilibrium, and no tangent is needed (carry_rigidly).
-    if (k == 1 && started_carried_ && residual <= settings_.residual_tol * load) {
+    if (k == 1 && !carried_.empty() && residual <= settings_.residual_tol * load) {
       accepted_carried_ = true;
       return omega = 0.0, true;
     }
@@ -676,16 +676,17 @@ void QuasiStatic::carry_rigidly(State& s) const {
       if (!fixed[d][i]) return false;
     return true;
   };
-  const auto groups = static_cast<std::size_t>(carried_groups_);
-  std::vector<double> low(3 * groups, HUGE_VAL), high(3 * groups, -HUGE_VAL);
+  // Per group and component (entry 3g + d), the least and the largest displacement of its nodes.
+  const auto at = [](std::int32_t g, std::size_t d) { return 3 * static_cast<std::size_t>(g) + d; };
+  std::vector<double> low(at(carried_groups_, 0), HUGE_VAL), high(low.size(), -HUGE_VAL);
   // Owned nodes only: a ghost's prescribed components are its owner's to advance (not yet at t1 here).
   const Decomposed* dec = op_.decomposed();
   for (std::size_t i = 0; i < s.size(); ++i) {
     const std::int32_t g = carried_[i];
     if (g < 0 || !held_in_full(i) || (dec && !dec->piece().owned[i])) continue;
     for (std::size_t d = 0; d < dim; ++d) {
-      low[3 * static_cast<std::size_t>(g) + d] = std::min(low[3 * static_cast<std::size_t>(g) + d], s.u[d][i]);
-      high[3 * static_cast<std::size_t>(g) + d] = std::max(high[3 * static_cast<std::size_t>(g) + d], s.u[d][i]);
+      low[at(g, d)] = std::min(low[at(g, d)], s.u[d][i]);
+      high[at(g, d)] = std::max(high[at(g, d)], s.u[d][i]);
     }
   }
   if (dec)
@@ -693,12 +694,11 @@ void QuasiStatic::carry_rigidly(State& s) const {
   for (std::size_t i = 0; i < s.size(); ++i) {
     const std::int32_t g = carried_[i];
     if (g < 0) continue;
-    const double* at = &low[3 * static_cast<std::size_t>(g)];
     bool translation = true;
-    for (std::size_t d = 0; d < dim; ++d) translation = translation && at[d] == high[3 * static_cast<std::size_t>(g) + d];
+    for (std::size_t d = 0; d < dim; ++d) translation = translation && low[at(g, d)] == high[at(g, d)];
     if (!translation) continue;  // no node held in full (±inf), or two that move apart
     for (std::size_t d = 0; d < dim; ++d)
-      if (!fixed[d][i]) s.u[d][i] = at[d];
+      if (!fixed[d][i]) s.u[d][i] = low[at(g, d)];
   }
 }
 
@@ -743,9 +743,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       for (std::size_t d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < s.size(); ++i)
           if (!op_.fixed()[d][i]) s.u[d][i] = state.u[d][i] + h * state.v[d][i];
-    started_carried_ = !carried_.empty();
     accepted_carried_ = false;
-    if (started_carried_) carry_rigidly(s);
+    if (!carried_.empty()) carry_rigidly(s);
     int iterations = 0, total = 0, rounds = 0;
     std::int64_t last_broken = 0;  // bonds broken by the last breaking round
     definite_first_ = !guess_from_velocity_;

@@ -206,11 +206,10 @@ class QuasiStatic : public Integrator {
   bool broken_since_start_ = false;  // a bond has broken in this run (then K is shifted, see .cpp)
   bool guess_from_velocity_ = true;
   bool started_cold_ = false;  // the last accepted step started without the predictor (checkpointed)
-  // The next step's pieces carried by their grips (carry_pieces; empty: none), and whether the step
-  // in progress started from them.
+  // The next step's pieces carried by their grips (carry_pieces; empty: none); kept through the step
+  // in progress, which starts from them (and every halving of it), and cleared when it ends.
   std::vector<std::int32_t> carried_;
   std::int32_t carried_groups_ = 0;
-  bool started_carried_ = false;
   bool accepted_carried_ = false;  // the last step's equilibrium was the carried state itself
   void carry_rigidly(State& s) const;
   int try_once_iterations_ = 0;  // the caps of try_once (0: none)
