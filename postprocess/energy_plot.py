@@ -4,7 +4,9 @@ The balance is every stored and dissipated energy minus the work put in (validat
     kinetic + strain + contact + indenter + broken bonds + damping work − external work,
 each term where history.csv has its column (formats.md §4). Without breaking, its drift is the
 integrator's error; with breaking, broken_bond_energy is the energy the broken bonds took with them,
-and leaving it out shows a loss that is not one (branching: −4.6 % instead of 1.2 %).
+and leaving it out shows a loss that is not one (branching: −4.6 % instead of 1.2 %). A quasi-static
+load step books what its jump to equilibrium gives up as damping work (the solver's run/loop.cpp),
+so the balance is flat across load steps and its drift is the dynamic steps' error.
 """
 from __future__ import annotations
 

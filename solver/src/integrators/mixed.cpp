@@ -130,8 +130,9 @@ void Mixed::to_quasi_static(State&, double t, double kinetic, double strain) {
   pause_probation_ = pause_return_;
   static_.forget_factorisation();  // bonds broke in the explicit steps
   // The next load step finds equilibrium and leaves only the mean velocity of the load step: the
-  // kinetic energy now is given up, booked as damping work so that the balance closes, when that
-  // step is accepted (Mixed::step: a tentative step that fails leaves the motion to Verlet).
+  // kinetic energy now, and the strain energy of the ringing beyond the equilibrium's, are given
+  // up, booked as damping work (run/loop.cpp: every quasi-static step's ledger) when that step is
+  // accepted (Mixed::step: a tentative step that fails leaves the motion to Verlet).
   const std::string why =
       pause_return_ ? "the crack stopped running: no bond broke for " + std::to_string(quiet_steps_) +
                           " steps, a horizon's crossing time of a stress wave; a tentative load step asks whether it is stable"
@@ -204,8 +205,6 @@ void Mixed::step(State& state, double& t, double& dt) {
     const bool tentative = returning || probation_steps_ > 0;
     static_.load_path_cut(separated_ && !separation_given_up_);  // strands carry no load then (hanging_nodes.hpp)
     const bool pause_rule = on_pause || (!from_explicit && probation_steps_ > 0 && pause_probation_);
-    // The motion the load step gives up, booked when it is accepted (to_quasi_static).
-    const double given_up = from_explicit ? op_.kinetic_energy(state) : 0.0;
     if (tentative) static_.try_once(kTentativeIterations, pause_rule ? pause_factorisations_ : 0);
     // Once separated, every load step starts from the pieces each carried by the one grip that holds
     // it (QuasiStatic::carry_rigidly): unstrained, their equilibrium, which Newton then accepts
@@ -214,7 +213,6 @@ void Mixed::step(State& state, double& t, double& dt) {
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();
-      state.damping_work += given_up;
       if (tentative) probation_steps_ = std::max(probation_steps_ - 1, 0);
       else pause_failures_ = 0;  // a load step past any probation: the pause rule's tries count anew
       if (returning)
