@@ -1039,7 +1039,7 @@ TEST(Mixed, ATryOnThePauseRuleFailsOnceItWouldNeedMoreNewTangentsThanItsCap) {
   // Without a cap the bar's first try re-solves through 3 breaking rounds, each on a new
   // factorisation, and fails on unstable growth. Capped at 2 it fails when it would need a third,
   // and says so; a failed try leaves the state as it was, so the explicit step after it is the
-  // uncapped run's bit for bit. The default cap (4) is above what any try on the bar needs: the
+  // uncapped run's bit for bit. The default cap (3) is what the bar's tries need at most: the
   // whole run is the uncapped one.
   CappedTries uncapped(0), capped(2), by_default(pd::Mixed::kPauseFactorisations);
   ASSERT_GE(uncapped.made.size(), 2u);
