@@ -785,7 +785,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
         throw StepFailed("bonds kept breaking at t = " + message_number(t1) + " s through " + std::to_string(rounds) +
                          " re-solves at the same load (" + std::to_string(broke_total.broken) +
                          " bonds): the crack grows unstably, which a quasi-static solve cannot follow; use "
-                         "time.integrator: verlet (or raise quasi_static.max_breaking_rounds)");
+                         "time.integrator: mixed (explicit steps while the crack runs) or verlet, or raise "
+                         "quasi_static.max_breaking_rounds");
       }
     }
     if (converged && cut_to > 0.0) {
@@ -836,8 +837,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       throw StepFailed("the quasi-static load step did not reach equilibrium at dt_min = " + message_number(dt_min_) +
                        " s (t = " + message_number(t) + " s, " + std::to_string(report_.rejected + 1) +
                        " attempts, last correction ω = " + message_number(omega) + "); the load may exceed what the "
-                       "body can carry (unstable fracture or buckling): use time.integrator: verlet, or raise "
-                       "quasi_static.max_iterations");
+                       "body can carry (unstable fracture or buckling): use time.integrator: mixed (explicit steps "
+                       "where no equilibrium is found, load steps again once the motion has settled) or verlet, or "
+                       "raise quasi_static.max_iterations");
     }
     ++report_.rejected;
     h = std::max(0.5 * h, dt_min_);
