@@ -349,8 +349,8 @@ CASE = {
                              "this fraction of the strain energy ...", default=0.05, above=0.0,
                              below=1.0),
         arrest_steps=Key("integer", "... for this many explicit steps in a row without a bond breaking "
-                         "(the crack arrested); back to quasi_static, the kinetic energy left is given up, as "
-                         "damping work (implicit keeps it)",
+                         "(the crack arrested); back to quasi_static, the kinetic energy left and the strain energy "
+                         "above the equilibrium's are given up, as damping work (implicit keeps them)",
                          default=200, minimum=1, maximum=1000000000),
     ),
     "output": section(
