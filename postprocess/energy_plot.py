@@ -22,8 +22,12 @@ STORED_TERMS = (("kinetic_energy", "kinetic"), ("strain_energy", "strain"), ("co
 
 
 def balance_terms(history: dict) -> list[tuple[str, str]]:
-    """The (column, label) of STORED_TERMS that history.csv has."""
-    return [(column, label) for column, label in STORED_TERMS if column in history]
+    """The (column, label) of STORED_TERMS that history.csv has. A run with quasi-static load steps
+    (`mode` 1) books in damping_work what their jumps to equilibrium give up, damped or not: its
+    label says so."""
+    load_steps = "mode" in history and bool(np.any(np.asarray(history["mode"]) == 1))
+    return [(column, "damping work + given up by load steps" if column == "damping_work" and load_steps else label)
+            for column, label in STORED_TERMS if column in history]
 
 
 def energy_balance(history: dict) -> np.ndarray:

@@ -94,6 +94,20 @@ def test_energy_balance_counts_broken_bonds_and_closes_to_what_validation_report
     check_readable(fig)
 
 
+def test_with_load_steps_the_damping_work_is_labelled_with_what_they_give_up(keep):
+    """A mixed run: the damping work holds what its quasi-static load steps gave up (the solver's
+    run/loop.cpp), with or without damping, and the legend says so; a run without load steps keeps
+    the plain label."""
+    h = fracture_history()
+    h["damping_work"] = 0.3 * h["external_work"]
+    h["mode"] = np.where(np.arange(len(h["time"])) < 100, 1, 0)
+    energy_plot.plot_energy(h, case(), "energy.png")
+    labels = [t.get_text() for t in keep["energy.png"].axes[0].get_legend().get_texts()]
+    assert "damping work + given up by load steps" in labels and "damping work" not in labels
+    h["mode"] = np.zeros(len(h["time"]), int)
+    assert ("damping_work", "damping work") in energy_plot.balance_terms(h)
+
+
 def test_every_stored_term_joins_the_balance():
     h = fracture_history()
     h["contact_energy"] = 0.1 * h["external_work"]
