@@ -31,7 +31,8 @@ COLUMNS = {
     "kinetic_energy": ("J", "kinetic energy, sum of 1/2 rho V |v|^2"),
     "strain_energy": ("J", "strain energy of the intact bonds, sum of 1/4 c s^2 |xi| V_i V_j"),
     "external_work": ("J", "work of body forces, of the reactions at prescribed nodes and of moving indenters"),
-    "damping_work": ("J", "energy removed by damping, integral of sum rho alpha V |v|^2 dt"),
+    "damping_work": ("J", "energy removed by damping, integral of sum rho alpha V |v|^2 dt, plus what "
+                     "quasi-static load steps gave up on their jumps to equilibrium"),
     "broken_bonds": ("1", "broken bonds, each counted once"),
     "wall_time": ("s", "wall-clock seconds since the time loop started"),
     "contact_energy": ("J", "potential of the short-range contact pairs (0 without contact)"),

@@ -325,7 +325,9 @@ struct LedgerRow {
   double time, kinetic, strain, work, damping, broken_energy;
   int mode;
   std::int64_t broken;
-  double balance() const { return kinetic + strain + damping + broken_energy - work; }
+  // A load step's row holds no kinetic energy in the balance (run/loop.cpp: its velocity is the
+  // step's mean rate, not motion), as energy.png draws it.
+  double balance() const { return (mode == 1 ? 0.0 : kinetic) + strain + damping + broken_energy - work; }
 };
 
 std::vector<LedgerRow> pulled_through_fracture(const std::string& integrator, std::string& log) {
@@ -374,7 +376,7 @@ TEST(EndToEnd, QuasiStaticLoadStepsBookWhatTheyGiveUpSoThatTheEnergyBalanceHolds
     ASSERT_GT(rows.size(), 10u);
     const LedgerRow& last = rows.back();
     ASSERT_NEAR(last.time, 1e-3, 1e-15);
-    ASSERT_GT(last.broken, 100);  // the plate is cut through: 148 bonds on the way
+    ASSERT_GT(last.broken, 100);  // the plate is cut through: 144 (quasi_static) and 154 (mixed) bonds
     ASSERT_GT(last.work, 0.0);
     int load_steps = 0, breaking_load_steps = 0;
     for (std::size_t k = 1; k < rows.size(); ++k) {  // a row every step
@@ -382,11 +384,20 @@ TEST(EndToEnd, QuasiStaticLoadStepsBookWhatTheyGiveUpSoThatTheEnergyBalanceHolds
       ++load_steps;
       breaking_load_steps += rows[k].broken > rows[k - 1].broken;
       EXPECT_NEAR(rows[k].balance(), rows[k - 1].balance(), 1e-12 * last.work) << "load step at t = " << rows[k].time;
+      // What a load step gives up is never negative, but for the trapezoidal external work's error
+      // (at most −3·10⁻⁴ W measured here).
+      EXPECT_GT(rows[k].damping - rows[k - 1].damping, -1e-3 * last.work) << "load step at t = " << rows[k].time;
     }
     // The fracture released most of the work put in: the broken bonds hold part, the load steps'
     // jumps gave up the rest (no damping in the case).
     EXPECT_GT(last.damping, 0.3 * last.work);
-    EXPECT_NEAR(last.balance(), rows.front().balance(), 0.01 * last.work);  // the explicit steps' drift
+    // Over the run the balance moves only by the explicit steps' error and by the motion Verlet
+    // starts from at a switch: the last load step's mean rate, whose kinetic energy the load steps
+    // left out (1.3·10⁻⁶ J, 2 % of this small plate's work; 10⁻⁵ of traction's).
+    double started_from = 0.0;
+    for (std::size_t k = 1; k < rows.size(); ++k)
+      if (rows[k].mode == 0 && rows[k - 1].mode == 1) started_from += rows[k - 1].kinetic;
+    EXPECT_NEAR(last.balance() - rows.front().balance(), started_from, 0.01 * last.work);
     if (integrator == "mixed") {
       EXPECT_NE(log.find("back in load steps"), std::string::npos) << log;
       EXPECT_GT(load_steps, 5);

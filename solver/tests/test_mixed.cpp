@@ -838,8 +838,8 @@ TEST(Mixed, TriesALoadStepWhenTheCrackPausesForAHorizonsCrossingTimeAndNotBefore
 
 TEST(Mixed, AFailedTryLeavesTheExplicitRunAsIfItHadNotBeenMade) {
   // A try that fails heals the bonds it broke and leaves the state alone (QuasiStatic::step works on
-  // a copy), so Verlet goes on bit for bit as in a run without the rule, up to the next try; the
-  // kinetic energy is booked as given up only by a try that succeeds.
+  // a copy), so Verlet goes on bit for bit as in a run without the rule, up to the next try (what a
+  // try that succeeds gives up is booked by the run loop, run/loop.cpp: not here).
   BarRun with("quasi_static", 3), without;
   bool tried = false;
   for (int k = 0; k < 100000 && with.t < kEnd * (1 - 1e-12); ++k) {
@@ -852,7 +852,6 @@ TEST(Mixed, AFailedTryLeavesTheExplicitRunAsIfItHadNotBeenMade) {
     ASSERT_TRUE(same_bits(with.state.u, without.state.u)) << "step " << k;
     ASSERT_TRUE(same_bits(with.state.v, without.state.v)) << "step " << k;
     ASSERT_EQ(with.model.bonds.broken, without.model.bonds.broken) << "step " << k;
-    ASSERT_EQ(with.state.damping_work, without.state.damping_work) << "step " << k;
     ASSERT_EQ(with.t, without.t);
   }
   ASSERT_TRUE(tried);

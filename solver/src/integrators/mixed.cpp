@@ -143,7 +143,8 @@ void Mixed::to_quasi_static(State&, double t, double kinetic, double strain) {
                        std::to_string(settings_.arrest_steps) + " steps";
   log_lines_.push_back("mixed: t = " + message_number(t) + " s: explicit → quasi-static (" + why + "); kinetic energy " +
                        message_number(kinetic) + " J (" + message_number(strain > 0.0 ? kinetic / strain : 0.0) +
-                       " of the strain energy) given up, booked as damping work if the load step finds equilibrium");
+                       " of the strain energy) and the strain energy above the equilibrium's given up, booked as damping work if the "
+                       "load step finds equilibrium");
 }
 
 void Mixed::to_implicit(const State& state, double t, double kinetic, double strain) {

@@ -731,6 +731,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   } off{at_start_.active};
   int cuts = 0;
   cut_to_ = 0.0;
+  // Bonds broken by attempts that then failed: they stay broken (below), so the accepted step
+  // reports them with its own (history.csv's broken bonds and their energy).
+  BreakReport broken_by_failed_attempts;
   std::optional<StretchRatio> start_ratio;
   for (;;) {
     const double t1 = t + h;
@@ -808,8 +811,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       started_cold_ = !guess_from_velocity_;
       state = std::move(s);
       report_.iterations = std::max(total, 1);
-      report_.broken_now = broke_total.broken;
-      report_.broken_energy_now = broke_total.energy;
+      report_.broken_now = broken_by_failed_attempts.broken + broke_total.broken;
+      report_.broken_energy_now = broken_by_failed_attempts.energy + broke_total.energy;
       t = t1;
       dt = h;
       double next = std::min(zohdi_step_factor(settings_.tol, omega, std::max(iterations, 1), settings_.kd, settings_.p), 2.0) * h;
@@ -819,6 +822,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     }
     // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved. The
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
+    broken_by_failed_attempts.broken += broke_total.broken;
+    broken_by_failed_attempts.energy += broke_total.energy;
     have_factor_ = false;
     if (iteration_cap_ > 0) {
       const std::string spent = factorisation_cap_hit_
