@@ -393,7 +393,7 @@ TEST(EndToEnd, QuasiStaticLoadStepsBookWhatTheyGiveUpSoThatTheEnergyBalanceHolds
     EXPECT_GT(last.damping, 0.3 * last.work);
     // Over the run the balance moves only by the explicit steps' error and by the motion Verlet
     // starts from at a switch: the last load step's mean rate, whose kinetic energy the load steps
-    // left out (1.3·10⁻⁶ J, 2 % of this small plate's work; 10⁻⁵ of traction's).
+    // left out (1.3·10⁻⁶ J, 2 % of this small plate's work; 2·10⁻⁵ of traction mixed's).
     double started_from = 0.0;
     for (std::size_t k = 1; k < rows.size(); ++k)
       if (rows[k].mode == 0 && rows[k - 1].mode == 1) started_from += rows[k - 1].kinetic;
