@@ -22,11 +22,16 @@ STORED_TERMS = (("kinetic_energy", "kinetic"), ("strain_energy", "strain"), ("co
                 ("damping_work", "damping work"))
 
 
+def load_step_rows(history: dict) -> np.ndarray | bool:
+    """Per row, whether it is a quasi-static load step's (`mode` 1); False without a mode column."""
+    return np.asarray(history["mode"]) == 1 if "mode" in history else False
+
+
 def balance_terms(history: dict) -> list[tuple[str, str]]:
     """The (column, label) of STORED_TERMS that history.csv has. A run with quasi-static load steps
     (`mode` 1) books in damping_work what their jumps to equilibrium give up, damped or not: its
     label says so."""
-    load_steps = "mode" in history and bool(np.any(np.asarray(history["mode"]) == 1))
+    load_steps = bool(np.any(load_step_rows(history)))
     return [(column, "damping work + given up by load steps" if column == "damping_work" and load_steps else label)
             for column, label in STORED_TERMS if column in history]
 
@@ -35,7 +40,7 @@ def energy_balance(history: dict) -> np.ndarray:
     """Σ stored and dissipated terms − external work [J]: constant up to the integrator's error. A
     quasi-static load step's row (`mode` 1) counts no kinetic energy: its velocity is the step's mean
     rate, which the static balance leaves out (the solver's run/loop.cpp)."""
-    load_step = np.asarray(history["mode"]) == 1 if "mode" in history else False
+    load_step = load_step_rows(history)
 
     def term(column):
         return np.where(load_step, 0.0, history[column]) if column == "kinetic_energy" else history[column]

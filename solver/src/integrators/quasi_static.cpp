@@ -775,8 +775,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       // falling, so the rounds would not end (the plate's: 4, 4, 8 bonds; traction's: 4, 8, 12).
       const bool not_slowing = fail_on_steady_breaking_ && rounds > 0 && broke.broken >= last_broken;
       last_broken = broke.broken;
-      broke_total.broken += broke.broken;
-      broke_total.energy += broke.energy;
+      broke_total += broke;
       have_factor_ = false;  // the tangent lost bonds
       amg_.clear();          // and the hierarchy too (rule (1) of quasi_static.hpp)
       broken_since_start_ = true;
@@ -811,8 +810,10 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       started_cold_ = !guess_from_velocity_;
       state = std::move(s);
       report_.iterations = std::max(total, 1);
-      report_.broken_now = broken_by_failed_attempts.broken + broke_total.broken;
-      report_.broken_energy_now = broken_by_failed_attempts.energy + broke_total.energy;
+      BreakReport broken_in_step = broken_by_failed_attempts;
+      broken_in_step += broke_total;
+      report_.broken_now = broken_in_step.broken;
+      report_.broken_energy_now = broken_in_step.energy;
       t = t1;
       dt = h;
       double next = std::min(zohdi_step_factor(settings_.tol, omega, std::max(iterations, 1), settings_.kd, settings_.p), 2.0) * h;
@@ -822,8 +823,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     }
     // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved. The
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
-    broken_by_failed_attempts.broken += broke_total.broken;
-    broken_by_failed_attempts.energy += broke_total.energy;
+    broken_by_failed_attempts += broke_total;
     have_factor_ = false;
     if (iteration_cap_ > 0) {
       const std::string spent = factorisation_cap_hit_

@@ -76,6 +76,12 @@ struct ParameterProblem {
 struct BreakReport {
   std::int64_t broken = 0;
   double energy = 0.0;
+  // The bonds of several breaking passes together (a load step's rounds and attempts).
+  BreakReport& operator+=(const BreakReport& other) {
+    broken += other.broken;
+    energy += other.energy;
+    return *this;
+  }
 };
 
 // How far the intact bonds that can break are from breaking at some u: the largest stretch ratio
