@@ -40,12 +40,12 @@ void Mixed::configure(const Case& c, double dt_exact) {
 
 // δ / c in explicit steps, rounded up, c = √(E/ρ) the bar wave speed of the slowest block (below the
 // P-wave speed of a 2D or 3D body: the longer wait). Measured on cases/traction (PMMA, c = 1640
-// m/s): δ/c = 0.92 µs, 4 steps of 0.274 µs at dx × 2 and 4 of 0.137 µs at dx = 0.25 mm. Off (0)
-// without a Young's modulus in every block or with an implicit home. From the case, not the model:
-// a decomposed run's piece carries no block materials.
+// m/s): δ/c = 0.92 µs, 4 steps of 0.274 µs at dx × 2 and 4 of 0.137 µs at dx = 0.25 mm. 0 without a
+// Young's modulus in every block. From the case, not the model: a decomposed run's piece carries no
+// block materials. The pause rule waits that long (off with an implicit home or no tries), and so
+// does the return on the separation (cut_steps()).
 void Mixed::set_pause_steps(const Case& c) {
-  pause_steps_ = 0;
-  if (home_ != kQuasiStatic || pause_tries_ == 0) return;
+  pause_steps_ = crossing_steps_ = 0;
   double slowest = HUGE_VAL;
   for (const BlockMaterial& block : c.blocks) {
     const std::optional<double> youngs = block.parameter("youngs_modulus");
@@ -54,7 +54,12 @@ void Mixed::set_pause_steps(const Case& c) {
   }
   if (!std::isfinite(slowest) || !(c.horizon > 0.0)) return;
   // (less a round-off's worth, so that an exact ratio is not rounded up a step by its last bit)
-  pause_steps_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(c.horizon / (slowest * dt_explicit_) - 1e-9)));
+  crossing_steps_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(c.horizon / (slowest * dt_explicit_) - 1e-9)));
+  if (home_ == kQuasiStatic && pause_tries_ > 0) pause_steps_ = crossing_steps_;
+}
+
+std::int64_t Mixed::cut_steps() const {
+  return crossing_steps_ > 0 ? std::min<std::int64_t>(crossing_steps_, settings_.arrest_steps) : settings_.arrest_steps;
 }
 
 bool Mixed::crack_paused() const {
@@ -137,7 +142,7 @@ void Mixed::to_quasi_static(State&, double t, double kinetic, double strain) {
       pause_return_ ? "the crack stopped running: no bond broke for " + std::to_string(quiet_steps_) +
                           " steps, a horizon's crossing time of a stress wave; a tentative load step asks whether it is stable"
       : separated_ && !separation_given_up_ ? "the cracks cut the load path between the prescribed motions " +
-                       std::to_string(settings_.arrest_steps) + " steps ago"
+                       std::to_string(cut_steps()) + " steps ago"
                  : "the crack arrested: no bond broke and the kinetic energy stayed below " +
                        message_number(settings_.kinetic_fraction) + " × the strain energy for " +
                        std::to_string(settings_.arrest_steps) + " steps";
@@ -290,7 +295,7 @@ void Mixed::step(State& state, double& t, double& dt) {
     pause_return_ = true;
     to_quasi_static(state, t, kinetic, strain);
     report_.next_dt = std::min(std::max(static_dt_, static_.dt_min()), static_.dt_max());
-  } else if (calm_steps_ >= settings_.arrest_steps) {
+  } else if (calm_steps_ >= (cut ? cut_steps() : settings_.arrest_steps)) {
     if (home_ == kImplicit) {
       to_implicit(state, t, kinetic, strain);
       report_.next_dt = std::min(std::max(static_dt_, implicit_.dt_min()), implicit_.dt_max());
@@ -393,7 +398,8 @@ std::vector<std::string> Mixed::describe(double dt_exact) const {
                   std::to_string(settings_.arrest_steps) + " steps without breaking and with kinetic energy below " +
                   message_number(settings_.kinetic_fraction) + " × the strain energy" +
                   (load_path_ && load_path_->linked_uncut()
-                       ? ", or that many steps after the cracks have cut the load path between the prescribed motions"
+                       ? ", or " + std::to_string(cut_steps()) + " steps" + (crossing_steps_ > 0 ? " (δ/c)" : "") +
+                             " after the cracks have cut the load path between the prescribed motions"
                        : "") +
                   (pause_steps_ > 0 ? "; and a tentative load step when the crack has stopped running (no bond broken for " +
                                           std::to_string(pause_steps_) + " steps, δ/c; at most " +

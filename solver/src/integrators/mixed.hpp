@@ -17,10 +17,16 @@
 //   row. The next load step solves equilibrium from the current state; the kinetic energy left is
 //   given up (added to the damping work, so that the energy balance still closes, and said in
 //   run.log). Also when the cracks have cut every load path between two prescribed motions that the
-//   uncut body linked (the specimen has separated, integrators/load_path.hpp), mixed.arrest_steps
-//   steps after the cut, whatever the kinetic energy and the bonds that still break in the ringing: the halves then hang each from its grip
-//   and ring undamped for ever (measured on cases/traction: the kinetic energy stays above the strain
-//   energy), which the quasi-static answer does without; the load steps finish the loading.
+//   uncut body linked (the specimen has separated, integrators/load_path.hpp), cut_steps() steps
+//   after the cut (δ/c, as the pause rule below; mixed.arrest_steps if shorter or without a Young's
+//   modulus), whatever the kinetic energy and the bonds that still break in the ringing: the halves
+//   then hang each from its grip and ring undamped for ever (measured on cases/traction: the kinetic
+//   energy stays above the strain energy), which the quasi-static answer does without; the load
+//   steps finish the loading. Why δ/c and no longer arrest_steps (4 Dec 2026): what breaks after
+//   the cut is the ringing's overshoot at the crack faces, which the load steps do without; on
+//   plate_with_hole at its own dx the 200 steps after the cut were 1.8 s of a 22 s run, and
+//   returning 4 steps after it moved each half's crack centroid by 1 µm (bench/quasi_static_cases.py's
+//   case, 1 thread; docs/accuracy.md "After the cut").
 //   From that return on, every load step starts with each piece carried by the one grip that
 //   holds it alone (LoadPath::held_by_one_group, QuasiStatic::carry_rigidly): unstrained, which is
 //   its equilibrium when nothing else loads it, so Newton accepts it without a tangent (measured on
@@ -163,7 +169,7 @@ class Mixed : public Integrator {
   double static_dt_ = 0.0;       // the load step proposed when the quasi-static mode was left [s]
   int switches_ = 0;
   std::int64_t breaking_steps_ = 0;  // implicit steps in a row in which bonds broke
-  // The grips' load path (load_path.hpp) and whether the cracks have cut it: arrest_steps steps
+  // The grips' load path (load_path.hpp) and whether the cracks have cut it: cut_steps() steps
   // after they have, the quasi-static home returns whatever the kinetic energy (the separated
   // halves ring undamped; that motion is not the quasi-static answer). The first load step then is
   // tentative (kTentativeIterations); if it fails, the rule is given up for the run.
@@ -199,6 +205,9 @@ class Mixed : public Integrator {
   void set_pause_steps(const Case& c);
   // After an explicit step: whether the crack has paused long enough to try a load step.
   bool crack_paused() const;
+  // Explicit steps from the cut of the load path to the return (see the header).
+  std::int64_t cut_steps() const;
+  std::int64_t crossing_steps_ = 0;  // δ/c in explicit steps (0: some block gives no Young's modulus)
   static constexpr std::uint64_t kPauseTag = 0x7061757365727531ULL;  // "pauseru1": the bytes of the pause rule follow
   // 15, not 10: on the full-resolution plate_with_hole, once load steps are cut to the first bond
   // failure, the return on the separation converged in 12 iterations (ω 4.4·10⁻⁷ at the 10th, the
