@@ -350,7 +350,10 @@ CASE = {
                              below=1.0),
         arrest_steps=Key("integer", "... for this many explicit steps in a row without a bond breaking "
                          "(the crack arrested); back to quasi_static, the kinetic energy left and the strain energy "
-                         "above the equilibrium's are given up, as damping work (implicit keeps them)",
+                         "above the equilibrium's are given up, as damping work (implicit keeps them). Once the "
+                         "cracks have cut the load path between the prescribed motions, quasi_static returns "
+                         "δ/c explicit steps after the cut (a stress wave's crossing time of the horizon), or this "
+                         "many if fewer or if a block has no youngs_modulus",
                          default=200, minimum=1, maximum=1000000000),
     ),
     "output": section(

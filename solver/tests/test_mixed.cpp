@@ -315,6 +315,48 @@ TEST(Mixed, StartedImplicitReturnsToImplicitWhenTheCrackArrests) {
   std::printf("mixed from implicit, arrested crack: %zu steps; %s\n", modes.size(), log[1].c_str());
 }
 
+TEST(Mixed, QuasiStaticHomeReturnsWhenTheCrackArrestsAfterArrestStepsCalmSteps) {
+  // The bar of the test above (upper half unbreakable), with the quasi-static home (undamped: the
+  // watch's kinetic fraction raised to 1 instead) and the pause rule off: the crack stops without
+  // cutting the load path, and the return waits mixed.arrest_steps (50) calm explicit steps, not
+  // δ/c (that wait is the cut's only).
+  pd::Case c = pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, 3.6);
+  pdtest::clamp_left_pull_right(c, 4e-3 * (kNx - 1) * kDx, kEnd, true);
+  pd::Model model = pd::build_model(c, pdtest::bar_with_grips(kNx, kNy, kNz, kDx));
+  for (std::size_t i = 0; i < model.nodes.size(); ++i) model.no_fail[i] = model.nodes.x[1][i] > 1.5 * kDx;
+  pd::ForceOperator op(model);
+  pd::Mixed mixed(op);
+  mixed.set_pause_tries(0);
+  pd::Case settings = mixed_case();
+  settings.mixed.kinetic_fraction = 1.0;
+  mixed.configure(settings);
+  pd::State state(model.nodes.size());
+  double t = 0.0, dt = *mixed.initial_dt();
+  mixed.initialize(state, t);
+  std::vector<std::string> log;
+  std::int64_t calm = 0, calm_at_return = -1;
+  while (t < kEnd * (1 - 1e-12) && calm_at_return < 0) {
+    double h = std::min(dt, kEnd - t);
+    const bool was_explicit = mixed.mode() == pd::Mixed::kExplicit;
+    mixed.step(state, t, h);
+    dt = mixed.last_step().next_dt;
+    if (was_explicit) calm = mixed.last_step().broken_now > 0 ? 0 : calm + 1;
+    for (auto& line : mixed.take_log_lines()) {
+      if (line.find("explicit → quasi-static (") != std::string::npos) calm_at_return = calm;
+      log.push_back(line);
+    }
+  }
+  ASSERT_GE(calm_at_return, 0) << "never back to quasi-static; " << (log.empty() ? "" : log.back());
+  EXPECT_FALSE(pd::LoadPath(model).separated(model.bonds));
+  EXPECT_GE(calm_at_return, 50);  // the kinetic-energy watch counts only its own calm steps
+  const auto back = std::find_if(log.begin(), log.end(), [](const std::string& line) {
+    return line.find("explicit → quasi-static (") != std::string::npos;
+  });
+  EXPECT_NE(back->find("(the crack arrested: no bond broke and the kinetic energy stayed below 1 × the strain "
+                       "energy for 50 steps)"),
+            std::string::npos) << *back;
+}
+
 namespace {
 // Breaks every bond across the plane x = cut, except `keep` of them.
 void cut_bar(pd::Model& m, double cut, int keep) {
@@ -439,46 +481,69 @@ TEST(LoadPath, TheVerdictAfterBondsBreakOneByOneIsTheUnionFindsWhateverTheOrderA
   EXPECT_GE(kept.full_counts(), 2);  // the first call, and the heal at least
 }
 
+namespace {
+// The snapped bar run to its end: its modes, the step that said the cut (its line comes with the
+// step that broke the last bond across) and the first load step after it, the return's line.
+struct SeparatedRun {
+  BarRun run;
+  std::vector<int> modes;
+  std::ptrdiff_t cut_step = -1, back_step = -1;
+  std::string back_line;
+  explicit SeparatedRun(const pd::Case& c) : run(c, 0, true) {
+    while (run.t < kEnd * (1 - 1e-12) && modes.size() < 100000u) {
+      const std::size_t lines = run.log.size();
+      run.step();
+      modes.push_back(*run.mixed.step_mode());
+      for (std::size_t k = lines; k < run.log.size(); ++k) {
+        if (cut_step < 0 && run.log[k].find("the cracks have cut the load path") != std::string::npos)
+          cut_step = static_cast<std::ptrdiff_t>(modes.size()) - 1;
+        if (cut_step >= 0 && back_line.empty() && run.log[k].find("explicit → quasi-static (") != std::string::npos)
+          back_line = run.log[k];
+      }
+      if (cut_step >= 0 && back_step < 0 && modes.back() == pd::Mixed::kQuasiStatic)
+        back_step = static_cast<std::ptrdiff_t>(modes.size()) - 1;
+    }
+  }
+};
+}  // namespace
+
 TEST(Mixed, ReturnsToQuasiStaticOnceTheBarHasSeparatedWhateverItsRinging) {
   // The snapped halves ring undamped (no kinetic-energy rule would ever end the explicit phase);
   // δ/c after the cracks have cut the bar (⌈δ/(c·Δt)⌉ = 4 explicit steps, c = √(E/ρ) = 1000 m/s;
   // arrest_steps is 50 here), the load steps finish the run.
-  BarRun run;
-  const auto crossing = static_cast<std::int64_t>(std::ceil(3.015 * kDx / (1000.0 * run.mixed.explicit_dt())));
+  SeparatedRun r(mixed_case());
+  const auto crossing = static_cast<std::int64_t>(std::ceil(3.015 * kDx / (1000.0 * r.run.mixed.explicit_dt())));
   ASSERT_EQ(crossing, 4);
-  // Stepped here to note the step that said the cut (its line comes with the step that broke the
-  // last bond across) and the first load step after it.
-  std::vector<int> modes;
-  std::ptrdiff_t cut_step = -1, back_step = -1;
-  while (run.t < kEnd * (1 - 1e-12) && modes.size() < 100000u) {
-    const std::size_t lines = run.log.size();
-    run.step();
-    modes.push_back(*run.mixed.step_mode());
-    for (std::size_t k = lines; k < run.log.size(); ++k)
-      if (cut_step < 0 && run.log[k].find("the cracks have cut the load path") != std::string::npos)
-        cut_step = static_cast<std::ptrdiff_t>(modes.size()) - 1;
-    if (cut_step >= 0 && back_step < 0 && modes.back() == pd::Mixed::kQuasiStatic)
-      back_step = static_cast<std::ptrdiff_t>(modes.size()) - 1;
-  }
-  ASSERT_LT(modes.size(), 100000u);
-  ASSERT_GE(cut_step, 0);
-  ASSERT_GE(back_step, 0);
+  ASSERT_LT(r.modes.size(), 100000u);
+  ASSERT_GE(r.cut_step, 0);
+  ASSERT_GE(r.back_step, 0);
   // The cut's step and crossing - 1 more explicit steps count the wait; then the load step.
-  EXPECT_EQ(back_step - cut_step, crossing);
-  for (std::ptrdiff_t k = cut_step; k < back_step; ++k) EXPECT_EQ(modes[k], pd::Mixed::kExplicit) << k;
-  const auto said = [&run](const std::string& what) {
-    return std::find_if(run.log.begin(), run.log.end(), [&](const std::string& line) { return line.find(what) != std::string::npos; });
-  };
-  const auto cut = said("the cracks have cut the load path between the prescribed motions"), back = said("explicit → quasi-static (");
-  ASSERT_NE(cut, run.log.end());
-  ASSERT_NE(back, run.log.end());
-  EXPECT_LT(cut, back);  // said when it happens, then the return
-  EXPECT_NE(back->find("(the cracks cut the load path between the prescribed motions 4 steps ago)"),
-            std::string::npos) << *back;
-  EXPECT_EQ(modes.back(), pd::Mixed::kQuasiStatic);
-  EXPECT_TRUE(pd::LoadPath(run.model).separated(run.model.bonds));
-  const auto explicit_steps = std::count(modes.begin(), modes.end(), static_cast<int>(pd::Mixed::kExplicit));
-  std::printf("snapped bar: %zu steps, %td explicit; %s\n", modes.size(), explicit_steps, back->c_str());
+  EXPECT_EQ(r.back_step - r.cut_step, crossing);
+  for (std::ptrdiff_t k = r.cut_step; k < r.back_step; ++k) EXPECT_EQ(r.modes[k], pd::Mixed::kExplicit) << k;
+  EXPECT_NE(r.back_line.find("(the cracks cut the load path between the prescribed motions; back after 4 explicit steps, δ/c)"),
+            std::string::npos) << r.back_line;
+  EXPECT_EQ(r.modes.back(), pd::Mixed::kQuasiStatic);
+  EXPECT_TRUE(pd::LoadPath(r.run.model).separated(r.run.model.bonds));
+  // The work plan says the wait.
+  bool described = false;
+  for (const std::string& line : r.run.mixed.describe(0.0))
+    described = described || line.find("or 4 steps (δ/c) after the cracks have cut the load path") != std::string::npos;
+  EXPECT_TRUE(described);
+  const auto explicit_steps = std::count(r.modes.begin(), r.modes.end(), static_cast<int>(pd::Mixed::kExplicit));
+  std::printf("snapped bar: %zu steps, %td explicit; %s\n", r.modes.size(), explicit_steps, r.back_line.c_str());
+}
+
+TEST(Mixed, AfterTheCutArrestStepsShorterThanTheCrossingTimeIsTheWait) {
+  // mixed.arrest_steps below δ/c (2 against 4 steps): the return comes 2 steps after the cut and
+  // does not say δ/c.
+  pd::Case c = mixed_case();
+  c.mixed.arrest_steps = 2;
+  SeparatedRun r(c);
+  ASSERT_GE(r.cut_step, 0);
+  ASSERT_GE(r.back_step, 0);
+  EXPECT_EQ(r.back_step - r.cut_step, 2);
+  EXPECT_NE(r.back_line.find("(the cracks cut the load path between the prescribed motions; back after 2 explicit steps)"),
+            std::string::npos) << r.back_line;
 }
 
 namespace {
@@ -849,7 +914,7 @@ TEST(Mixed, TriesALoadStepWhenTheCrackPausesForAHorizonsCrossingTimeAndNotBefore
     return line.find("the crack stopped running") != std::string::npos;
   });
   const auto cut_return = std::find_if(p.run.log.begin(), p.run.log.end(), [](const std::string& line) {
-    return line.find("(the cracks cut the load path between the prescribed motions 4 steps ago)") != std::string::npos;
+    return line.find("(the cracks cut the load path between the prescribed motions; back after 4 explicit steps, δ/c)") != std::string::npos;
   });
   ASSERT_NE(cut_return, p.run.log.end());
   EXPECT_LT(std::distance(p.run.log.begin(), last_try.base()), std::distance(p.run.log.begin(), cut_return) + 1);

@@ -58,9 +58,9 @@ void Mixed::set_pause_steps(const Case& c) {
   if (home_ == kQuasiStatic && pause_tries_ > 0) pause_steps_ = crossing_steps_;
 }
 
-std::int64_t Mixed::cut_steps() const {
-  return crossing_steps_ > 0 ? std::min<std::int64_t>(crossing_steps_, settings_.arrest_steps) : settings_.arrest_steps;
-}
+bool Mixed::cut_is_crossing() const { return crossing_steps_ > 0 && crossing_steps_ <= settings_.arrest_steps; }
+
+std::int64_t Mixed::cut_steps() const { return cut_is_crossing() ? crossing_steps_ : settings_.arrest_steps; }
 
 bool Mixed::crack_paused() const {
   return pause_steps_ > 0 && cracked_ && quiet_steps_ >= pause_steps_ && pause_failures_ < pause_tries_;
@@ -141,8 +141,8 @@ void Mixed::to_quasi_static(State&, double t, double kinetic, double strain) {
   const std::string why =
       pause_return_ ? "the crack stopped running: no bond broke for " + std::to_string(quiet_steps_) +
                           " steps, a horizon's crossing time of a stress wave; a tentative load step asks whether it is stable"
-      : separated_ && !separation_given_up_ ? "the cracks cut the load path between the prescribed motions " +
-                       std::to_string(cut_steps()) + " steps ago"
+      : separated_ && !separation_given_up_ ? "the cracks cut the load path between the prescribed motions; back after " +
+                       std::to_string(calm_steps_) + " explicit steps" + (cut_is_crossing() ? ", δ/c" : "")
                  : "the crack arrested: no bond broke and the kinetic energy stayed below " +
                        message_number(settings_.kinetic_fraction) + " × the strain energy for " +
                        std::to_string(settings_.arrest_steps) + " steps";
@@ -280,9 +280,11 @@ void Mixed::step(State& state, double& t, double& dt) {
   if (report_.broken_now > 0) {
     cracked_ = true;
     // The graph changes only when bonds break: one O(bonds) pass then.
-    if (load_path_ && !separated_ && (separated_ = load_path_cut()))
+    if (load_path_ && !separated_ && (separated_ = load_path_cut())) {
       log_lines_.push_back("mixed: t = " + message_number(t) +
                            " s: the cracks have cut the load path between the prescribed motions");
+      calm_steps_ = 0;  // the wait after the cut counts from this step (the calm steps before it are another watch's)
+    }
   }
   // Once the load path is cut, the pieces hang each from one grip: what still breaks is the
   // overshoot of their undamped ringing at the crack faces, which the equilibrium ahead does
@@ -398,7 +400,7 @@ std::vector<std::string> Mixed::describe(double dt_exact) const {
                   std::to_string(settings_.arrest_steps) + " steps without breaking and with kinetic energy below " +
                   message_number(settings_.kinetic_fraction) + " × the strain energy" +
                   (load_path_ && load_path_->linked_uncut()
-                       ? ", or " + std::to_string(cut_steps()) + " steps" + (crossing_steps_ > 0 ? " (δ/c)" : "") +
+                       ? ", or " + std::to_string(cut_steps()) + " steps" + (cut_is_crossing() ? " (δ/c)" : "") +
                              " after the cracks have cut the load path between the prescribed motions"
                        : "") +
                   (pause_steps_ > 0 ? "; and a tentative load step when the crack has stopped running (no bond broken for " +

@@ -164,7 +164,9 @@ class Mixed : public Integrator {
   Mode home_ = kQuasiStatic;  // mixed.start
   Mode mode_ = kQuasiStatic;
   int step_mode_ = kQuasiStatic;
-  std::int64_t calm_steps_ = 0;  // explicit steps in a row with no breaking and low kinetic energy
+  // Explicit steps in a row with no breaking and low kinetic energy; once the load path is cut,
+  // explicit steps since the cut (or since a later explicit phase began).
+  std::int64_t calm_steps_ = 0;
   bool cracked_ = false;         // a bond has broken in this explicit phase
   double static_dt_ = 0.0;       // the load step proposed when the quasi-static mode was left [s]
   int switches_ = 0;
@@ -205,9 +207,12 @@ class Mixed : public Integrator {
   void set_pause_steps(const Case& c);
   // After an explicit step: whether the crack has paused long enough to try a load step.
   bool crack_paused() const;
-  // Explicit steps from the cut of the load path to the return (see the header).
+  // Explicit steps from the cut of the load path (or from the start of a later explicit phase) to
+  // the return (see the header), and whether that is δ/c (else mixed.arrest_steps).
   std::int64_t cut_steps() const;
-  std::int64_t crossing_steps_ = 0;  // δ/c in explicit steps (0: some block gives no Young's modulus)
+  bool cut_is_crossing() const;
+  // δ/c in explicit steps (0: some block gives no Young's modulus, or the home is implicit).
+  std::int64_t crossing_steps_ = 0;
   static constexpr std::uint64_t kPauseTag = 0x7061757365727531ULL;  // "pauseru1": the bytes of the pause rule follow
   // 15, not 10: on the full-resolution plate_with_hole, once load steps are cut to the first bond
   // failure, the return on the separation converged in 12 iterations (ω 4.4·10⁻⁷ at the 10th, the
