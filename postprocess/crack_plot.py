@@ -6,7 +6,9 @@ crack_path.png, left: the final crack (its nodes, φ > DAMAGED, light grey) seen
 time, over SPEED_LAG frames. crack_tips.csv: one row per frame and tip, columns time [s], tip (the
 track's name), x, y, z [m], extension (distance of the tip from its origin [m]), speed [m/s] over
 the frames i − 1 … i + 1 (empty at the first and last frame); empty cells where a crack without a
-notch has no tip yet (pipeline/formats.md §4).
+notch has no tip yet (pipeline/formats.md §4). A tip that grew at least half its length between two
+frames (crack_tip.largest_jump) is reported as not resolved, with the lower bound of its mean speed
+that the frames give, instead of a peak speed the frames cannot show.
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ import numpy as np
 from pipeline.atomic import write_atomically
 
 from .casefile import CaseSettings
-from .crack_tip import DAMAGED, SPEED_LAG, Track, tip_positions, tip_speeds
+from .crack_tip import DAMAGED, SPEED_LAG, UNRESOLVED, Track, largest_jump, tip_positions, tip_speeds
 from .plotting import new_figure, place_legend, plain_ticks, save_figure, short_title, si_scale, time_axis
 
 CSV_COLUMNS = ("time", "tip", "x", "y", "z", "extension", "speed")
@@ -69,14 +71,25 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     ax_path.set_xlim(lo[0], hi[0])
     ax_path.set_ylim(lo[1], hi[1])
     ax_path.set_aspect("equal")
-    peaks = []
+    peaks, unresolved = [], []
     for number, track in enumerate(tracks):
         colour = f"C{number}"
         tips = tip_positions(x, crack_masks, track)
         ax_path.plot(tips[:, 0] * length, tips[:, 1] * length, "-", color=colour, lw=1.0, marker=".", ms=3,
                      label=f"tip, {track.name}")
         mid, speed = tip_speeds(times, tips)
-        if np.isfinite(speed).any():
+        found = np.all(np.isfinite(tips), axis=1)
+        reach = float(np.max(np.linalg.norm(tips[found] - track.origin, axis=1))) if found.any() else 0.0
+        jump, j = largest_jump(times, tips, track)
+        if reach > 0.0 and jump >= UNRESOLVED * reach:
+            # Most of the crack grew between two frames: a speed from the frames would be a
+            # fraction of the real one (0 once it has stopped), so say what the frames do show.
+            unresolved.append(f"{track.name}: {jump * length:.3g} {length_unit} in one frame interval, "
+                              f"≥ {jump / (times[j + 1] - times[j]):.3g} m/s")
+            peaks.append(f"not resolved by the frames ({track.name}: {jump * length:.3g} {length_unit} between "
+                         f"{times[j] * t_factor:.4g} and {times[j + 1] * t_factor:.4g} {t_unit}, at least "
+                         f"{jump / (times[j + 1] - times[j]):.3g} m/s on average)")
+        elif np.isfinite(speed).any():
             ax_speed.plot(mid * t_factor, speed, "-", color=colour,
                           marker=".", ms=3, label=track.name)
             k = int(np.nanargmax(speed))
@@ -93,9 +106,14 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     ax_speed.set_ylim(bottom=0.0)
     ax_speed.grid(alpha=0.3)
     plain_ticks(ax_speed)
-    if tracks:
+    if unresolved:
+        # (their speed from the frames is not drawn: it would show the run as a stop)
+        ax_speed.text(0.5, 0.5, "speed not resolved by the frames:\n" + "\n".join(unresolved),
+                      transform=ax_speed.transAxes, fontsize="small", ha="center", va="center")
+    if tracks and ax_speed.get_lines():
         place_legend(ax_speed, fontsize="small")
     fig.tight_layout()
     save_figure(fig, path)
     return (f"crack_path.png and crack_tips.csv: {len(tracks)} crack tip(s) over {len(times)} frames; "
-            f"peak speed {'; '.join(peaks) if peaks else 'none'}")
+            f"peak speed {'; '.join(peaks) if peaks else 'none'}" +
+            ("; frames more often (output.every_time) would follow the crack's run" if unresolved else ""))

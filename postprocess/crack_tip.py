@@ -82,6 +82,26 @@ def tip_speeds(times, tips, lag: int = SPEED_LAG) -> tuple[np.ndarray, np.ndarra
     return 0.5 * (t[lag:] + t[:-lag]), speed
 
 
+def largest_jump(times, tips, track: Track) -> tuple[float, int]:
+    """(growth [m], k): the largest growth of the tip's distance from its origin between frames
+    k and k + 1 (a tip that first appears counts from the origin). When it is at least
+    UNRESOLVED × the largest distance the crack reaches, the frames do not follow the crack's run:
+    it grew most of its length between two frames (a crack that runs in a few µs, as a mixed run's
+    explicit phase between load steps, against frames every 0.1 ms), and jump / Δt is only a lower
+    bound of its mean speed. (0, 0) with fewer than two frames."""
+    tips = np.asarray(tips, dtype=np.float64)
+    if len(tips) < 2:
+        return 0.0, 0
+    found = np.all(np.isfinite(tips), axis=1)
+    extension = np.where(found, np.linalg.norm(np.where(found[:, None], tips, 0.0) - track.origin, axis=1), 0.0)
+    growth = np.diff(extension)
+    k = int(np.argmax(growth))
+    return float(growth[k]), k
+
+
+UNRESOLVED = 0.5  # a crack that grew this share of its length between two frames is not followed
+
+
 def _xy_normal(direction: np.ndarray) -> np.ndarray:
     """The direction turned by +90° about z: the side "above" a crack line in the xy plane."""
     return _unit([-direction[1], direction[0], 0.0])

@@ -171,6 +171,44 @@ def test_crack_path_figure_is_readable_and_draws_the_known_speed(monkeypatch, tm
         plt.close(fig)
 
 
+def test_a_crack_that_grew_between_two_frames_is_reported_as_not_resolved(monkeypatch, tmp_path):
+    """A crack without a notch that appears 9 nodes long between frames 4 and 5 and grows no more
+    (a mixed run's crack runs in µs between frames 0.1 ms apart): no peak speed (the frames would
+    say 0 m/s), but the growth, the frame interval and the lower bound of the mean speed."""
+    kept = {}
+
+    def spy(fig, path):
+        fig.canvas.draw()
+        kept["fig"] = fig
+
+    monkeypatch.setattr(crack_plot, "save_figure", spy)
+    points = grid()
+    x, y = points[:, 0], points[:, 1]
+    crack = np.isclose(x, 20 * DX) & (y >= 6 * DX - 1e-12) & (y <= 14 * DX + 1e-12)
+    times = np.arange(9) * FRAME
+    masks = [crack if k >= 5 else np.zeros(len(points), bool) for k in range(len(times))]
+    tracks = crack_tip.plan_tracks(points, masks)
+    assert [t.name for t in tracks] == ["+y end", "−y end"]
+    jump, k = crack_tip.largest_jump(times, crack_tip.tip_positions(points, masks, tracks[0]), tracks[0])
+    assert k == 4 and np.isclose(jump, 4 * DX)  # from the centre (y = 10 dx) to the end at 14 dx
+    case = CaseSettings(name="snap", dimension=2, title="snap")
+    said = crack_plot.plot_crack_path(times, points, masks, tracks, case, str(tmp_path / "crack_path.png"))
+    try:
+        check_readable(kept["fig"])
+        assert "m/s at" not in said  # no peak speed
+        bound = 4 * DX / FRAME
+        assert (f"not resolved by the frames (+y end: 4 mm between {4 * FRAME * 1e6:.4g} and {5 * FRAME * 1e6:.4g} µs, "
+                f"at least {bound:.3g} m/s on average") in said
+        assert "−y end: 4 mm" in said
+        assert said.endswith("; frames more often (output.every_time) would follow the crack's run")
+        texts = [t.get_text() for t in kept["fig"].axes[1].texts]
+        assert texts == [f"speed not resolved by the frames:\n+y end: 4 mm in one frame interval, ≥ {bound:.3g} m/s\n"
+                         f"−y end: 4 mm in one frame interval, ≥ {bound:.3g} m/s"]
+        assert kept["fig"].axes[1].get_lines() == []  # no speed curve that would show the run as a stop
+    finally:
+        plt.close(kept["fig"])
+
+
 def write_fracture_run(out, *, grow=True):
     """A run in out/ with the notch_damage frames (or the notch only), a breakable block, the notch."""
     out.mkdir(parents=True)
