@@ -136,7 +136,9 @@ def fracture_case():
                         cracks=[([0.0, NOTCH_Y, 0.0], [NOTCH_TIP, NOTCH_Y, 0.0])])
 
 
-def test_crack_path_figure_is_readable_and_draws_the_known_speed(monkeypatch, tmp_path):
+@pytest.fixture
+def drawn(monkeypatch):
+    """crack_plot's figure, drawn and kept instead of saved: drawn["fig"] after plot_crack_path."""
     kept = {}
 
     def spy(fig, path):
@@ -144,6 +146,11 @@ def test_crack_path_figure_is_readable_and_draws_the_known_speed(monkeypatch, tm
         kept["fig"] = fig
 
     monkeypatch.setattr(crack_plot, "save_figure", spy)
+    return kept
+
+
+def test_crack_path_figure_is_readable_and_draws_the_known_speed(drawn, tmp_path):
+    kept = drawn
     points = grid()
     times, fields = notch_damage(points)
     masks = [d > crack_tip.DAMAGED for d in fields]
@@ -171,17 +178,11 @@ def test_crack_path_figure_is_readable_and_draws_the_known_speed(monkeypatch, tm
         plt.close(fig)
 
 
-def test_a_crack_that_grew_between_two_frames_is_reported_as_not_resolved(monkeypatch, tmp_path):
+def test_a_crack_that_grew_between_two_frames_is_reported_as_not_resolved(drawn, tmp_path):
     """A crack without a notch that appears 9 nodes long between frames 4 and 5 and grows no more
     (a mixed run's crack runs in µs between frames 0.1 ms apart): no peak speed (the frames would
     say 0 m/s), but the growth, the frame interval and the lower bound of the mean speed."""
-    kept = {}
-
-    def spy(fig, path):
-        fig.canvas.draw()
-        kept["fig"] = fig
-
-    monkeypatch.setattr(crack_plot, "save_figure", spy)
+    kept = drawn
     points = grid()
     x, y = points[:, 0], points[:, 1]
     crack = np.isclose(x, 20 * DX) & (y >= 6 * DX - 1e-12) & (y <= 14 * DX + 1e-12)
