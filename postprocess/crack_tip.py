@@ -14,8 +14,13 @@ How the tracks are chosen (plan_tracks):
   followed on each branch; validation/branching.py uses the upper one);
 - no pre-crack: from the centroid of the nodes first damaged, along the principal direction of the
   final crack (the longest axis of its nodes), two tracks: forward and backward (the two cracks
-  from the edge of a hole, or the two ends of a crack that starts inside). A track whose tip never
-  leaves its origin is dropped.
+  from the edge of a hole, or the two ends of a crack that starts inside). When the final crack
+  nodes fall into separate cracks that do not lie on one line (cases/traction's two cracks across
+  the specimen, side by side), each crack gets its own two tracks, "crack k, ±axis end", from its
+  own first damaged nodes along its own longest axis, among its own nodes only (separate: no crack
+  node of one within CLUSTER_REACH node spacings of the other; small specks of damage, below
+  SPECK of the largest crack's nodes, are not cracks). A track whose tip never leaves its origin is
+  dropped.
 
 Used by the normal output (postprocess/crack_plot.py: crack_path.png and crack_tips.csv) and by
 `python -m validation branching`.
@@ -27,6 +32,9 @@ import dataclasses
 import numpy as np
 
 DAMAGED = 0.3    # damage above which a node belongs to the crack (validation/branching.py, C7)
+CLUSTER_REACH = 2.5  # crack nodes closer than this many node spacings belong to one crack
+SPECK = 0.1          # a group of crack nodes smaller than this share of the largest is no crack of its own
+COLLINEAR = 0.87     # cos 30°: cracks whose axes lie within 30° of the line through them are one line
 SPEED_LAG = 2    # frames over which the tip speed is measured (branching: 2 × 1 µs, as C7)
 
 
@@ -37,6 +45,7 @@ class Track:
     direction: np.ndarray         # (3,) unit: along which the tip runs
     side: np.ndarray | None = None  # (3,) unit: only nodes with (x − origin)·side ≥ 0 (one branch)
     rests_at_origin: bool = True  # no crack node ahead: the tip is the origin (a notch tip), else NaN
+    members: np.ndarray | None = None  # bool per node: the tip is among these nodes only (one of several cracks)
 
 
 def _unit(v) -> np.ndarray:
@@ -61,6 +70,8 @@ def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
     allowed = ahead > 0.0
     if track.side is not None:
         allowed &= relative @ track.side >= 0.0
+    if track.members is not None:
+        allowed &= track.members
     tips = np.empty((len(crack_masks), 3))
     for i, crack in enumerate(crack_masks):
         candidates = np.flatnonzero(crack & allowed)
@@ -107,6 +118,59 @@ def _xy_normal(direction: np.ndarray) -> np.ndarray:
     return _unit([-direction[1], direction[0], 0.0])
 
 
+def _principal_axis(points: np.ndarray) -> np.ndarray:
+    """The longest axis of a cloud of points (unit; its largest component positive, for readable
+    names); x for a single point."""
+    if len(points) < 2:
+        return np.array([1.0, 0.0, 0.0])
+    _, _, vt = np.linalg.svd(points - points.mean(axis=0), full_matrices=False)
+    direction = vt[0]
+    return _unit(direction * np.sign(direction[np.argmax(np.abs(direction))]))
+
+
+def separate_cracks(points: np.ndarray) -> list[np.ndarray]:
+    """Index arrays of the separate cracks among crack nodes `points` (n, 3): nodes closer than
+    CLUSTER_REACH × their typical spacing (the median distance to the nearest other crack node) are
+    linked, a crack is a linked group; groups smaller than SPECK × the largest are left out. Largest
+    first."""
+    n = len(points)
+    if n < 2:
+        return [np.arange(n)] if n else []
+    parent = np.arange(n)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    nearest = np.full(n, np.inf)
+    chunk = max(1, 4_000_000 // n)  # rows of the distance matrix at a time
+    for start in range(0, n, chunk):
+        d = np.linalg.norm(points[start:start + chunk, None, :] - points[None, :, :], axis=2)
+        d[np.arange(d.shape[0]), start + np.arange(d.shape[0])] = np.inf
+        nearest[start:start + chunk] = d.min(axis=1)
+    reach = CLUSTER_REACH * float(np.median(nearest))
+    for start in range(0, n, chunk):
+        d = np.linalg.norm(points[start:start + chunk, None, :] - points[None, :, :], axis=2)
+        for a, b in zip(*np.nonzero(d <= reach)):
+            ra, rb = root(start + a), root(b)
+            if ra != rb:
+                parent[ra] = rb
+    roots = np.array([root(i) for i in range(n)])
+    groups = sorted((np.flatnonzero(roots == r) for r in np.unique(roots)), key=len, reverse=True)
+    return [g for g in groups if len(g) >= SPECK * len(groups[0])]
+
+
+def _on_one_line(groups: list[np.ndarray], points: np.ndarray) -> bool:
+    """Whether separate cracks lie on one line: each one's longest axis within 30° of the line
+    through their centroids (the two cracks from a hole's edges), so that one pair of tracks from
+    where they started follows both."""
+    centroids = np.array([points[g].mean(axis=0) for g in groups])
+    line = _principal_axis(centroids)
+    return all(abs(float(_principal_axis(points[g]) @ line)) >= COLLINEAR for g in groups)
+
+
 def plan_tracks(x, crack_masks, cracks=()) -> list[Track]:
     """The tracks of a run (see the module docstring): [] when no crack grew beyond the pre-cracks.
     `cracks`: the pre-cracks as (from, to) points [m]; x the reference positions."""
@@ -130,19 +194,27 @@ def plan_tracks(x, crack_masks, cracks=()) -> list[Track]:
             tracks += [Track(f"{label}above the notch line", end, direction, normal),
                        Track(f"{label}below the notch line", end, direction, -normal)]
     else:
-        first = next(i for i, crack in enumerate(crack_masks) if (crack & ~crack_masks[0]).any())
-        origin = x[crack_masks[first] & ~crack_masks[0]].mean(axis=0)
-        final = x[grown]
-        if len(final) > 1:
-            _, _, vt = np.linalg.svd(final - final.mean(axis=0), full_matrices=False)
-            direction = vt[0]
+        grown_nodes = np.flatnonzero(grown)
+        groups = separate_cracks(x[grown_nodes])
+        if len(groups) > 1 and not _on_one_line(groups, x[grown_nodes]):
+            # cracks side by side: numbered along the line through them
+            centroids = np.array([x[grown_nodes[g]].mean(axis=0) for g in groups])
+            order = np.argsort(centroids @ _principal_axis(centroids))
+            parts = [(f"crack {k + 1}, ", grown_nodes[groups[i]]) for k, i in enumerate(order)]
         else:
-            direction = np.array([1.0, 0.0, 0.0])
-        # a readable sign: the largest component positive
-        direction = _unit(direction * np.sign(direction[np.argmax(np.abs(direction))]))
-        axis = "xyz"[int(np.argmax(np.abs(direction)))]
-        tracks += [Track(f"+{axis} end", origin, direction, rests_at_origin=False),
-                   Track(f"−{axis} end", origin, -direction, rests_at_origin=False)]
+            parts = [("", grown_nodes)]
+        for label, nodes in parts:
+            members = None
+            if label:
+                members = np.zeros(len(x), dtype=bool)
+                members[nodes] = True
+            inside = members if members is not None else np.ones(len(x), dtype=bool)
+            first = next(i for i, crack in enumerate(crack_masks) if (crack & ~crack_masks[0] & inside).any())
+            origin = x[crack_masks[first] & ~crack_masks[0] & inside].mean(axis=0)
+            direction = _principal_axis(x[nodes])
+            axis = "xyz"[int(np.argmax(np.abs(direction)))]
+            tracks += [Track(f"{label}+{axis} end", origin, direction, rests_at_origin=False, members=members),
+                       Track(f"{label}−{axis} end", origin, -direction, rests_at_origin=False, members=members)]
 
     def moved(track):
         tips = tip_positions(x, crack_masks, track)

@@ -94,6 +94,45 @@ def test_tracker_without_a_notch_follows_both_ends_at_their_speeds():
     assert np.allclose(speed_up, SPEED) and np.allclose(speed_down, SPEED / 2)
 
 
+def test_two_cracks_side_by_side_get_two_tracks_each_and_cracks_on_one_line_one_pair():
+    """Two cracks across the body at x = 10 and 30 dx, growing up and down from y = 10 dx one node
+    per frame (cases/traction's two cracks): each its own +y and −y end, its tips its own nodes
+    only, at 500 m/s. Two cracks on one line (from the edges of a hole at y = 7..13 dx, running
+    away from it): one pair of tracks from where they started, as before."""
+    points = grid()
+    x, y = points[:, 0], points[:, 1]
+    frames = 8
+    times = np.arange(frames) * FRAME
+
+    def masks_of(columns, grows):
+        out = []
+        for k in range(frames):
+            mask = np.zeros(len(points), bool)
+            if k >= 1:
+                for c in columns:
+                    mask |= np.isclose(x, c * DX) & grows(k)
+            out.append(mask)
+        return out
+
+    side_by_side = masks_of((10, 30), lambda k: (y >= (10 - k) * DX - 1e-12) & (y <= (10 + k) * DX + 1e-12))
+    tracks = crack_tip.plan_tracks(points, side_by_side)
+    assert [t.name for t in tracks] == ["crack 1, +y end", "crack 1, −y end", "crack 2, +y end", "crack 2, −y end"]
+    for track, column, sign in zip(tracks, (10, 10, 30, 30), (1, -1, 1, -1)):
+        tips = crack_tip.tip_positions(points, side_by_side, track)
+        assert np.allclose(tips[1:, 0], column * DX)                               # its own crack's nodes
+        assert np.allclose(tips[2:, 1], (10 + sign * np.arange(2, frames)) * DX)    # its end, one node per frame
+        _, speed = crack_tip.tip_speeds(times[2:], tips[2:])
+        assert np.allclose(speed, SPEED)
+    # a speck of damage far from both (one node) is no crack of its own
+    speck = [m.copy() for m in side_by_side]
+    speck[-1][np.flatnonzero(np.isclose(x, 20 * DX) & np.isclose(y, 0.0))] = True
+    assert [t.name for t in crack_tip.plan_tracks(points, speck)] == [t.name for t in tracks]
+    # on one line: above and below a hole at the centre column
+    on_a_line = masks_of((20,), lambda k: ((y >= 13 * DX - 1e-12) & (y <= (13 + k) * DX + 1e-12))
+                         | ((y <= 7 * DX + 1e-12) & (y >= (7 - k) * DX - 1e-12)))
+    assert [t.name for t in crack_tip.plan_tracks(points, on_a_line)] == ["+y end", "−y end"]
+
+
 def test_no_tracks_when_nothing_grew_beyond_the_notch():
     points = grid()
     times, fields = notch_damage(points)
