@@ -131,34 +131,22 @@ def _principal_axis(points: np.ndarray) -> np.ndarray:
 def separate_cracks(points: np.ndarray) -> list[np.ndarray]:
     """Index arrays of the separate cracks among crack nodes `points` (n, 3): nodes closer than
     CLUSTER_REACH × their typical spacing (the median distance to the nearest other crack node) are
-    linked, a crack is a linked group; groups smaller than SPECK × the largest are left out. Largest
-    first."""
+    linked, a crack is a linked group (connected components of that graph); groups smaller than
+    SPECK × the largest are left out. Largest first."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
     n = len(points)
     if n < 2:
         return [np.arange(n)] if n else []
-    parent = np.arange(n)
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    nearest = np.full(n, np.inf)
-    chunk = max(1, 4_000_000 // n)  # rows of the distance matrix at a time
-    for start in range(0, n, chunk):
-        d = np.linalg.norm(points[start:start + chunk, None, :] - points[None, :, :], axis=2)
-        d[np.arange(d.shape[0]), start + np.arange(d.shape[0])] = np.inf
-        nearest[start:start + chunk] = d.min(axis=1)
-    reach = CLUSTER_REACH * float(np.median(nearest))
-    for start in range(0, n, chunk):
-        d = np.linalg.norm(points[start:start + chunk, None, :] - points[None, :, :], axis=2)
-        for a, b in zip(*np.nonzero(d <= reach)):
-            ra, rb = root(start + a), root(b)
-            if ra != rb:
-                parent[ra] = rb
-    roots = np.array([root(i) for i in range(n)])
-    groups = sorted((np.flatnonzero(roots == r) for r in np.unique(roots)), key=len, reverse=True)
+    tree = cKDTree(points)
+    nearest, _ = tree.query(points, k=2)
+    reach = CLUSTER_REACH * float(np.median(nearest[:, 1]))
+    links = tree.query_pairs(reach, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    groups = sorted((np.flatnonzero(label == k) for k in np.unique(label)), key=len, reverse=True)
     return [g for g in groups if len(g) >= SPECK * len(groups[0])]
 
 
