@@ -7,8 +7,9 @@ time, over SPEED_LAG frames. crack_tips.csv: one row per frame and tip, columns 
 track's name), x, y, z [m], extension (distance of the tip from its origin [m]), speed [m/s] over
 the frames i − 1 … i + 1 (empty at the first and last frame); empty cells where a crack without a
 notch has no tip yet (pipeline/formats.md §4). A tip that grew at least half its length between two
-frames (crack_tip.largest_jump) is reported as not resolved, with the lower bound of its mean speed
-that the frames give, instead of a peak speed the frames cannot show.
+frames (crack_tip.not_resolved) is reported as not resolved, with the lower bound of its mean speed
+that the frames give, instead of a peak speed the frames cannot show (its speed cells in
+crack_tips.csv are left empty, its curve is not drawn).
 """
 from __future__ import annotations
 
@@ -20,20 +21,36 @@ import numpy as np
 from pipeline.atomic import write_atomically
 
 from .casefile import CaseSettings
-from .crack_tip import DAMAGED, SPEED_LAG, UNRESOLVED, Track, largest_jump, tip_positions, tip_speeds
+from .crack_tip import DAMAGED, SPEED_LAG, Track, not_resolved, tip_positions, tip_speeds, typical_spacing
 from .plotting import new_figure, place_legend, plain_ticks, save_figure, short_title, si_scale, time_axis
 
 CSV_COLUMNS = ("time", "tip", "x", "y", "z", "extension", "speed")
 
 
+def unresolved_growth(times, x, crack_masks, tracks: list[Track]) -> dict[str, tuple[float, float, float]]:
+    """The tracks whose growth the frames do not follow (crack_tip.not_resolved), by name."""
+    final = np.asarray(x)[crack_masks[-1]] if len(crack_masks) else np.zeros((0, 3))
+    spacing = typical_spacing(final)
+    out = {}
+    for track in tracks:
+        found = not_resolved(times, x, crack_masks, track, spacing)
+        if found is not None:
+            out[track.name] = found
+    return out
+
+
 def tip_table(times, x, crack_masks, tracks: list[Track]) -> list[dict]:
     """Rows of crack_tips.csv: per frame and track, the tip, its extension and its speed over the
-    SPEED_LAG frames centred on it (None where the window leaves the run)."""
+    SPEED_LAG frames centred on it (None where the window leaves the run, and for a track whose
+    growth the frames do not follow: unresolved_growth)."""
     rows = []
     half = SPEED_LAG // 2
+    unresolved = unresolved_growth(times, x, crack_masks, tracks)
     for track in tracks:
         tips = tip_positions(x, crack_masks, track)
         _, speed = tip_speeds(times, tips)
+        if track.name in unresolved:
+            speed = np.full_like(speed, np.nan)
         for i, t in enumerate(times):
             k = i - half  # the window [i − half, i + half] is speed[k]
             found = bool(np.all(np.isfinite(tips[i])))
@@ -56,6 +73,11 @@ def write_tip_csv(path: str, rows: list[dict]):
     write_atomically(path, text.getvalue())
 
 
+def _speed(v: float) -> str:
+    """A speed for the log: whole m/s from 100 m/s on (not 1e+04), 3 digits below."""
+    return f"{v:.0f}" if v >= 100.0 else f"{v:.3g}"
+
+
 def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettings, path: str) -> str:
     """crack_path.png (see the module docstring); returns the line post-processing says."""
     x = np.asarray(x, dtype=np.float64)
@@ -72,23 +94,21 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     ax_path.set_ylim(lo[1], hi[1])
     ax_path.set_aspect("equal")
     peaks, unresolved = [], []
+    not_followed = unresolved_growth(times, x, crack_masks, tracks)
     for number, track in enumerate(tracks):
         colour = f"C{number}"
         tips = tip_positions(x, crack_masks, track)
         ax_path.plot(tips[:, 0] * length, tips[:, 1] * length, "-", color=colour, lw=1.0, marker=".", ms=3,
                      label=f"tip, {track.name}")
         mid, speed = tip_speeds(times, tips)
-        found = np.all(np.isfinite(tips), axis=1)
-        reach = float(np.max(np.linalg.norm(tips[found] - track.origin, axis=1))) if found.any() else 0.0
-        jump, j = largest_jump(times, tips, track)
-        if reach > 0.0 and jump >= UNRESOLVED * reach:
-            # Most of the crack grew between two frames: a speed from the frames would be a
+        if track.name in not_followed:
+            # Most of this end grew between two frames: a speed from the frames would be a
             # fraction of the real one (0 once it has stopped), so say what the frames do show.
-            unresolved.append(f"{track.name}: {jump * length:.3g} {length_unit} in one frame interval, "
-                              f"≥ {jump / (times[j + 1] - times[j]):.3g} m/s")
+            jump, t_a, t_b = not_followed[track.name]
+            bound = _speed(jump / (t_b - t_a))
+            unresolved.append(f"{track.name}: {jump * length:.3g} {length_unit} in one frame interval, ≥ {bound} m/s")
             peaks.append(f"not resolved by the frames ({track.name}: {jump * length:.3g} {length_unit} between "
-                         f"{times[j] * t_factor:.4g} and {times[j + 1] * t_factor:.4g} {t_unit}, at least "
-                         f"{jump / (times[j + 1] - times[j]):.3g} m/s on average)")
+                         f"{t_a * t_factor:.4g} and {t_b * t_factor:.4g} {t_unit}, at least {bound} m/s on average)")
         elif np.isfinite(speed).any():
             ax_speed.plot(mid * t_factor, speed, "-", color=colour,
                           marker=".", ms=3, label=track.name)
@@ -108,8 +128,9 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     plain_ticks(ax_speed)
     if unresolved:
         # (their speed from the frames is not drawn: it would show the run as a stop)
-        ax_speed.text(0.5, 0.5, "speed not resolved by the frames:\n" + "\n".join(unresolved),
-                      transform=ax_speed.transAxes, fontsize="small", ha="center", va="center")
+        ax_speed.text(0.02, 0.97, "speed not resolved by the frames:\n" + "\n".join(unresolved),
+                      transform=ax_speed.transAxes, fontsize="small", ha="left", va="top",
+                      bbox={"facecolor": "white", "edgecolor": "0.7", "alpha": 0.9})
     if tracks and ax_speed.get_lines():
         place_legend(ax_speed, fontsize="small")
     fig.tight_layout()

@@ -16,11 +16,12 @@ How the tracks are chosen (plan_tracks):
   final crack (the longest axis of its nodes), two tracks: forward and backward (the two cracks
   from the edge of a hole, or the two ends of a crack that starts inside). When the final crack
   nodes fall into separate cracks that do not lie on one line (cases/traction's two cracks across
-  the specimen, side by side), each crack gets its own two tracks, "crack k, ±axis end", from its
-  own first damaged nodes along its own longest axis, among its own nodes only (separate: no crack
-  node of one within CLUSTER_REACH node spacings of the other; small specks of damage, below
-  SPECK of the largest crack's nodes, are not cracks). A track whose tip never leaves its origin is
-  dropped.
+  the specimen, side by side: each reaches farther across the line through them than along it),
+  each crack gets its own two tracks, "crack k, ±axis end", from its own first damaged nodes along
+  its own longest axis in the x–y plane, among its own nodes only (separate: no crack node of one
+  within CLUSTER_REACH node spacings of the other; specks of damage, below SPECK of the largest
+  crack's nodes or MIN_CRACK_NODES, are no cracks and are followed by no track). A track whose tip
+  never leaves its origin is dropped.
 
 Used by the normal output (postprocess/crack_plot.py: crack_path.png and crack_tips.csv) and by
 `python -m validation branching`.
@@ -32,10 +33,16 @@ import dataclasses
 import numpy as np
 
 DAMAGED = 0.3    # damage above which a node belongs to the crack (validation/branching.py, C7)
-CLUSTER_REACH = 2.5  # crack nodes closer than this many node spacings belong to one crack
-SPECK = 0.1          # a group of crack nodes smaller than this share of the largest is no crack of its own
-COLLINEAR = 0.87     # cos 30°: cracks whose axes lie within 30° of the line through them are one line
 SPEED_LAG = 2    # frames over which the tip speed is measured (branching: 2 × 1 µs, as C7)
+# Separate cracks (plan_tracks): crack nodes closer than CLUSTER_REACH node spacings belong to one
+# crack; a group smaller than SPECK × the largest, or than MIN_CRACK_NODES, is no crack of its own.
+CLUSTER_REACH = 2.5
+SPECK = 0.1
+MIN_CRACK_NODES = 5
+# Growth the frames do not follow (not_resolved): at least this share of an end's length, and at
+# least MIN_JUMP node spacings, between two frames.
+UNRESOLVED = 0.5
+MIN_JUMP = 2.0
 
 
 @dataclasses.dataclass
@@ -58,13 +65,9 @@ def _points3(x) -> np.ndarray:
     return x if x.shape[1] == 3 else np.hstack([x, np.zeros((len(x), 3 - x.shape[1]))])
 
 
-def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
-    """(frames, 3) tip of `track` in each frame: among the crack nodes (crack_masks[i], a bool per
-    node) ahead of the origin ((x − origin)·direction > 0) and on its side, the one farthest along
-    the direction (the first such node on a tie); when there is none, the origin (a notch tip, from
-    which the crack starts) or NaN (a crack without a notch has no tip before it appears: its
-    first tip lies on the body's edge, and a step from the origin there is no speed)."""
-    x = _points3(x)
+def _ahead(x: np.ndarray, track: Track) -> tuple[np.ndarray, np.ndarray]:
+    """Each node's distance along the track's direction from its origin, and whether it may hold
+    the tip: ahead of the origin, on the track's side, among its members."""
     relative = x - track.origin
     ahead = relative @ track.direction
     allowed = ahead > 0.0
@@ -72,6 +75,17 @@ def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
         allowed &= relative @ track.side >= 0.0
     if track.members is not None:
         allowed &= track.members
+    return ahead, allowed
+
+
+def tip_positions(x, crack_masks, track: Track) -> np.ndarray:
+    """(frames, 3) tip of `track` in each frame: among the crack nodes (crack_masks[i], a bool per
+    node) ahead of the origin ((x − origin)·direction > 0) and on its side, the one farthest along
+    the direction (the first such node on a tie); when there is none, the origin (a notch tip, from
+    which the crack starts) or NaN (a crack without a notch has no tip before it appears: its
+    first tip lies on the body's edge, and a step from the origin there is no speed)."""
+    x = _points3(x)
+    ahead, allowed = _ahead(x, track)
     tips = np.empty((len(crack_masks), 3))
     for i, crack in enumerate(crack_masks):
         candidates = np.flatnonzero(crack & allowed)
@@ -93,24 +107,50 @@ def tip_speeds(times, tips, lag: int = SPEED_LAG) -> tuple[np.ndarray, np.ndarra
     return 0.5 * (t[lag:] + t[:-lag]), speed
 
 
-def largest_jump(times, tips, track: Track) -> tuple[float, int]:
-    """(growth [m], k): the largest growth of the tip's distance from its origin between frames
-    k and k + 1 (a tip that first appears counts from the origin). When it is at least
-    UNRESOLVED × the largest distance the crack reaches, the frames do not follow the crack's run:
-    it grew most of its length between two frames (a crack that runs in a few µs, as a mixed run's
-    explicit phase between load steps, against frames every 0.1 ms), and jump / Δt is only a lower
-    bound of its mean speed. (0, 0) with fewer than two frames."""
-    tips = np.asarray(tips, dtype=np.float64)
-    if len(tips) < 2:
-        return 0.0, 0
-    found = np.all(np.isfinite(tips), axis=1)
-    extension = np.where(found, np.linalg.norm(np.where(found[:, None], tips, 0.0) - track.origin, axis=1), 0.0)
-    growth = np.diff(extension)
+def end_lengths(x, crack_masks, track: Track) -> np.ndarray:
+    """(frames,) the length of `track`'s end of the crack in each frame [m]: along its direction,
+    from the first to the farthest of its crack nodes (ahead of the origin, on its side, among its
+    members) — from the notch tip for a notch's track; 0 while it has none. Not the tip's distance
+    from the origin: a crack without a notch starts where its first nodes broke (the edge of a
+    hole, not the hole's centre where the origin of both its ends lies)."""
+    ahead, allowed = _ahead(_points3(x), track)
+    lengths = np.zeros(len(crack_masks))
+    for i, crack in enumerate(crack_masks):
+        along = ahead[crack & allowed]
+        if len(along):
+            lengths[i] = along.max() - (0.0 if track.rests_at_origin else along.min())
+    return lengths
+
+
+def not_resolved(times, x, crack_masks, track: Track, spacing: float) -> tuple[float, float, float] | None:
+    """(growth [m], t_a, t_b) when `track`'s end grew at least UNRESOLVED × its largest length, and at
+    least MIN_JUMP node spacings, between two frames t_a < t_b: the frames do not follow its run (a
+    crack that runs in µs, as a mixed run's between load steps, against frames 0.1 ms apart), and
+    growth / (t_b − t_a) is only a lower bound of its mean speed. None when the frames follow it.
+    Frames at one time (series.py keeps them) count as one, the last."""
+    t = np.asarray(times, dtype=np.float64)
+    keep = np.append(t[1:] > t[:-1], True)  # the last of frames at one time
+    lengths = end_lengths(x, crack_masks, track)[keep]
+    t = t[keep]
+    if len(t) < 2 or not lengths.max() > 0.0:
+        return None
+    growth = np.diff(lengths)
     k = int(np.argmax(growth))
-    return float(growth[k]), k
+    if growth[k] >= UNRESOLVED * lengths.max() and growth[k] >= MIN_JUMP * spacing:
+        return float(growth[k]), float(t[k]), float(t[k + 1])
+    return None
 
 
-UNRESOLVED = 0.5  # a crack that grew this share of its length between two frames is not followed
+def typical_spacing(points) -> float:
+    """The median distance from a node to its nearest other node (the lattice's spacing); 0 for fewer
+    than two nodes."""
+    from scipy.spatial import cKDTree
+
+    points = _points3(points)
+    if len(points) < 2:
+        return 0.0
+    nearest, _ = cKDTree(points).query(points, k=2)
+    return float(np.median(nearest[:, 1]))
 
 
 def _xy_normal(direction: np.ndarray) -> np.ndarray:
@@ -128,6 +168,17 @@ def _principal_axis(points: np.ndarray) -> np.ndarray:
     return _unit(direction * np.sign(direction[np.argmax(np.abs(direction))]))
 
 
+def _xy_axis(points: np.ndarray) -> np.ndarray:
+    """The longest axis of a cloud of points in the x–y plane (z 0: a 3D crack through the thickness
+    runs in the plane, whatever its depth; its largest component positive); x for a single point."""
+    flat = points[:, :2]
+    if len(flat) < 2:
+        return np.array([1.0, 0.0, 0.0])
+    _, _, vt = np.linalg.svd(flat - flat.mean(axis=0), full_matrices=False)
+    axis = np.array([vt[0][0], vt[0][1], 0.0])
+    return _unit(axis * np.sign(axis[np.argmax(np.abs(axis))]))
+
+
 def separate_cracks(points: np.ndarray) -> list[np.ndarray]:
     """Index arrays of the separate cracks among crack nodes `points` (n, 3): nodes closer than
     CLUSTER_REACH × their typical spacing (the median distance to the nearest other crack node) are
@@ -141,22 +192,28 @@ def separate_cracks(points: np.ndarray) -> list[np.ndarray]:
     if n < 2:
         return [np.arange(n)] if n else []
     tree = cKDTree(points)
-    nearest, _ = tree.query(points, k=2)
-    reach = CLUSTER_REACH * float(np.median(nearest[:, 1]))
-    links = tree.query_pairs(reach, output_type="ndarray")
+    links = tree.query_pairs(CLUSTER_REACH * typical_spacing(points), output_type="ndarray")
     graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n, n))
     _, label = connected_components(graph, directed=False)
     groups = sorted((np.flatnonzero(label == k) for k in np.unique(label)), key=len, reverse=True)
-    return [g for g in groups if len(g) >= SPECK * len(groups[0])]
+    return [g for g in groups if len(g) >= max(SPECK * len(groups[0]), min(MIN_CRACK_NODES, len(groups[0])))]
 
 
 def _on_one_line(groups: list[np.ndarray], points: np.ndarray) -> bool:
-    """Whether separate cracks lie on one line: each one's longest axis within 30° of the line
-    through their centroids (the two cracks from a hole's edges), so that one pair of tracks from
-    where they started follows both."""
+    """Whether separate cracks lie on one line, so that one pair of tracks from where they started
+    follows both (the two cracks from a hole's edges), rather than side by side (cases/traction's
+    two cracks across the specimen): side by side when every crack reaches farther across the line
+    through their centroids (in the x–y plane) than along it. A crack's own axis would not do: the
+    damage of a quasi-statically grown crack is 6 mm wide for 10 mm long (traction quasi_static)."""
     centroids = np.array([points[g].mean(axis=0) for g in groups])
-    line = _principal_axis(centroids)
-    return all(abs(float(_principal_axis(points[g]) @ line)) >= COLLINEAR for g in groups)
+    line = _xy_axis(centroids)
+    across = np.array([-line[1], line[0], 0.0])
+    for g in groups:
+        p = points[g]
+        along, side = p @ line, p @ across
+        if np.ptp(side) <= np.ptp(along):
+            return True
+    return False
 
 
 def plan_tracks(x, crack_masks, cracks=()) -> list[Track]:
@@ -184,29 +241,36 @@ def plan_tracks(x, crack_masks, cracks=()) -> list[Track]:
     else:
         grown_nodes = np.flatnonzero(grown)
         groups = separate_cracks(x[grown_nodes])
-        if len(groups) > 1 and not _on_one_line(groups, x[grown_nodes]):
-            # cracks side by side: numbered along the line through them
+        side_by_side = len(groups) > 1 and not _on_one_line(groups, x[grown_nodes])
+        if side_by_side:
+            # cracks side by side: numbered along the line through them (below, once the tracks
+            # that never left their origin are dropped)
             centroids = np.array([x[grown_nodes[g]].mean(axis=0) for g in groups])
-            order = np.argsort(centroids @ _principal_axis(centroids))
-            parts = [(f"crack {k + 1}, ", grown_nodes[groups[i]]) for k, i in enumerate(order)]
+            order = np.argsort(centroids @ _xy_axis(centroids))
+            parts = [grown_nodes[groups[i]] for i in order]
         else:
-            parts = [("", grown_nodes)]
-        for label, nodes in parts:
-            members = None
-            if label:
-                members = np.zeros(len(x), dtype=bool)
-                members[nodes] = True
-            inside = members if members is not None else np.ones(len(x), dtype=bool)
-            first = next(i for i, crack in enumerate(crack_masks) if (crack & ~crack_masks[0] & inside).any())
-            origin = x[crack_masks[first] & ~crack_masks[0] & inside].mean(axis=0)
-            direction = _principal_axis(x[nodes])
+            # one crack, or cracks on one line: one pair of tracks over them (specks left out)
+            parts = [grown_nodes[np.concatenate(groups)]] if groups else []
+        for nodes in parts:
+            members = np.zeros(len(x), dtype=bool)
+            members[nodes] = True
+            first = next(i for i, crack in enumerate(crack_masks) if (crack & members).any())
+            origin = x[crack_masks[first] & members].mean(axis=0)
+            direction = _xy_axis(x[nodes]) if side_by_side else _principal_axis(x[nodes])
             axis = "xyz"[int(np.argmax(np.abs(direction)))]
-            tracks += [Track(f"{label}+{axis} end", origin, direction, rests_at_origin=False, members=members),
-                       Track(f"{label}−{axis} end", origin, -direction, rests_at_origin=False, members=members)]
+            tracks += [Track(f"+{axis} end", origin, direction, rests_at_origin=False, members=members),
+                       Track(f"−{axis} end", origin, -direction, rests_at_origin=False, members=members)]
 
     def moved(track):
         tips = tip_positions(x, crack_masks, track)
         found = np.all(np.isfinite(tips), axis=1)
         return bool(np.any(np.linalg.norm(tips[found] - track.origin, axis=1) > 0.0))
 
-    return [t for t in tracks if moved(t)]
+    kept = [t for t in tracks if moved(t)]
+    if len(cracks) or len({id(t.members) for t in kept}) < 2:
+        return kept
+    # cracks side by side, numbered 1, 2, … among those still followed
+    number = {}
+    for t in kept:
+        number.setdefault(id(t.members), len(number) + 1)
+    return [dataclasses.replace(t, name=f"crack {number[id(t.members)]}, {t.name}") for t in kept]
