@@ -6,8 +6,8 @@ crack_path.png, left: the final crack (its nodes, φ > DAMAGED, light grey) seen
 time, over SPEED_LAG frames. crack_tips.csv: one row per frame and tip, columns time [s], tip (the
 track's name), x, y, z [m], extension (distance of the tip from its origin [m]), speed [m/s] over
 the frames i − 1 … i + 1 (empty at the first and last frame); empty cells where a crack without a
-notch has no tip yet (pipeline/formats.md §4). A tip that grew at least half its length between two
-frames (crack_tip.not_resolved) is reported as not resolved, with the lower bound of its mean speed
+notch has no tip yet (pipeline/formats.md §4). A tip that grew at least half its length, and 2
+node spacings, between two frames (crack_tip.not_resolved) is reported as not resolved, with the lower bound of its mean speed
 that the frames give, instead of a peak speed the frames cannot show (its speed cells in
 crack_tips.csv are left empty, its curve is not drawn).
 """
