@@ -75,7 +75,7 @@ def _remove_stale_maps(directory: str, count: int, keep_damage: bool = True):
 def _crack_outputs(out_dir, fig_dir, case, times, points, crack_masks) -> list[str]:
     """crack_path.png and crack_tips.csv when bonds can break and a crack grew; else none (and
     those of an earlier run removed)."""
-    from .crack_plot import plot_crack_path, tip_table, write_tip_csv
+    from .crack_plot import plot_crack_path, tip_table, unresolved_growth, write_tip_csv
     from .crack_tip import plan_tracks
 
     paths = [os.path.join(fig_dir, "crack_path.png"), os.path.join(out_dir, "crack_tips.csv")]
@@ -88,8 +88,9 @@ def _crack_outputs(out_dir, fig_dir, case, times, points, crack_masks) -> list[s
             say("crack_path.png: none, no crack grew (no node's damage passed "
                 f"{DAMAGED:g} beyond the pre-cracks)")
         return []
-    write_tip_csv(paths[1], tip_table(times, points, crack_masks, tracks))
-    say(plot_crack_path(times, points, crack_masks, tracks, case, paths[0]))
+    unresolved = unresolved_growth(times, points, crack_masks, tracks)  # once, for the table and the figure
+    write_tip_csv(paths[1], tip_table(times, points, crack_masks, tracks, unresolved))
+    say(plot_crack_path(times, points, crack_masks, tracks, case, paths[0], unresolved))
     return paths
 
 

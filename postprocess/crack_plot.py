@@ -39,13 +39,14 @@ def unresolved_growth(times, x, crack_masks, tracks: list[Track]) -> dict[str, t
     return out
 
 
-def tip_table(times, x, crack_masks, tracks: list[Track]) -> list[dict]:
+def tip_table(times, x, crack_masks, tracks: list[Track], unresolved: dict | None = None) -> list[dict]:
     """Rows of crack_tips.csv: per frame and track, the tip, its extension and its speed over the
     SPEED_LAG frames centred on it (None where the window leaves the run, and for a track whose
-    growth the frames do not follow: unresolved_growth)."""
+    growth the frames do not follow: `unresolved`, unresolved_growth's, computed here if not given)."""
     rows = []
     half = SPEED_LAG // 2
-    unresolved = unresolved_growth(times, x, crack_masks, tracks)
+    if unresolved is None:
+        unresolved = unresolved_growth(times, x, crack_masks, tracks)
     for track in tracks:
         tips = tip_positions(x, crack_masks, track)
         _, speed = tip_speeds(times, tips)
@@ -78,8 +79,10 @@ def _speed(v: float) -> str:
     return f"{v:.0f}" if v >= 100.0 else f"{v:.3g}"
 
 
-def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettings, path: str) -> str:
-    """crack_path.png (see the module docstring); returns the line post-processing says."""
+def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettings, path: str,
+                    not_followed: dict | None = None) -> str:
+    """crack_path.png (see the module docstring); returns the line post-processing says.
+    `not_followed`: unresolved_growth's verdict, computed here if not given."""
     x = np.asarray(x, dtype=np.float64)
     final = x[crack_masks[-1]]
     length, length_unit = si_scale(x[:, :2], "m")
@@ -94,7 +97,8 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     ax_path.set_ylim(lo[1], hi[1])
     ax_path.set_aspect("equal")
     peaks, unresolved = [], []
-    not_followed = unresolved_growth(times, x, crack_masks, tracks)
+    if not_followed is None:
+        not_followed = unresolved_growth(times, x, crack_masks, tracks)
     for number, track in enumerate(tracks):
         colour = f"C{number}"
         tips = tip_positions(x, crack_masks, track)
