@@ -8,10 +8,12 @@
 # BLAS made them 4-5x slower (pd_linear_solvers 24 10 12, 1 thread: factorisation 2.79 s reference,
 # 0.54 s OpenBLAS; solve 30 ms against 7 ms). The serial build keeps results the same for any
 # OMP_NUM_THREADS; installing it makes it the system's libblas.so.3 (update-alternatives, auto).
+# liblapack-dev: the dense LU of the Woodbury correction that takes broken bonds out of a factorised
+# tangent (solver/src/linalg/woodbury.cpp; libarmadillo-dev pulls it in too).
 # libhypre-dev: BoomerAMG, the algebraic multigrid preconditioner of quasi_static's CG on large 3D
 # models (solver/src/linalg/amg.hpp).
 set -eu
-PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev libhypre-dev libopenblas0-serial nlohmann-json3-dev zlib1g-dev \
+PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev liblapack-dev libhypre-dev libopenblas0-serial nlohmann-json3-dev zlib1g-dev \
 libopenmpi-dev openmpi-bin \
 gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
 python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev lammps"

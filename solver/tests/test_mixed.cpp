@@ -1101,7 +1101,11 @@ struct CappedTries {
   std::vector<std::string> said;
   pd::Vec3Array u_after_first, v_after_first;
   std::vector<std::uint8_t> broken_after_first;
-  explicit CappedTries(int cap) {
+  // The bar's breaking rounds pass kMaxRemovedColumns (3D: many bonds at once) and factorise anew;
+  // off, so that these counts stay about the cap whatever that limit becomes.
+  explicit CappedTries(int cap, double stall_ratio = pd::QuasiStatic::kStallRatio) {
+    run.mixed.set_max_removed_columns(0);
+    run.mixed.set_stall_ratio(stall_ratio);
     run.mixed.set_pause_factorisations(cap);
     for (int k = 0; run.t < kEnd * (1 - 1e-12) && k < 100000; ++k) {
       const bool try_now = k > 0 && run.mixed.mode() == pd::Mixed::kQuasiStatic && *run.mixed.step_mode() == pd::Mixed::kExplicit;
@@ -1142,4 +1146,69 @@ TEST(Mixed, ATryOnThePauseRuleFailsOnceItWouldNeedMoreNewTangentsThanItsCap) {
   EXPECT_EQ(by_default.made, uncapped.made);
   EXPECT_TRUE(same_bits(by_default.run.state.u, uncapped.run.state.u));
   EXPECT_EQ(by_default.run.model.bonds.broken, uncapped.run.model.bonds.broken);
+}
+
+TEST(Mixed, ATryFailsAtTheFirstNewtonIterationThatStallsAndLeavesTheRunAsItWas) {
+  // The stall rule of a capped try (QuasiStatic::kStallRatio): with a ratio no iteration meets, the
+  // bar's first try fails at its first check, after its one factorisation, and says where; like any
+  // failed try it leaves the state as it found it, so the explicit step after it is bit for bit that
+  // of the try that ran to its own failure (unstable growth, 3 factorisations).
+  CappedTries normal(pd::Mixed::kPauseFactorisations), stalled(pd::Mixed::kPauseFactorisations, 1e-12);
+  ASSERT_FALSE(normal.made.empty());
+  ASSERT_FALSE(stalled.made.empty());
+  EXPECT_EQ(normal.made[0], 3);
+  EXPECT_EQ(stalled.made[0], 1);
+  EXPECT_NE(stalled.said[0].find("the tentative load step reached no equilibrium in 1 factorisation of the tangent: its "
+                                 "Newton iteration 1 took the residual down only ×"),
+            std::string::npos)
+      << stalled.said[0];
+  EXPECT_TRUE(same_bits(stalled.u_after_first, normal.u_after_first));
+  EXPECT_TRUE(same_bits(stalled.v_after_first, normal.v_after_first));
+  EXPECT_EQ(stalled.broken_after_first, normal.broken_after_first);
+}
+
+TEST(Mixed, ABreakingRoundTakesItsBondsOutOfTheFactorisationInsteadOfFactorisingAgain) {
+  // The bar's load steps up to the one that fails on unstable growth, with the bonds of each breaking
+  // round taken out of the factor (integrators/bonds_out_of_factor.hpp) and without (a new
+  // factorisation at each re-solve): the same bonds break at the same load, the equilibria before
+  // agree to Newton's tolerance, and the rounds cost no factorisation.
+  struct Steps {
+    pd::Model model = breakable_bar();
+    pd::ForceOperator op{model};
+    pd::QuasiStatic qs{op};
+    pd::State state{model.nodes.size()};
+    double t = 0.0;
+    std::vector<std::uint8_t> broken_at_failure;
+    explicit Steps(int columns) {
+      qs.configure(mixed_case());
+      qs.limit(3, kEnd / 1000);
+      qs.set_max_removed_columns(columns);
+      qs.initialize(state, t);
+      double dt = kEnd / 40;
+      for (int k = 0; k < 200 && t < kEnd * (1 - 1e-12); ++k) {
+        double h = std::min(dt, kEnd - t);
+        try {
+          qs.step(state, t, h);
+          dt = qs.last_step().next_dt;
+        } catch (const pd::StepFailed&) {
+          broken_at_failure = model.bonds.broken;
+          return;
+        }
+      }
+    }
+  };
+  Steps out(1 << 20), anew(0);
+  ASSERT_FALSE(out.broken_at_failure.empty()) << "the bar never snapped";
+  EXPECT_EQ(out.t, anew.t);
+  EXPECT_EQ(out.broken_at_failure, anew.broken_at_failure);
+  EXPECT_GT(out.qs.bonds_taken_out(), 0);
+  EXPECT_EQ(anew.qs.bonds_taken_out(), 0);
+  EXPECT_LT(out.qs.factorisations(), anew.qs.factorisations());
+  EXPECT_NE(out.qs.linear_algebra_summary().find(" broken bonds taken out of the factorisation in "), std::string::npos)
+      << out.qs.linear_algebra_summary();
+  double diff = 0.0, scale = 0.0;
+  for (std::size_t d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < out.state.size(); ++i)
+      diff = std::max(diff, std::fabs(out.state.u[d][i] - anew.state.u[d][i])), scale = std::max(scale, std::fabs(anew.state.u[d][i]));
+  EXPECT_LT(diff, 1e-6 * scale);
 }

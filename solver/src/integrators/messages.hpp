@@ -11,4 +11,9 @@ inline std::string message_number(double value) {
   return buffer;
 }
 
+// "1 factorisation", "3 factorisations": a count and its noun.
+inline std::string counted(long long count, const std::string& noun) {
+  return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
+}
+
 }  // namespace pd

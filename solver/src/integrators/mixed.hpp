@@ -38,9 +38,9 @@
 //   horizon (δ/c, c = √(E/ρ) of the slowest block): a running crack tip breaks bonds at least that
 //   often, since what loads the bonds ahead of it travels at most at the wave speed. Whether the
 //   crack has stopped for good is then asked of the equilibrium itself: one tentative load step
-//   (kTentativeIterations Newton iterations on at most kPauseFactorisations new tangents, no
-//   halving, and no more than unstable_rounds breaking rounds) from the current state at the
-//   current load. If it converges the crack is stable under
+//   (kTentativeIterations Newton iterations on at most kPauseFactorisations new tangents, none of
+//   which may stall, QuasiStatic::kStallRatio; no halving, and no more than unstable_rounds breaking
+//   rounds) from the current state at the current load. If it converges the crack is stable under
 //   the load and the load steps go on (the first kProbationSteps tentative); if not, the bonds it
 //   broke heal and Verlet goes on until the next pause. After kPauseTries failed tries (counted
 //   since the last load step past a probation) the rule rests until such a step. Why: the explicit
@@ -137,6 +137,10 @@ class Mixed : public Integrator {
   // New factorisations a try may make before it fails (kPauseFactorisations; 0: no cap, only
   // kTentativeIterations). Before the step that tries.
   void set_pause_factorisations(int factorisations) { pause_factorisations_ = factorisations; }
+  // The load steps' knobs of quasi_static.hpp, for tests: broken bonds taken out of the factorisation
+  // (0 columns: none) and a try's stall ratio.
+  void set_max_removed_columns(int columns) { static_.set_max_removed_columns(columns); }
+  void set_stall_ratio(double ratio) { static_.set_stall_ratio(ratio); }
   // Load steps cut to the first bond failure (quasi_static.hpp), since configure.
   int cuts_in_use() const { return home_ == kImplicit ? 0 : static_.cuts(); }
   int factorisations_in_use() const { return home_ == kImplicit ? implicit_.factorisations() : static_.factorisations(); }

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "parallel/decomposed.hpp"
 #include "parallel/node_sum.hpp"
+#include "integrators/bonds_out_of_factor.hpp"
 #include "integrators/messages.hpp"
 #include "integrators/newton_krylov.hpp"
 
@@ -315,6 +316,7 @@ bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool sh
     double& seconds;
     ~Timer() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
   } timer{start, factorise_seconds_};
+  bonds_out_.clear();  // a new factor has the bonds as they are
   SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, definite);
   if (K.rows < 0)
     throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
@@ -396,6 +398,7 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   std::memcpy(&t, at, sizeof t), at += sizeof t;
   std::memcpy(&factorisations, at, sizeof factorisations), at += sizeof factorisations;
   have_factor_ = false;
+  bonds_out_.clear();
   // The factorisation and the hierarchy were made with the hanging nodes' bonds masked, if there were
   // any: the same nodes now (a function of the broken flags, which have not changed since: breaking
   // forgets both), so the same masked K.
@@ -446,6 +449,9 @@ void QuasiStatic::find_hanging() {
 // bits).
 bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_start, int& iterations, double& omega) {
   find_hanging();
+  // Nodes left hanging by the bonds taken out: the factor has no masks for them (it was made without
+  // any); a new one is made with them masked.
+  if (bonds_out_.active() && !skip_dof_.empty()) have_factor_ = false, bonds_out_.clear();
   if (skip_dof_.empty()) return newton(s, t1, u_start, iterations, omega);
   // A free fragment stays where the last state left it: not where the predictor would carry it (its
   // last mean velocity, extrapolated, would go on stretching it load step after load step).
@@ -500,6 +506,14 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
       return omega = 0.0, true;
     }
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
+    // A try with a cap on its tangents (try_once) is a guess that an equilibrium is near: an
+    // iteration that takes the residual down by less than kStallRatio says Newton has stalled where
+    // it is (measured: see kStallRatio), and more tangents only buy linear convergence there.
+    if (factorisation_cap_ > 0 && std::isfinite(previous) && residual > stall_ratio_limit_ * previous) {
+      stall_ratio_ = residual / previous;
+      stalled_at_ = k - 1;  // the iteration whose correction gave this residual
+      return false;
+    }
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew (also
     // when only ω is above TOL: an old factor then reduces ω only linearly).
     if (!use_cg_ && (!have_factor_ || residual > 0.25 * previous)) {
@@ -563,6 +577,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     } else {
       const auto solve_start = std::chrono::steady_clock::now();
       factor_->solve(rhs_, correction_);
+      bonds_out_.apply(correction_);  // the bonds broken since the factorisation, taken out
       solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
       ++solves_;
     }
@@ -637,6 +652,7 @@ void QuasiStatic::remember_solver() {
 // load_state).
 void QuasiStatic::restore_solver() {
   const std::size_t n = op_.size();
+  bonds_out_.clear();  // a cut trial breaks nothing; this is for safety: they belong to the other factor
   if (at_start_.swapped) {
     std::swap(factor_, spare_factor_);
     std::swap(factor_u_, at_start_.factor_u);
@@ -707,6 +723,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   failure_reason_.clear();
   iteration_cap_ = try_once_iterations_;  // this step only
   factorisation_cap_ = try_once_factorisations_;
+  stalled_at_ = 0;
   try_once_iterations_ = try_once_factorisations_ = 0;
   factorisations_at_step_ = factorisations_;
   // The carried pieces are for this step only; a step that fails and is halved redoes it from them.
@@ -767,6 +784,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
           h > dt_min_ * (1.0 + 1e-12))
         cut_to = cut_step(state, s, h, start_ratio);
       if (cut_to > 0.0) break;
+      // The flags before the round, for taking its bonds out of the factor (only when there is one).
+      const bool can_take_out = max_removed_columns_ > 0 && have_factor_ && !use_cg_ && bond_based_ && !op_.decomposed() && skip_dof_.empty();
+      if (can_take_out) broken_before_round_ = op_.model().bonds.broken;
       const BreakReport broke = op_.break_bonds(s);
       if (broke.broken == 0) break;
       at_start_.active = false;  // no cut can follow (one needs no bond broken in the run)
@@ -776,7 +796,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       const bool not_slowing = fail_on_steady_breaking_ && rounds > 0 && broke.broken >= last_broken;
       last_broken = broke.broken;
       broke_total += broke;
-      have_factor_ = false;  // the tangent lost bonds
+      // The tangent lost bonds: taken out of the factor, or a new factorisation at the re-solve.
+      if (can_take_out) take_out_broken_bonds(broken_before_round_);
+      else have_factor_ = false, bonds_out_.clear();
       amg_.clear();          // and the hierarchy too (rule (1) of quasi_static.hpp)
       broken_since_start_ = true;
       if (++rounds >= settings_.max_breaking_rounds || not_slowing) {
@@ -806,6 +828,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       // s.f is already the force at the equilibrium with these bonds: solve_equilibrium returns true
       // only just after evaluating it, and a breaking round that broke nothing changed no bond.
       op_.update_work(s, t1, h);
+      if (bonds_out_.active()) have_factor_ = false, bonds_out_.clear();  // for one step only (see .hpp)
       carried_load_ = std::max(carried_load_, load_scale(s, t1));
       started_cold_ = !guess_from_velocity_;
       state = std::move(s);
@@ -825,12 +848,17 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     broken_by_failed_attempts += broke_total;
     have_factor_ = false;
+    bonds_out_.clear();
     if (iteration_cap_ > 0) {
-      const std::string spent = factorisation_cap_hit_
-                                    ? std::to_string(factorisation_cap_) + " factorisations of the tangent and " +
-                                          std::to_string(total) + " Newton iterations"
-                                    : std::to_string(iteration_cap_) + " Newton iterations";
+      const std::string spent =
+          stalled_at_ > 0 ? counted(factorisations_ - factorisations_at_step_, "factorisation") + " of the tangent: its Newton "
+                            "iteration " + std::to_string(stalled_at_) + " took the residual down only ×" +
+                            message_number(stall_ratio_) + ", a stall"
+          : factorisation_cap_hit_ ? std::to_string(factorisation_cap_) + " factorisations of the tangent and " +
+                                         std::to_string(total) + " Newton iterations"
+                                   : std::to_string(iteration_cap_) + " Newton iterations";
       factorisation_cap_hit_ = false;
+      stalled_at_ = 0;
       failure_reason_ = "the tentative load step reached no equilibrium in " + spent + " (last correction ω = " +
                         message_number(omega) + ")";
       throw StepFailed("the tentative quasi-static load step at t = " + message_number(t1) + " s reached no equilibrium in " +
@@ -864,6 +892,21 @@ double QuasiStatic::cut_step(State& start, State& end, double h, std::optional<S
   return cut < h ? cut : 0.0;
 }
 
+void QuasiStatic::take_out_broken_bonds(const std::vector<std::uint8_t>& broken_before) {
+  const auto start = std::chrono::steady_clock::now();
+  // On any failure the factor is dropped (a new factorisation at the re-solve, as without this), so
+  // the blocks are added in place.
+  const std::int64_t bonds = add_broken_bonds(op_.model(), broken_before, factor_u_, factor_definite_, dofs_, bonds_out_);
+  const bool fits = bonds >= 0 && bonds_out_.columns() <= max_removed_columns_ && bonds_out_.update(*factor_, dofs_.size());
+  if (fits) {
+    bonds_taken_out_ += bonds;
+  } else {
+    have_factor_ = false;
+    bonds_out_.clear();
+  }
+  bonds_out_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 std::string QuasiStatic::linear_algebra_summary() const {
   char buffer[160];
   std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s", factorisations_,
@@ -876,6 +919,12 @@ std::string QuasiStatic::linear_algebra_summary() const {
     cut_text = analyses_text;
   }
   if (cuts_ > 0) cut_text += ", " + std::to_string(cuts_) + " load steps cut to the first bond failure";
+  if (bonds_taken_out_ > 0) {
+    char out_text[112];
+    std::snprintf(out_text, sizeof out_text, ", %lld broken bonds taken out of the factorisation in %.3f s",
+                  static_cast<long long>(bonds_taken_out_), bonds_out_seconds_);
+    cut_text += out_text;
+  }
   if (!use_cg_) return buffer + cut_text;
   // On the matrix-free path every CG iteration is one J·x product, about one force evaluation.
   std::string text = std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +

@@ -81,6 +81,7 @@
 #include "linalg/amg.hpp"
 #include "linalg/cholesky.hpp"
 #include "linalg/pcg.hpp"
+#include "linalg/woodbury.hpp"
 #include "integrators/newton_krylov.hpp"
 #include "linalg/sparse_matrix.hpp"
 #include "parallel/dof_sums.hpp"
@@ -153,10 +154,29 @@ class QuasiStatic : public Integrator {
   // max_iterations Newton iterations and, when max_factorisations > 0, at most that many new
   // factorisations of the tangent: a tentative step, which fails fast (and cheaply: on a large 2D
   // lattice one factorisation costs some 200 explicit steps, see mixed.hpp kPauseFactorisations).
+  // With a cap on factorisations it also fails at a Newton iteration that stalls (kStallRatio).
   void try_once(int max_iterations, int max_factorisations = 0) {
     try_once_iterations_ = max_iterations;
     try_once_factorisations_ = max_factorisations;
   }
+  // The most columns of broken bonds taken out of a factorisation (kMaxRemovedColumns; 0: none, a
+  // breaking round then always factorises anew at its re-solve). Before the steps.
+  void set_max_removed_columns(int columns) { max_removed_columns_ = columns; }
+  // A capped try (try_once with a cap on factorisations) also fails at the first Newton iteration that takes the
+  // residual down by less than this: a stall. Measured (bench/quasi_static_cases.py's mixed case, 1
+  // thread, 4 Dec 2026): the pause tries that succeed on plate_with_hole and traction at dx × 2 and
+  // × 4 reduce it by ×0.06–×0.80 at every iteration (the worst, ×0.80 and ×0.72, on the definite
+  // tangent of the ringing state, before a new one); the try that fails on plate_with_hole at its own
+  // dx by ×0.99 at its second iteration, after which three more tangents (two refused by CHOLMOD:
+  // indefinite) bought linear convergence (×0.45) and the cap: 7.3 s of a 24.4 s run, against
+  // 2.1 s when it stops at the stall, with every other history.csv bit the same (a failed try
+  // leaves the state as it found it). Deuflhard's residual monotonicity test (Newton Methods for
+  // Nonlinear Problems, 2004, §3.3: ×(1 − λ/4), ×0.75 for a full step) would fail the dx × 2 plate's
+  // successful try at its ×0.80.
+  static constexpr double kStallRatio = 0.9;
+  // The stall ratio of a capped try (kStallRatio; see there). Before the step that tries.
+  void set_stall_ratio(double ratio) { stall_ratio_limit_ = ratio; }
+  std::int64_t bonds_taken_out() const { return bonds_taken_out_; }
   // For the next step only: the pieces the cracks have separated, carried by their grips. Per local
   // node the group of prescribed motions that alone holds its piece, −1 for none or several
   // (LoadPath::held_by_one_group), and the number of groups (the same on every rank). See
@@ -168,7 +188,7 @@ class QuasiStatic : public Integrator {
   // Whether the last step's equilibrium was the carried state itself (no correction, no tangent).
   bool accepted_as_carried() const { return accepted_carried_; }
   // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
-  void forget_factorisation() { have_factor_ = false, amg_.clear(); }
+  void forget_factorisation() { have_factor_ = false, amg_.clear(), bonds_out_.clear(); }
   // Why the last step() threw StepFailed, in a few words for run.log.
   const std::string& failure_reason() const { return failure_reason_; }
   double dt_min() const { return dt_min_; }
@@ -220,6 +240,9 @@ class QuasiStatic : public Integrator {
   int factorisation_cap_ = 0;    // the step in progress's new factorisations at most (0: no cap)
   int factorisations_at_step_ = 0;  // factorisations_ when the step in progress began
   bool factorisation_cap_hit_ = false;  // the step in progress failed on factorisation_cap_
+  double stall_ratio_limit_ = kStallRatio;
+  double stall_ratio_ = 0.0;  // the ratio of the stall that failed the try in progress, at
+  int stalled_at_ = 0;        // this Newton iteration (0: none)
 
   ForceOperator& op_;
   QuasiStaticSettings settings_;
@@ -241,6 +264,25 @@ class QuasiStatic : public Integrator {
   double factor_t_ = 0.0;
   bool factor_definite_ = false, factor_shifted_ = false;
   bool factorize_at(const State& s, double t1, bool definite, bool shifted);
+  // The bonds broken since the factorisation in use, taken out of it (bonds_out_of_factor.hpp): every
+  // solve with the factor is corrected by them. For one load step only: a step that ends with
+  // bonds taken out drops its factor, so that what a checkpoint holds (factor_u_ with the bonds of
+  // the checkpoint) is what a restart factorises again, bit for bit.
+  Woodbury bonds_out_;
+  std::int64_t bonds_taken_out_ = 0;  // bonds so, since configure (run.log's summary)
+  double bonds_out_seconds_ = 0.0;
+  // At most this many columns (2 per bond in 2D, 3 in 3D) are taken out; a round that would pass it
+  // factorises anew, as before. A column costs one right-hand side of a solve with many, and then
+  // O(n) per solve. Measured on plate_with_hole at its own dx (155 120 dofs, bench/quasi_static_cases.py's
+  // mixed case, 1 thread): 10 bonds, 20 columns, in 0.40 s against 1.9 s for the assembly and numeric
+  // factorisation they replaced; so 64 columns stay below a factorisation there, and the cap is
+  // a count, not a timing, so that the results do not depend on the machine.
+  static constexpr int kMaxRemovedColumns = 64;
+  int max_removed_columns_ = kMaxRemovedColumns;
+  // After a breaking round (flags before it): the bonds it broke taken out of the factor, or the
+  // factor dropped (have_factor_ false) when that cannot be done.
+  void take_out_broken_bonds(const std::vector<std::uint8_t>& broken_before);
+  std::vector<std::uint8_t> broken_before_round_;  // scratch: the flags before a breaking round
   std::string failure_reason_;
   // The matrix-free path: the choice and why (configure), the correction by PCG at (s, t1) for the
   // forcing term eta; false when CG made no progress.

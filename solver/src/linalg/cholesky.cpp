@@ -100,15 +100,21 @@ bool SparseCholesky::factorize(const SparseMatrix& K) {
   return true;
 }
 
-void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const {
+void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const { solve_columns(b, 1, x); }
+
+void SparseCholesky::solve_columns(const std::vector<double>& b, int columns, std::vector<double>& x) const {
   cholmod_common* cm = &impl_->common;
   const AtMostOurThreads cap;
+  const std::size_t rows = impl_->factor->n;
+  if (columns < 1 || b.size() != rows * static_cast<std::size_t>(columns))
+    throw Error("SparseCholesky::solve_columns: " + std::to_string(b.size()) + " values for " + std::to_string(rows) +
+                " rows × " + std::to_string(columns) + " columns");
   cholmod_dense B;
   std::memset(&B, 0, sizeof B);
-  B.nrow = b.size();
-  B.ncol = 1;
+  B.nrow = rows;
+  B.ncol = static_cast<std::size_t>(columns);
   B.nzmax = b.size();
-  B.d = b.size();
+  B.d = rows;
   B.x = const_cast<double*>(b.data());
   B.xtype = CHOLMOD_REAL;
   B.dtype = CHOLMOD_DOUBLE;
