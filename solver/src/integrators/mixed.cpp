@@ -276,7 +276,8 @@ void Mixed::step(State& state, double& t, double& dt) {
   report_.next_dt = dt_explicit_;
   step_mode_ = kExplicit;
   // The arrest watch: the crack has stopped and the motion it released has died down.
-  const double kinetic = op_.kinetic_energy(state), strain = op_.strain_energy(state);
+  const ForceOperator::KineticAndStrain energies = op_.kinetic_and_strain_energy(state);  // one pass, the same bits
+  const double kinetic = energies.kinetic, strain = energies.strain;
   if (report_.broken_now > 0) {
     cracked_ = true;
     // The graph changes only when bonds break: one O(bonds) pass then.
