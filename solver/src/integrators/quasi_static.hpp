@@ -20,7 +20,10 @@
 // (the round-off floor of the stretches, ~1e-16/strain of the load, above residual_tol at small strain). Then bonds over their critical
 // stretch break (thesis §2.2 rule) and the same load is solved again, until none breaks
 // (max_breaking_rounds: more is unstable crack growth, and the step fails; mixed also fails it when
-// a re-solve breaks no fewer bonds than the one before, see limit()). The next step is
+// a re-solve breaks no fewer bonds than the one before, see limit()). The re-solve keeps the
+// factorisation in use with the round's bonds taken out of it by the Woodbury identity
+// (integrators/bonds_out_of_factor.hpp, linalg/woodbury.hpp) while they fit in kMaxRemovedColumns,
+// instead of factorising again; for that load step only (a step that ends so drops its factor). The next step is
 // Φ_K·Δt with Φ_K of eq. 2.8 (control/zohdi.hpp) from the last correction, not larger after a step
 // in which bonds broke; a step that does not converge is redone from t with Δt/2. Velocities are
 // the mean over the load step, (u_{n+1} − u_n)/Δt, so the work ledger integrates the reactions.
