@@ -18,21 +18,33 @@ namespace {
 constexpr double kDx = 1e-3;
 constexpr int kSide = 16;
 
+pd::Model plate_model(int dimension) {
+  if (dimension == 2)
+    return pdtest::held_at_left(pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0),
+                                pdtest::cubic_lattice(kSide, kSide, 1, kDx, 2), kDx);
+  return pdtest::held_at_left(pdtest::lattice_case(3, "3d", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0),
+                              pdtest::cubic_lattice(kSide, kSide - 2, 5, kDx, 3), kDx);
+}
+
 struct Plate {
-  // A 2D lattice of 16 × 16 nodes, δ = 3.015 dx, its first two columns held; stretched along x and
-  // sheared, so that every bond has both an axial and a transverse stiffness (s/y ≠ 0).
-  pd::Model m = pdtest::held_at_left(pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 1e9, 1000.0, -1.0),
-                                     pdtest::cubic_lattice(kSide, kSide, 1, kDx, 2), kDx);
+  // A 2D lattice of 16 × 16 nodes (or a 3D slab of 16 × 14 × 5), δ = 3.015 dx, its first
+  // two columns held; stretched along x and sheared, so that every bond has both an axial and a
+  // transverse stiffness (s/y ≠ 0).
+  int dimension;
+  pd::Model m;
   pd::ForceOperator op{m};
   pd::State s{m.nodes.size()};
   pd::FreeDofs dofs;
-  Plate() {
+  explicit Plate(int dim = 2) : dimension(dim), m(plate_model(dim)) {
     for (std::size_t i = 0; i < s.size(); ++i) {
       s.u[0][i] = 1e-3 * m.nodes.x[0][i] + 2e-4 * m.nodes.x[1][i];
       s.u[1][i] = -3e-4 * m.nodes.x[1][i];
+      if (dim == 3) s.u[2][i] = 1e-4 * m.nodes.x[0][i] - 2e-4 * m.nodes.x[2][i];
     }
     op.impose_prescribed_motion(s, 0.0);
-    dofs = pd::FreeDofs::of(m.nodes.size(), 2, op.fixed());
+    // A node held in y alone (a roller): its bonds keep their x (and z) columns only at that end.
+    m.conditions.fixed[1][node(8, 2)] = 1;
+    dofs = pd::FreeDofs::of(m.nodes.size(), dim, op.fixed());
   }
   bool factorize(pd::SparseCholesky& factor) const { return factor.factorize(op.assemble_stiffness(s, 0.0, dofs)); }
   // Breaks the bond of row i to j, both halves (or only i's with one_side).
@@ -43,7 +55,7 @@ struct Plate {
         if (static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]) == b) m.bonds.broken[static_cast<std::size_t>(k)] = 1;
     }
   }
-  std::size_t node(int x, int y) const { return pdtest::node_index(x, y, 0, kSide, kSide); }
+  std::size_t node(int x, int y) const { return pdtest::node_index(x, y, dimension == 3 ? 2 : 0, kSide, dimension == 3 ? kSide - 2 : kSide); }
 };
 
 std::vector<double> load(std::size_t n) {
@@ -61,8 +73,10 @@ double relative_difference(const std::vector<double>& a, const std::vector<doubl
 
 }  // namespace
 
-TEST(Woodbury, BondsTakenOutRoundByRoundSolveAsTheTangentWithoutThem) {
-  Plate p;
+namespace {
+
+void rounds_solve_as_the_tangent_without_them(int dimension) {
+  Plate p(dimension);
   pd::SparseCholesky factor;
   ASSERT_TRUE(p.factorize(factor));
   const std::vector<double> b = load(p.dofs.size());
@@ -74,9 +88,11 @@ TEST(Woodbury, BondsTakenOutRoundByRoundSolveAsTheTangentWithoutThem) {
   p.break_bond(c, p.node(8, 10));
   p.break_bond(c, p.node(10, 9));
   p.break_bond(p.node(1, 5), p.node(3, 5));  // node (1, 5) is held: its end has no dofs
-  EXPECT_EQ(pd::add_broken_bonds(p.m, before, p.s.u, false, p.dofs, out), 4);
-  EXPECT_EQ(out.columns(), 8);  // 2 components at each bond, in 2D
-  EXPECT_EQ(p.m.bonds.broken[0], before[0]);
+  p.break_bond(p.node(8, 2), p.node(9, 2));  // node (8, 2) is held in y only
+  const std::vector<std::uint8_t> after = p.m.bonds.broken;
+  EXPECT_EQ(pd::add_broken_bonds(p.m, before, p.s.u, false, p.dofs, out), 5);
+  EXPECT_EQ(out.columns(), 5 * dimension);  // every component is a dof at one end at least
+  EXPECT_EQ(p.m.bonds.broken, after);  // the flags as they were found
   ASSERT_TRUE(out.update(factor, p.dofs.size()));
   std::vector<double> corrected, direct;
   factor.solve(b, corrected);
@@ -84,7 +100,7 @@ TEST(Woodbury, BondsTakenOutRoundByRoundSolveAsTheTangentWithoutThem) {
   pd::SparseCholesky fresh;
   ASSERT_TRUE(p.factorize(fresh));  // now without the four bonds
   fresh.solve(b, direct);
-  EXPECT_LT(relative_difference(corrected, direct), 1e-10);
+  EXPECT_LT(relative_difference(corrected, direct), 1e-10) << dimension << "D";
   // Without the correction the solve is another one: the check above is not vacuous.
   std::vector<double> plain;
   factor.solve(b, plain);
@@ -94,14 +110,20 @@ TEST(Woodbury, BondsTakenOutRoundByRoundSolveAsTheTangentWithoutThem) {
   p.break_bond(p.node(12, 3), p.node(13, 3));
   p.break_bond(p.node(12, 3), p.node(12, 4));
   EXPECT_EQ(pd::add_broken_bonds(p.m, before, p.s.u, false, p.dofs, out), 2);
-  EXPECT_EQ(out.columns(), 12);
+  EXPECT_EQ(out.columns(), 7 * dimension);
   ASSERT_TRUE(out.update(factor, p.dofs.size()));
   factor.solve(b, corrected);
   out.apply(corrected);
   ASSERT_TRUE(p.factorize(fresh));
   fresh.solve(b, direct);
-  EXPECT_LT(relative_difference(corrected, direct), 1e-10);
+  EXPECT_LT(relative_difference(corrected, direct), 1e-10) << dimension << "D";
 }
+
+}  // namespace
+
+TEST(Woodbury, BondsTakenOutRoundByRoundSolveAsTheTangentWithoutThemIn2d) { rounds_solve_as_the_tangent_without_them(2); }
+
+TEST(Woodbury, BondsTakenOutRoundByRoundSolveAsTheTangentWithoutThemIn3d) { rounds_solve_as_the_tangent_without_them(3); }
 
 TEST(Woodbury, ABondBrokenOnOneSideOrANodeLeftHangingIsRefused) {
   Plate p;

@@ -9,9 +9,10 @@
 // back for the computation. Newton then goes on with the tangent it had, less exactly the bonds it
 // lost: a modified Newton iteration whose tangent still has the crack's new faces.
 //
-// Why: the re-solve after a breaking round was a new factorisation at the same load (quasi_static.hpp
-// rule (2)); the few bonds of a round (6–12 on plate_with_hole and traction before their cracks run)
-// cost some 20–40 right-hand sides of one solve instead (measured: quasi_static.cpp, kMaxRemovedColumns).
+// Why: the re-solve after a breaking round was a new factorisation at the same load (quasi_static.hpp,
+// "Then bonds over their critical stretch break"); the few bonds of a round (4–12 on plate_with_hole
+// and traction before their cracks run) cost 8–24 right-hand sides of one solve instead (measured:
+// quasi_static.hpp, kMaxRemovedColumns).
 #pragma once
 #include <cstdint>
 #include <vector>

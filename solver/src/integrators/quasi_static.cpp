@@ -47,7 +47,8 @@ void QuasiStatic::configure(const Case& c, double) {
 // 5.95e7 entries, 0.48 GB, peak 0.97 GB resident) against 1.3 s CPU (67×; 0.2 s to the first
 // Eisenstat–Walker tolerance 0.1); at 67,200 dofs PCG 7.3 s CPU. The factor's fill grew as
 // dofs^1.5 and its time as dofs^2.3: above some 20,000 dofs a factorisation costs more than the
-// Newton iterations it can serve once bonds break (every breaking round refactorises), so auto
+// Newton iterations it can serve once bonds break (a breaking round of more than a few bonds
+// refactorises: kMaxRemovedColumns), so auto
 // takes cg; at 10⁵ nodes (3·10⁵ dofs) the factor would hold some 2·10⁹ entries, 17 GB.
 // In 2D the factor stays small (the traction lattice, 47,871 dofs, factorises in seconds and one
 // factorisation serves the elastic range): auto keeps direct whatever the size there, unless a term
@@ -368,6 +369,7 @@ std::vector<char> QuasiStatic::save_state() const {
   // Last: a checkpoint of a solver without them reads (carried_load_ = 0, started_cold_ = false).
   const std::uint8_t cold = started_cold_ ? 1 : 0;
   put(carried_load_), put(cold);
+  put(bonds_taken_out_);  // after them: older checkpoints read with 0 (run.log's summary only)
   return bytes;
 }
 
@@ -383,14 +385,17 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   const bool have_amg = amg && bytes.size() > kReportBytes + extra && bytes[kReportBytes + extra] != 0;
   const std::size_t amg_extra = amg ? amg_part + (have_amg ? 3 * n * sizeof(double) : 0) : 0;
   const std::size_t known = kReportBytes + extra + amg_extra;
-  if (bytes.size() != known && bytes.size() != known + sizeof(double) + 1)
+  const std::size_t tail = sizeof(double) + 1, counted_out = sizeof(std::int64_t);
+  if (bytes.size() != known && bytes.size() != known + tail && bytes.size() != known + tail + counted_out)
     throw std::runtime_error("integrator state of the wrong size");
   carried_load_ = 0.0;
   started_cold_ = false;
+  bonds_taken_out_ = 0;
   if (bytes.size() > known) {
     std::memcpy(&carried_load_, bytes.data() + known, sizeof carried_load_);
     started_cold_ = bytes[known + sizeof(double)] != 0;
   }
+  if (bytes.size() == known + tail + counted_out) std::memcpy(&bonds_taken_out_, bytes.data() + known + tail, counted_out);
   const char* at = bytes.data() + kReportBytes + 1;
   const bool definite = *at++ != 0, shifted = *at++ != 0;
   double t = 0.0;
@@ -508,8 +513,13 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     if (residual == 0.0) return omega = 0.0, true;  // nothing loads the body
     // A try with a cap on its tangents (try_once) is a guess that an equilibrium is near: an
     // iteration that takes the residual down by less than kStallRatio says Newton has stalled where
-    // it is (measured: see kStallRatio), and more tangents only buy linear convergence there.
-    if (factorisation_cap_ > 0 && std::isfinite(previous) && residual > stall_ratio_limit_ * previous) {
+    // it is (measured: see kStallRatio), and more tangents only buy linear convergence there. Only
+    // on what it was measured on: a direct factorisation made in this step with the bonds as they
+    // are (not one from an earlier step, nor one with bonds taken out, whose slow convergence a new
+    // tangent cures: the 4× rule below), and a residual still above its tolerance.
+    if (factorisation_cap_ > 0 && !use_cg_ && have_factor_ && !bonds_out_.active() &&
+        factorisations_ > factorisations_at_step_ && std::isfinite(previous) &&
+        residual > settings_.residual_tol * load && residual > stall_ratio_limit_ * previous) {
       stall_ratio_ = residual / previous;
       stalled_at_ = k - 1;  // the iteration whose correction gave this residual
       return false;
@@ -802,6 +812,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       amg_.clear();          // and the hierarchy too (rule (1) of quasi_static.hpp)
       broken_since_start_ = true;
       if (++rounds >= settings_.max_breaking_rounds || not_slowing) {
+        have_factor_ = have_factor_ && !bonds_out_.active();  // the bonds taken out are this step's
+        bonds_out_.clear();
         failure_reason_ = "bonds kept breaking through " + std::to_string(rounds) + " re-solves at one load (" +
                           std::to_string(broke_total.broken) + " bonds" +
                           (not_slowing ? ", the last re-solve " + std::to_string(broke.broken) + ", no fewer than the one before" : "") +
@@ -851,8 +863,8 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     bonds_out_.clear();
     if (iteration_cap_ > 0) {
       const std::string spent =
-          stalled_at_ > 0 ? counted(factorisations_ - factorisations_at_step_, "factorisation") + " of the tangent: its Newton "
-                            "iteration " + std::to_string(stalled_at_) + " took the residual down only ×" +
+          stalled_at_ > 0 ? counted(factorisations_ - factorisations_at_step_, "factorisation") + " of the tangent: Newton "
+                            "iteration " + std::to_string(stalled_at_) + " of its solve took the residual down only ×" +
                             message_number(stall_ratio_) + ", a stall"
           : factorisation_cap_hit_ ? std::to_string(factorisation_cap_) + " factorisations of the tangent and " +
                                          std::to_string(total) + " Newton iterations"
@@ -897,7 +909,10 @@ void QuasiStatic::take_out_broken_bonds(const std::vector<std::uint8_t>& broken_
   // On any failure the factor is dropped (a new factorisation at the re-solve, as without this), so
   // the blocks are added in place.
   const std::int64_t bonds = add_broken_bonds(op_.model(), broken_before, factor_u_, factor_definite_, dofs_, bonds_out_);
-  const bool fits = bonds >= 0 && bonds_out_.columns() <= max_removed_columns_ && bonds_out_.update(*factor_, dofs_.size());
+  // W is dofs × columns doubles: at most kMaxRemovedBytes of it, whatever the cap in columns.
+  const auto byte_cap = static_cast<int>(std::min<std::size_t>(kMaxRemovedBytes / (sizeof(double) * std::max<std::size_t>(dofs_.size(), 1)),
+                                                                static_cast<std::size_t>(max_removed_columns_)));
+  const bool fits = bonds >= 0 && bonds_out_.columns() <= byte_cap && bonds_out_.update(*factor_, dofs_.size());
   if (fits) {
     bonds_taken_out_ += bonds;
   } else {

@@ -281,6 +281,8 @@ class QuasiStatic : public Integrator {
   // factorisation they replaced; so 64 columns stay below a factorisation there, and the cap is
   // a count, not a timing, so that the results do not depend on the machine.
   static constexpr int kMaxRemovedColumns = 64;
+  // And W's memory at most this (256 MB: 64 columns up to 5·10⁵ dofs, fewer above).
+  static constexpr std::size_t kMaxRemovedBytes = std::size_t{256} << 20;
   int max_removed_columns_ = kMaxRemovedColumns;
   // After a breaking round (flags before it): the bonds it broke taken out of the factor, or the
   // factor dropped (have_factor_ false) when that cannot be done.

@@ -4,6 +4,7 @@
 #include <cholmod.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 
@@ -103,6 +104,11 @@ bool SparseCholesky::factorize(const SparseMatrix& K) {
 void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const { solve_columns(b, 1, x); }
 
 void SparseCholesky::solve_columns(const std::vector<double>& b, int columns, std::vector<double>& x) const {
+  x.resize(b.size());
+  solve_columns(b, columns, x.data());
+}
+
+void SparseCholesky::solve_columns(const std::vector<double>& b, int columns, double* x) const {
   cholmod_common* cm = &impl_->common;
   const AtMostOurThreads cap;
   const std::size_t rows = impl_->factor->n;
@@ -121,7 +127,7 @@ void SparseCholesky::solve_columns(const std::vector<double>& b, int columns, st
   cholmod_dense* X = cholmod_l_solve(CHOLMOD_A, impl_->factor, &B, cm);
   if (!X) throw Error("CHOLMOD could not solve with the factorised tangent (status " + std::to_string(cm->status) + ")");
   const auto* values = static_cast<const double*>(X->x);
-  x.assign(values, values + b.size());
+  std::copy(values, values + b.size(), x);
   cholmod_l_free_dense(&X, cm);
 }
 

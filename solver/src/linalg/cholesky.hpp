@@ -30,6 +30,8 @@ class SparseCholesky {
   // X = K⁻¹ B for `columns` right-hand sides at once (B and X column-major, rows × columns): one
   // pass of CHOLMOD's supernodal solve over L for all of them (BLAS-3 on each supernode).
   void solve_columns(const std::vector<double>& B, int columns, std::vector<double>& X) const;
+  // The same into X[0 .. rows × columns) (caller's memory: no copy of X's vector).
+  void solve_columns(const std::vector<double>& B, int columns, double* X) const;
 
   const std::string& failure() const { return failure_; }
   int analyses() const { return analyses_; }            // symbolic analyses so far (orderings)

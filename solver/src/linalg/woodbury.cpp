@@ -50,15 +50,17 @@ bool Woodbury::update(const SparseCholesky& factor, std::size_t rows) {
   // W's new columns: K⁻¹ applied to U's columns added since the last update, in one solve.
   const int fresh = r - solved_;
   if (fresh > 0) {
-    std::vector<double> u(rows * static_cast<std::size_t>(fresh), 0.0), w;
+    std::vector<double> u(rows * static_cast<std::size_t>(fresh), 0.0);
     for (int a = 0; a < fresh; ++a) {
       const auto column = static_cast<std::size_t>(solved_ + a);
       double* col = u.data() + static_cast<std::size_t>(a) * rows;
       if (plus_[column] >= 0) col[plus_[column]] = 1.0;
       if (minus_[column] >= 0) col[minus_[column]] = -1.0;
     }
-    factor.solve_columns(u, fresh, w);
-    w_.insert(w_.end(), w.begin(), w.end());
+    // W's new columns straight after the old ones (column-major): no copy of them.
+    const std::size_t old_size = w_.size();
+    w_.resize(old_size + u.size());
+    factor.solve_columns(u, fresh, w_.data() + old_size);
     solved_ = r;
   }
   if (r == 0) return true;
