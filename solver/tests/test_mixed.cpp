@@ -1167,29 +1167,43 @@ TEST(Mixed, ATryFailsAtTheFirstNewtonIterationThatStallsAndLeavesTheRunAsItWas) 
   EXPECT_EQ(stalled.broken_after_first, normal.broken_after_first);
 }
 
+namespace {
+
+// The bar under quasi-static load steps alone, from t = 0 in steps of kEnd/40, with at most
+// `columns` columns of broken bonds taken out of a factorisation; `limited`: mixed's limits
+// (3 breaking rounds, the steady-breaking verdict).
+struct BarStatic {
+  pd::Model model = breakable_bar();
+  pd::ForceOperator op{model};
+  pd::QuasiStatic qs{op};
+  pd::State state{model.nodes.size()};
+  double t = 0.0, dt = kEnd / 40;
+  BarStatic(const pd::Case& c, int columns, bool limited) {
+    qs.configure(c);
+    if (limited) qs.limit(3, kEnd / 1000);
+    qs.set_max_removed_columns(columns);
+    qs.initialize(state, t);
+  }
+  void step() {
+    double h = std::min(dt, kEnd - t);
+    qs.step(state, t, h);
+    dt = qs.last_step().next_dt;
+  }
+};
+
+}  // namespace
+
 TEST(Mixed, ABreakingRoundTakesItsBondsOutOfTheFactorisationInsteadOfFactorisingAgain) {
   // The bar's load steps up to the one that fails on unstable growth, with the bonds of each breaking
   // round taken out of the factor (integrators/bonds_out_of_factor.hpp) and without (a new
   // factorisation at each re-solve): the same bonds break at the same load, the equilibria before
   // agree to Newton's tolerance, and the rounds cost no factorisation.
-  struct Steps {
-    pd::Model model = breakable_bar();
-    pd::ForceOperator op{model};
-    pd::QuasiStatic qs{op};
-    pd::State state{model.nodes.size()};
-    double t = 0.0;
+  struct Steps : BarStatic {
     std::vector<std::uint8_t> broken_at_failure;
-    explicit Steps(int columns) {
-      qs.configure(mixed_case());
-      qs.limit(3, kEnd / 1000);
-      qs.set_max_removed_columns(columns);
-      qs.initialize(state, t);
-      double dt = kEnd / 40;
+    explicit Steps(int columns) : BarStatic(mixed_case(), columns, true) {
       for (int k = 0; k < 200 && t < kEnd * (1 - 1e-12); ++k) {
-        double h = std::min(dt, kEnd - t);
         try {
-          qs.step(state, t, h);
-          dt = qs.last_step().next_dt;
+          step();
         } catch (const pd::StepFailed&) {
           broken_at_failure = model.bonds.broken;
           return;
@@ -1218,26 +1232,15 @@ TEST(Mixed, ACheckpointAfterALoadStepThatTookBondsOutOfTheFactorisationContinues
   // ends, so the checkpoint after it (which holds where a factor was made, not the correction) is
   // restarted bit for bit. quasi_static alone on the bar, with its default limits: steps are
   // accepted with bonds broken in them.
-  struct Run {
-    pd::Model model = breakable_bar();
-    pd::ForceOperator op{model};
-    pd::QuasiStatic qs{op};
-    pd::State state{model.nodes.size()};
-    double t = 0.0, dt = kEnd / 40;
-    Run() {
-      pd::Case c = mixed_case();
-      c.time.integrator = "quasi_static";
-      qs.configure(c);
-      qs.set_max_removed_columns(1 << 20);
-      qs.initialize(state, t);
-    }
-    void step() {
-      double h = std::min(dt, kEnd - t);
-      qs.step(state, t, h);
-      dt = qs.last_step().next_dt;
-    }
+  const auto quasi_static = [] {
+    pd::Case c = mixed_case();
+    c.time.integrator = "quasi_static";
+    return c;
   };
-  Run a;
+  struct Run : BarStatic {
+    explicit Run(const pd::Case& c) : BarStatic(c, 1 << 20, false) {}
+  };
+  Run a(quasi_static());
   bool took_out = false;
   for (int k = 0; k < 400 && !took_out && a.t < kEnd * (1 - 1e-12); ++k) {
     const std::int64_t before = a.qs.bonds_taken_out();
@@ -1247,7 +1250,7 @@ TEST(Mixed, ACheckpointAfterALoadStepThatTookBondsOutOfTheFactorisationContinues
   ASSERT_TRUE(took_out) << "no accepted load step took bonds out";
   const std::vector<char> saved = a.qs.save_state();
   const int a_at_save = a.qs.factorisations();
-  Run b;
+  Run b(quasi_static());
   b.state = a.state, b.t = a.t, b.dt = a.dt;
   b.model.bonds.broken = a.model.bonds.broken;
   b.qs.load_state(saved);
