@@ -13,7 +13,7 @@
 #                             (pipeline/fuzz_cli.py), FUZZ_SECONDS (60) each (clang)
 #   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
 #   make bench-accuracy       error against run time: Verlet, adaptive, quasi_static, mixed → out/bench/accuracy.csv (docs/accuracy.md)
-#   make bench-implicit       implicit dynamics vs Verlet on a drum lattice → out/bench/implicit.csv
+#   make bench-implicit       implicit dynamics vs Verlet on a drum lattice and the membrane → out/bench/implicit.csv
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
@@ -240,8 +240,9 @@ bench-accuracy: $(SOLVER) | $(DEPS)
 	$(PY) -m bench.accuracy --solver $(SOLVER) --out out/bench $(ACCURACY_ARGS)
 
 # Implicit dynamics (issue 13): Verlet at several steps and time.integrator: implicit over a sweep of
-# implicit.tol on a drum lattice, struck (cases/drum's blow) and pushed by a smooth pulse, error of u_z
-# against a fine Verlet run versus wall time and force evaluations (bench/implicit_dynamics.py).
+# implicit.tol on a drum lattice, struck (cases/drum's blow) and pushed by a smooth pulse, and on
+# cases/membrane's lattice, error of u_z against a fine Verlet run versus wall time and force
+# evaluations (bench/implicit_dynamics.py).
 bench-implicit: $(SOLVER) | $(DEPS)
 	$(PY) -m bench.implicit_dynamics --solver $(SOLVER) --out out/bench $(IMPLICIT_ARGS)
 

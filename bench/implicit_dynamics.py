@@ -1,4 +1,4 @@
-"""Implicit dynamics against Verlet on the drum (make bench-implicit; issue 13): a lattice model of
+"""Implicit dynamics against Verlet on the drum and the membrane (make bench-implicit; issue 13): a lattice model of
 cases/drum — a square membrane pre-strained by ε0 = 10⁻³ inside a clamped frame, struck with
 v_z = 0.1 m/s, ringing out of plane at a frequency set by the tension (the membrane wave speed
 √(Eε0/((1−ν)ρ)) ≈ 61 m/s is 1/26 of the in-plane wave speed that sets the explicit limit, so the
@@ -25,8 +25,12 @@ span-30 pulse run at tol 1e-3; 45 % of its time in dsyrk/dgemm/dtrsm of Debian's
 force 2.5 %) costs hundreds of force evaluations, and Verlet at its limit is already far more
 accurate than the slow motion needs: implicit does not win here.
 
+And cases/membrane on its own lattice (--loads membrane, 2500 nodes, to --membrane-end 2 ms): measured
+4 Dec 2026 (docs/accuracy.md), Verlet at 0.8 × eq. 2.5 7.1e-3 in 1.1 s; implicit at tol 1e-2
+6.3e-2 in 8.7 s, at 1e-5 8.9e-4 in 54.7 s: Verlet wins here too.
+
     /usr/bin/python3 -m bench.implicit_dynamics [--solver build/solver/pdsolve] [--threads 1]
-        [--repeat 3] [--span 30] [--periods 2]
+        [--repeat 3] [--span 30] [--periods 2] [--loads blow,pulse,membrane] [--membrane-end 2e-3]
 """
 from __future__ import annotations
 
@@ -87,13 +91,44 @@ def drum_problem(directory: str, span: int, periods: float, load: str) -> dict:
     }
 
 
+MEMBRANE_SIDE = 50       # nodes per side of cases/membrane's lattice (dx = 1 mm)
+MEMBRANE_DX = 1.0e-3
+
+
+def membrane_problem(directory: str, end: float) -> dict:
+    """cases/membrane on its lattice (50 × 50 nodes, dx = 1 mm, δ = 3.015 dx): clamped in a layer 3 mm
+    deep along the four sides, a central disk of radius 6 mm set moving out of plane at 10 m/s,
+    velocity damping 300 1/s, no pre-strain: the membrane resists out-of-plane motion only through
+    the stretch its deflection causes (thesis §5.1), so its motion is slow and nonlinear next to the
+    in-plane waves that set the explicit limit."""
+    dx, n = MEMBRANE_DX, MEMBRANE_SIDE
+    x, y = np.meshgrid(np.arange(n) * dx, np.arange(n) * dx, indexing="xy")
+    points = np.column_stack([x.ravel() + 0.5 * dx, y.ravel() + 0.5 * dx, np.zeros(x.size)])
+    side = n * dx
+    clamped = ((points[:, 0] < 3e-3) | (points[:, 0] > side - 3e-3) | (points[:, 1] < 3e-3) | (points[:, 1] > side - 3e-3))
+    centre = np.hypot(points[:, 0] - side / 2, points[:, 1] - side / 2) < 6e-3
+    cloud = NodeCloud(points=points, volume=np.full(len(points), dx * dx * 1e-3), block=np.ones(len(points), np.int32),
+                      sets={"clamped": clamped, "centre": centre}, grid_spacing=dx, dimension=2)
+    write_node_file(os.path.join(directory, "nodes.vtu"), cloud)
+    return {
+        "dimension": 2, "analysis": "plane_stress", "thickness": 1e-3, "grid_spacing": dx, "horizon": 3.015 * dx,
+        "blocks": [{"id": 1, "name": "membrane", "model": "pmb", "density": 1200.0, "youngs_modulus": 3.0e9,
+                    "fracture_energy": None}],
+        "node_sets": ["clamped", "centre"],
+        "initial_conditions": [{"set": "centre", "kind": "velocity", "component": 2, "value": 10.0}],
+        "boundary_conditions": [{"set": "clamped", "kind": "velocity", "component": c, "times": [0.0], "values": [0.0]}
+                                for c in range(3)],
+        "damping": 300.0, "end": end, "every_time": end / 20, "nodes": len(points),
+    }
+
+
 def write_case(directory: str, problem: dict, name: str, time: dict, implicit: dict | None) -> str:
     run_dir = os.path.join(directory, name)
     os.makedirs(run_dir, exist_ok=True)
     case = {key: problem[key] for key in ("dimension", "analysis", "thickness", "grid_spacing", "horizon", "blocks",
                                           "node_sets", "boundary_conditions", "initial_conditions")}
     case.update({"format_version": 1, "case": name, "nodes_file": "../nodes.vtu", "output_dir": ".",
-                 "no_fail_sets": [], "damping": 0.0,
+                 "no_fail_sets": [], "damping": problem.get("damping", 0.0),
                  "time": dict(time, end=problem["end"], max_steps=10_000_000),
                  "output": {"every_time": problem["every_time"], "every_steps": None, "history_every": 1_000_000,
                             "precision": "float64"}})
@@ -132,9 +167,14 @@ def schemes(factors: list[float], rhos: list[float], tols: list[float]):
 def bench_load(args, load: str) -> list[dict]:
     directory = os.path.join(args.out, "implicit", load)
     os.makedirs(directory, exist_ok=True)
-    problem = drum_problem(directory, args.span, args.periods, load)
-    print(f"drum lattice, {load}: {problem['nodes']} nodes, span {args.span} dx, {args.periods:g} periods; "
-          f"{machine()}, {args.threads} thread(s); load {os.getloadavg()[0]:.2f}")
+    if load == "membrane":
+        problem = membrane_problem(directory, args.membrane_end)
+        print(f"cases/membrane's lattice: {problem['nodes']} nodes, to t = {args.membrane_end:g} s; "
+              f"{machine()}, {args.threads} thread(s); load {os.getloadavg()[0]:.2f}")
+    else:
+        problem = drum_problem(directory, args.span, args.periods, load)
+        print(f"drum lattice, {load}: {problem['nodes']} nodes, span {args.span} dx, {args.periods:g} periods; "
+              f"{machine()}, {args.threads} thread(s); load {os.getloadavg()[0]:.2f}")
 
     reference_path = write_case(directory, problem, "reference", {"integrator": "verlet", "dt": "stable",
                                                                   "safety_factor": 0.05}, None)
@@ -173,7 +213,9 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--span", type=int, default=30, help="free span in grid spacings (cases/drum: 100)")
     parser.add_argument("--periods", type=float, default=2.0, help="length of the run in fundamental periods")
-    parser.add_argument("--loads", default="blow,pulse", help="blow (cases/drum's), pulse (smooth), or both")
+    parser.add_argument("--loads", default="blow,pulse,membrane",
+                        help="blow (cases/drum's), pulse (smooth), membrane (cases/membrane's), comma-separated")
+    parser.add_argument("--membrane-end", type=float, default=2e-3, help="the membrane run's end time [s]")
     parser.add_argument("--verlet", default="0.8,0.4,0.2", help="Verlet's steps as fractions of eq. 2.5")
     parser.add_argument("--rho", default="1,0.8", help="implicit.rho_infinity values")
     parser.add_argument("--tols", default="1e-2,1e-3,1e-4,1e-5", help="implicit.tol values")
