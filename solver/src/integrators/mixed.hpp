@@ -40,8 +40,8 @@
 //   crack has stopped for good is then asked of the equilibrium itself: one tentative load step
 //   (kTentativeIterations Newton iterations on at most kPauseFactorisations new tangents, no
 //   iteration of which may stall, QuasiStatic::kStallRatio; no halving, and no more than
-//   unstable_rounds breaking rounds) from the current state at the current load. If it converges the crack is stable under
-//   the load and the load steps go on (the first kProbationSteps tentative); if not, the bonds it
+//   unstable_rounds breaking rounds) from the current state at the current load. If it converges
+//   the crack is stable under the load and the load steps go on (the first kProbationSteps tentative); if not, the bonds it
 //   broke heal and Verlet goes on until the next pause. After kPauseTries failed tries (counted
 //   since the last load step past a probation) the rule rests until such a step. Why: the explicit
 //   phase is undamped, and after the crack has run its released energy rings in the pieces for

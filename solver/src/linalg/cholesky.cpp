@@ -101,11 +101,9 @@ bool SparseCholesky::factorize(const SparseMatrix& K) {
   return true;
 }
 
-void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const { solve_columns(b, 1, x); }
-
-void SparseCholesky::solve_columns(const std::vector<double>& b, int columns, std::vector<double>& x) const {
+void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const {
   x.resize(b.size());
-  solve_columns(b, columns, x.data());
+  solve_columns(b, 1, x.data());
 }
 
 void SparseCholesky::solve_columns(const std::vector<double>& b, int columns, double* x) const {

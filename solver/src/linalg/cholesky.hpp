@@ -27,10 +27,9 @@ class SparseCholesky {
   bool factorize(const SparseMatrix& K);
   // x = K⁻¹ b with the last successful factorisation.
   void solve(const std::vector<double>& b, std::vector<double>& x) const;
-  // X = K⁻¹ B for `columns` right-hand sides at once (B and X column-major, rows × columns): one
-  // pass of CHOLMOD's supernodal solve over L for all of them (BLAS-3 on each supernode).
-  void solve_columns(const std::vector<double>& B, int columns, std::vector<double>& X) const;
-  // The same into X[0 .. rows × columns) (caller's memory: no copy of X's vector).
+  // X = K⁻¹ B for `columns` right-hand sides at once (B and X column-major, rows × columns; X is the
+  // caller's memory): one pass of CHOLMOD's supernodal solve over L for all of them (BLAS-3 on each
+  // supernode).
   void solve_columns(const std::vector<double>& B, int columns, double* X) const;
 
   const std::string& failure() const { return failure_; }
