@@ -165,3 +165,18 @@ def test_run_log_tells_the_story(runs):
     _, cut, _ = runs
     log = (cut / "run.log").read_text()
     assert "interrupted: " in log and "restart from" in log and "done: " in log
+
+
+def test_the_restarted_runs_rate_counts_only_its_own_steps(runs):
+    # "done: N steps … in W s wall (R bond updates/s)": R·W is the bond updates of the run that
+    # printed it, so the restart's R·W over the whole run's is its share of the steps, N − M over N
+    # (M the step it restarted from), not N/N (fixed: the rate divided every step by the restart's
+    # wall time alone: N/(N − M) times too high).
+    import re
+    line = re.compile(r"(done|interrupted): (\d+) steps to t = \S+ s in ([\d.]+) s wall \(([\d.e+-]+) bond updates/s\)")
+    whole, cut, _ = runs
+    (_, n_whole, w_whole, r_whole), = line.findall((whole / "run.log").read_text())
+    (_, m, _, _), (_, n, w_restart, r_restart) = line.findall((cut / "run.log").read_text())
+    assert int(n) == int(n_whole) and 0 < int(m) < int(n)
+    share = float(r_restart) * float(w_restart) / (float(r_whole) * float(w_whole))
+    assert share == pytest.approx((int(n) - int(m)) / int(n), rel=0.05)

@@ -319,6 +319,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     if (out) out->finish();
   });
   end.wall = seconds_since(loop_start);
+  end.steps = loop.step - first_step;
   // What the ranks exchanged, per step of this run (issue 15's measures; bench/mpi_ranks.py reads them).
   if (dec)
     for (const std::string& text : dec->traffic_report(loop.step - first_step)) log.line(text);

@@ -16,6 +16,7 @@ struct LoopEnd {
   int interrupted = 0;       // the signal that stopped it, or 0
   double output_seconds = 0.0;  // wall time writing frames and history rows
   double wall = 0.0;         // wall time of this run's loop, the last frame and closing the output included
+  std::int64_t steps = 0;    // steps this run took (a restarted run's steps before its restart not counted)
 };
 
 // s.loop and s.state are advanced in place. Throws pd::Error if output fails (a full disk).

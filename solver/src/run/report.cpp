@@ -11,7 +11,8 @@ int report(const RunOptions& opt, const Prepared& p, const LoopState& loop, cons
            RunLog& log) {
   const Model& model = p.model;
   const double wall = end.wall;
-  const double updates = static_cast<double>(p.directed_bonds()) * static_cast<double>(loop.step);
+  // The rate of this run: its steps over its wall time (a restart's wall time starts at the restart).
+  const double updates = static_cast<double>(p.directed_bonds()) * static_cast<double>(end.steps);
   log.line(std::string(end.interrupted ? "interrupted" : end.status == kOk ? "done" : "stopped") + ": " +
            std::to_string(loop.step) + " steps to t = " + format("%.6g", loop.t) + " s in " + format("%.3f", wall) +
            " s wall (" + format("%.3g", wall > 0 ? updates / wall : 0.0) + " bond updates/s), " +
