@@ -54,7 +54,9 @@ endif
 # R × cores threads on the cores (2 ranks × 2 spinning threads on 2 cores: 0.8–0.9 × 10⁸ bond
 # updates/s at 40³ against 4.3 × 10⁸ for 2 ranks × 1 thread, docs/performance.md §7).
 RANK_THREADS := $(if $(filter-out 1,$(RANKS)),$(if $(OMP_NUM_THREADS),,$(shell t=$$(( $$(nproc) / $(RANKS) )); [ $$t -ge 1 ] || t=1; echo $$t)))
-MPIRUN := $(if $(filter-out 1,$(RANKS)),mpiexec --oversubscribe -np $(RANKS)$(if $(RANK_THREADS), -x OMP_NUM_THREADS=$(RANK_THREADS)))
+# Through pipeline/run-ranks.sh: it passes a Ctrl-C or SIGTERM to the ranks themselves, which finish
+# their step and write checkpoint.bin; Open MPI's mpirun would kill them 2 s after the signal.
+MPIRUN := $(if $(filter-out 1,$(RANKS)),sh pipeline/run-ranks.sh mpiexec --oversubscribe -np $(RANKS)$(if $(RANK_THREADS), -x OMP_NUM_THREADS=$(RANK_THREADS)))
 
 ifeq ($(origin config),undefined)
   config := $(case)
@@ -148,10 +150,10 @@ CHECKPOINT := $(OUT)/checkpoint.bin
 $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
 	@if [ -f '$(CHECKPOINT)' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/case.json' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/nodes.vtu' ] \
 	    && [ '$(CHECKPOINT)' -nt '$(SOLVER)' ]; then \
-	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
+	  echo "$(strip $(MPIRUN) $(SOLVER)) $(OUT)/case.json --restart $(CHECKPOINT)   (resuming the interrupted run)"; \
 	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json' --restart '$(CHECKPOINT)'; \
 	else \
-	  echo "$(MPIRUN) $(SOLVER) $(OUT)/case.json"; \
+	  echo "$(strip $(MPIRUN) $(SOLVER)) $(OUT)/case.json"; \
 	  exec $(MPIRUN) '$(SOLVER)' '$(OUT)/case.json'; \
 	fi
 	@touch '$@'

@@ -93,8 +93,18 @@ void print_version() {
             << "MPI: " << (pd::built_with_mpi() ? "on (PD_MPI; mpirun -np R pdsolve CASE.json)" : "off") << "\n";
 }
 
+// The options are read before MPI starts, so the rank is not known yet; the launcher puts it in the
+// environment (Open MPI: OMPI_COMM_WORLD_RANK; MPICH's and PMIx's launchers: PMI_RANK, PMIX_RANK).
+// True for rank 0, and for a process started without a launcher.
+bool launched_as_rank_zero() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+    if (const char* value = std::getenv(name)) return std::string(value) == "0";
+  return true;
+}
+
+// Under mpiexec every rank finds the same mistake: rank 0 alone says it (not R copies of the usage).
 [[noreturn]] void usage_error(const std::string& what) {
-  std::cerr << "pdsolve: " << what << "\n" << kUsage;
+  if (launched_as_rank_zero()) std::cerr << "pdsolve: " << what << "\n" << kUsage;
   std::exit(pd::kUsageError);
 }
 

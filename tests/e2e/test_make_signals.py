@@ -7,6 +7,7 @@ checkpoint in 5 of 24 trials). Every trial here must end with a checkpoint that 
 whole (its checksum is checked by a restart) and run.log saying why it stopped.
 """
 import os
+import shutil
 import signal
 import struct
 import subprocess
@@ -15,7 +16,7 @@ import time
 import pytest
 
 from e2e_support import SOLVER, new_case_folder  # noqa: E402
-from make_tree import default_sigint, make_tree, start_make, wait_for_steps
+from make_tree import default_sigint, make_command, make_env, make_tree, start_make, wait_for_steps
 
 NAME = "sig"
 
@@ -88,3 +89,42 @@ def test_timeout_running_make_writes_a_checkpoint(tree):
     code, err = finish(process)
     assert code == 124, err   # timeout's own code: the time ran out
     assert_whole_checkpoint(out, "SIGTERM")
+
+
+# A stand-in for the solver under `make case=X RANKS=2`: on SIGTERM it takes 3 s to stop, as a
+# rank in a long quasi-static load step finishes it before it writes its checkpoint, then leaves a
+# mark per rank. (POSIX sh runs the trap once the 0.1 s sleep under way has ended.)
+SLOW_STOP = """#!/bin/sh
+folder=$(dirname "$1")
+trap 'sleep 3; echo stopped > "$folder/stopped.$OMPI_COMM_WORLD_RANK"; exit 143' TERM
+echo started > "$folder/started.$OMPI_COMM_WORLD_RANK"
+while :; do sleep 0.1; done
+"""
+
+
+@pytest.mark.skipif(shutil.which("mpiexec") is None, reason="no mpiexec (openmpi-bin: pipeline/install-deps.sh)")
+def test_under_mpiexec_the_ranks_may_finish_their_step_before_they_stop(tree, tmp_path):
+    """Open MPI's mpiexec does not pass a SIGTERM on: it stops the job itself, SIGCONT, SIGTERM 1 s
+    later, SIGKILL 1 s after that. A 2-rank quasi_static run killed so inside a load step of tens of
+    seconds wrote no checkpoint and lost everything (and a second signal made mpiexec exit and leave
+    the ranks running). The Makefile runs mpiexec through pipeline/run-ranks.sh, which signals the
+    ranks themselves: here each takes 3 s to stop, and both do."""
+    out = fresh(tree)
+    for stale in out.glob("st*ed.*"):
+        stale.unlink()
+    solver = tmp_path / "slow_stop.sh"
+    solver.write_text(SLOW_STOP)
+    solver.chmod(0o755)
+    env = dict(make_env(), OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    process = subprocess.Popen(make_command(tree, NAME, f"out/{NAME}/.solved") + ["RANKS=2", f"SOLVER={solver}"],
+                               env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               stdin=subprocess.DEVNULL, start_new_session=True, preexec_fn=default_sigint)
+    deadline = time.monotonic() + 60
+    while not ((out / "started.0").exists() and (out / "started.1").exists()):
+        assert process.poll() is None and time.monotonic() < deadline, process.communicate()
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGTERM)
+    code, err = finish(process)
+    assert code != 0
+    assert (out / "stopped.0").exists() and (out / "stopped.1").exists(), err
+    assert not (out / ".solved").exists()

@@ -266,3 +266,14 @@ def test_what_is_not_decomposed_is_refused_before_any_output(prepared):
             "(here 2); use preconditioner: block_jacobi (or auto), or run on one rank") in result.stderr, result.stderr
     assert result.stderr.count("pdsolve: error") == 1  # said once, by rank 0
     assert not (folder / "history.csv").exists() and not (folder / "frames").exists()
+
+
+def test_a_usage_error_is_said_once_under_mpiexec(prepared):
+    """The options are read before MPI starts; every rank finds the mistake, rank 0 alone says it
+    (it printed the 40-line usage once per rank)."""
+    folder = copy_case(prepared, "usage")
+    result = subprocess.run([MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--bogus"],
+                            capture_output=True, text=True, timeout=120, env=MPI_ENV)
+    assert result.returncode != 0
+    assert result.stderr.count("unknown option '--bogus'") == 1, result.stderr
+    assert result.stderr.count("usage: pdsolve") == 1, result.stderr

@@ -105,7 +105,7 @@ def test_ranks_puts_the_solver_under_mpiexec():
         return [line for line in result.stdout.splitlines() if "exec " in line and "--restart" not in line]
     assert not any("mpiexec" in line for line in solve_line())
     assert not any("mpiexec" in line for line in solve_line("RANKS=1"))
-    assert any("exec mpiexec --oversubscribe -np 3 -x OMP_NUM_THREADS=" in line and "'build/solver/pdsolve'" in line
+    assert any("exec sh pipeline/run-ranks.sh mpiexec --oversubscribe -np 3 -x OMP_NUM_THREADS=" in line and "'build/solver/pdsolve'" in line
                for line in solve_line("RANKS=3"))
 
 
@@ -131,7 +131,7 @@ def test_ranks_resumes_a_checkpoint_under_mpiexec_too():
     the solve recipe runs under the same mpiexec as a fresh solve."""
     result = make("-n", "-B", "case=membrane", "RANKS=3", "out/membrane/.solved")
     resume = [line for line in result.stdout.splitlines() if line.strip().startswith("exec ") and "--restart" in line]
-    assert resume and all("exec mpiexec --oversubscribe -np 3 " in line and "'build/solver/pdsolve'" in line
+    assert resume and all("exec sh pipeline/run-ranks.sh mpiexec --oversubscribe -np 3 " in line and "'build/solver/pdsolve'" in line
                           for line in resume), resume
     serial = make("-n", "-B", "case=membrane", "out/membrane/.solved")
     assert not any("mpiexec" in line for line in serial.stdout.splitlines() if "--restart" in line)
