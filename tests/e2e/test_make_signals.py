@@ -128,3 +128,22 @@ def test_under_mpiexec_the_ranks_may_finish_their_step_before_they_stop(tree, tm
     assert code != 0
     assert (out / "stopped.0").exists() and (out / "stopped.1").exists(), err
     assert not (out / ".solved").exists()
+
+
+@pytest.mark.skipif(shutil.which("mpiexec") is None, reason="no mpiexec (openmpi-bin: pipeline/install-deps.sh)")
+def test_ctrl_c_to_a_two_rank_make_writes_a_checkpoint(tree):
+    """The real solver on 2 ranks, SIGINT to make's process group as a terminal's Ctrl-C sends it:
+    the ranks get it from pipeline/run-ranks.sh as it came, stop after the same step and rank 0
+    writes a whole checkpoint (which the serial solver then accepts)."""
+    out = fresh(tree)
+    env = dict(make_env(), OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    process = subprocess.Popen(make_command(tree, NAME, f"out/{NAME}/.solved") + ["RANKS=2"],
+                               env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               stdin=subprocess.DEVNULL, start_new_session=True, preexec_fn=default_sigint)
+    wait_for_steps(out, process)
+    os.killpg(process.pid, signal.SIGINT)
+    code, err = finish(process)
+    assert code != 0
+    assert "2 MPI ranks" in (out / "run.log").read_text()
+    assert_whole_checkpoint(out, "SIGINT")
+    assert not (out / ".solved").exists()
