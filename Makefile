@@ -14,6 +14,7 @@
 #   make bench                speed of the bond kernel on 3D bricks, and of LAMMPS PERI on one → out/bench/ (docs/performance.md)
 #   make bench-accuracy       error against run time: Verlet, adaptive, quasi_static, mixed → out/bench/accuracy.csv (docs/accuracy.md)
 #   make bench-implicit       implicit dynamics vs Verlet on a drum lattice and the membrane → out/bench/implicit.csv
+#   make help                 this list
 # Only stale stages rerun: an edit to the .yaml reruns preprocessing and what follows,
 # a change of the gmsh parameters in the .yaml also re-meshes.
 
@@ -91,7 +92,7 @@ SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'C
 # each other's frames in progress and read half-written history rows. A goal that writes out/<case>/
 # re-runs make under flock(1) (util-linux) on $(OUT)/.lock, held until that make ends; a second
 # make fails at once saying who holds it, or waits LOCK_WAIT seconds for it (LOCK_WAIT=600).
-UNLOCKED_GOALS := test test-asan fuzz solver deps check clean bench bench-accuracy bench-implicit validate
+UNLOCKED_GOALS := help test test-asan fuzz solver deps check clean bench bench-accuracy bench-implicit validate
 LOCKED_GOALS   := $(filter-out $(UNLOCKED_GOALS),$(or $(MAKECMDGOALS),all))
 LOCK_WAIT      ?= 0
 DRY_RUN        := $(findstring n,$(firstword -$(MAKEFLAGS)))# make -n writes nothing: no lock
@@ -108,8 +109,12 @@ pd-case-lock:
 	    sh '$(OUT)/.lock' $(MAKE) --no-print-directory $(MAKECMDGOALS)
 else
 
-.PHONY: all run figures test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
+.PHONY: all run figures help test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
 .DELETE_ON_ERROR:
+
+# The list at the top of this file.
+help:
+	@sed -n '/^#   make /,/^# Only stale/{/^# Only stale/d;s/^# //;p}' '$(firstword $(MAKEFILE_LIST))'
 
 all: run
 run: $(OUT)/figures/.done

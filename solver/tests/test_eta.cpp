@@ -111,3 +111,13 @@ TEST(ProgressLine, SaysStepTimePercentRateAndTimeLeft) {
   EXPECT_EQ(pd::duration_text(3900.0), "1h05m");
   EXPECT_EQ(pd::duration_text(-1.0), "?");
 }
+
+// An integrator that sets its own step (adaptive, quasi_static, implicit, mixed) does not know its
+// step count ahead: the line shows the count alone (a mixed run showed "step 38/8", its count
+// against end / dt_initial).
+TEST(ProgressLine, WithoutAnExpectedCountShowsTheStepAlone) {
+  pd::ProgressSettings settings;
+  settings.interval = 0.0;
+  pd::Progress progress(settings, 1e-3, 1000000, 0, nullptr);
+  EXPECT_EQ(progress.line(5e-4, 38), "progress: step 38, t = 0.0005/0.001 s, 50.0 %, ? steps/s, ETA ?");
+}

@@ -135,3 +135,15 @@ def test_ranks_resumes_a_checkpoint_under_mpiexec_too():
                           for line in resume), resume
     serial = make("-n", "-B", "case=membrane", "out/membrane/.solved")
     assert not any("mpiexec" in line for line in serial.stdout.splitlines() if "--restart" in line)
+
+
+def test_make_help_lists_the_commands():
+    """`make help` prints the list at the top of the Makefile (it was "No rule to make target
+    'help'", then the case lock's error)."""
+    result = make("help")
+    assert result.returncode == 0, result.stderr
+    lines = [line.strip() for line in result.stdout.splitlines()]
+    assert lines[0].startswith("make case=membrane ")
+    assert any(line.startswith("make case=X RANKS=R ") for line in lines)
+    assert any(line.startswith("make test ") for line in lines)
+    assert not any(line.startswith("#") for line in lines) and result.stderr == ""

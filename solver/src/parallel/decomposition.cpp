@@ -60,7 +60,7 @@ Decomposition decompose(const Vec3Array& x, const std::vector<std::int64_t>& off
   if (ranks > n)
     throw Error("decomposition: " + std::to_string(ranks) + " MPI ranks for " + std::to_string(n) +
                 " nodes: every rank needs nodes of its own; run with at most " + std::to_string(n) +
-                " ranks (mpirun -np)");
+                " ranks (RANKS=R with make, mpiexec -np R by hand)");
   Decomposition d;
   d.ranks = ranks;
   const std::vector<std::uint64_t> keys = morton_keys(x);
@@ -94,7 +94,7 @@ Decomposition decompose(const Vec3Array& x, const std::vector<std::int64_t>& off
     if (d.piece_start[static_cast<std::size_t>(r)] == d.piece_start[static_cast<std::size_t>(r) + 1])
       throw Error("decomposition: rank " + std::to_string(r) + " of " + std::to_string(ranks) +
                   " gets no node (one node holds more than 1/" + std::to_string(ranks) +
-                  " of the bonds); run with fewer ranks (mpirun -np)");
+                  " of the bonds); run with fewer ranks (RANKS=R with make, mpiexec -np R by hand)");
   if (ranks > 1) {
     for (int r = 0; r < ranks; ++r) {
       double lo[3], hi[3];
@@ -110,7 +110,7 @@ Decomposition decompose(const Vec3Array& x, const std::vector<std::int64_t>& off
         throw Error("decomposition: rank " + std::to_string(r) + "'s piece is " + std::to_string(side) +
                     " m across, less than the horizon " + std::to_string(horizon) + " m (" + std::to_string(n) +
                     " nodes on " + std::to_string(ranks) + " ranks): its ghosts would outnumber its nodes; "
-                    "run with fewer ranks (mpirun -np)");
+                    "run with fewer ranks (RANKS=R with make, mpiexec -np R by hand)");
     }
   }
   return d;

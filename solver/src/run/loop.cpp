@@ -68,7 +68,8 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   progress_settings.terminal = out && isatty(fileno(stderr)) != 0;
   progress_settings.to_stderr = !opt.quiet;
   progress_settings.interval = out ? opt.progress_interval : 0.0;
-  Progress progress(progress_settings, p.c.time.end, p.max_steps, p.steps_expected, out ? &log : nullptr);
+  Progress progress(progress_settings, p.c.time.end, p.max_steps, integrator.controls_step() ? 0 : p.steps_expected,
+                    out ? &log : nullptr);
   LoopEnd end;
 
   // What output reads: the run's state, or on a decomposed run every rank's owned part gathered on

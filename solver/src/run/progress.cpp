@@ -37,9 +37,10 @@ double Progress::fraction(double t, std::int64_t step) const {
 
 std::string Progress::line(double t, std::int64_t step) const {
   const double rate = eta_.step_rate();
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, "progress: step %lld/%lld, t = %.4g/%.4g s, %.1f %%, %s steps/s, ETA %s",
-                static_cast<long long>(step), static_cast<long long>(steps_expected_), t, end_,
+  char buffer[256], of[32] = "";
+  if (steps_expected_ > 0) std::snprintf(of, sizeof of, "/%lld", static_cast<long long>(steps_expected_));
+  std::snprintf(buffer, sizeof buffer, "progress: step %lld%s, t = %.4g/%.4g s, %.1f %%, %s steps/s, ETA %s",
+                static_cast<long long>(step), of, t, end_,
                 100.0 * fraction(t, step), rate >= 0.0 ? std::to_string(std::lround(rate)).c_str() : "?",
                 duration_text(eta_.seconds_left()).c_str());
   return buffer;

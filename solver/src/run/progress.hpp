@@ -24,7 +24,9 @@ struct ProgressSettings {
 
 class Progress {
  public:
-  // end: time.end [s]; max_steps: the step cap; steps_expected: the steps the run is expected to take.
+  // end: time.end [s]; max_steps: the step cap; steps_expected: the steps the run is expected to take,
+  // 0 when its integrator sets its own step size (then the count is not known ahead: "step 38", not
+  // a count from the initial step that a mixed run passed five times over, "step 38/8").
   Progress(const ProgressSettings& settings, double end, std::int64_t max_steps, std::int64_t steps_expected,
            RunLog* log);
   // After each step: t and step of the run, wall seconds since the loop started.
