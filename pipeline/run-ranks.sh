@@ -8,28 +8,46 @@
 # timeout only delays the SIGTERM as much. A second signal to mpirun (make passes one on) makes it
 # exit at once and leave the ranks running.
 #
-# So mpiexec runs in a session of its own (the terminal's Ctrl-C and a SIGTERM to make's process
-# group do not reach it), and a SIGINT or SIGTERM that reaches this script is sent to the ranks,
-# its children, as it came: each finishes the step under way, they write checkpoint.bin and stop
-# (pipeline/formats.md §5), and mpiexec ends with them. Exit status: mpiexec's. (In a script without
-# job control the background mpiexec reads /dev/null, so it takes no keystrokes from the terminal.)
+# So mpiexec runs in a session of its own (the terminal's Ctrl-C and a signal to make's process
+# group do not reach it), and a SIGINT, SIGTERM, SIGQUIT or SIGHUP that reaches this script is sent
+# to the ranks, mpiexec's children on this machine: they finish the step under way, write
+# checkpoint.bin and stop (pipeline/formats.md §5), and mpiexec ends with them. One rank is enough:
+# the ranks agree after every step on whether any was signalled. Exit status: mpiexec's. A SIGKILL
+# cannot be passed on: the line printed at the start says how to kill the session.
 set -u
 launcher=
-# pkill -P: the processes whose parent is mpiexec, the ranks it started on this machine. A signal
-# before mpiexec has started stops the script there.
+pending=
+signalled=
+# The signal, to the ranks; before mpiexec exists, kept for when it does. Ranks still being started
+# are waited for (pkill -P finds none yet), as long as mpiexec runs.
 forward() {
-  [ -n "$launcher" ] || exit "$2"
-  pkill -"$1" -P "$launcher"
+  signalled=1
+  if [ -z "$launcher" ]; then
+    pending=$1
+    return
+  fi
+  while kill -0 "$launcher" 2>/dev/null; do
+    pkill -"$1" -P "$launcher" && return
+    sleep 0.1
+  done
 }
-trap 'forward INT 130' INT
-trap 'forward TERM 143' TERM
-# The terminal closed: mpiexec, in its own session, would not hear of it; stop as for a SIGTERM.
-trap 'forward TERM 129' HUP
-setsid "$@" &
+trap 'forward INT' INT
+trap 'forward TERM' TERM
+trap 'forward TERM' QUIT
+trap 'forward TERM' HUP  # the terminal closed: mpiexec, in its own session, would not hear of it
+case $pending in INT) exit 130 ;; TERM) exit 143 ;; esac  # stopped before mpiexec started
+# A background job of a shell without job control starts with SIGINT and SIGQUIT ignored, and the
+# solver keeps an ignored SIGINT (run/signals.cpp): env gives them back their default action. Its
+# stdin is /dev/null (POSIX), so it takes no keystrokes from the terminal.
+setsid env --default-signal=INT,QUIT "$@" &
 launcher=$!
+echo "run-ranks.sh: mpiexec is process $launcher, in a session of its own: Ctrl-C or SIGTERM here stops the ranks" \
+  "after their step (with a checkpoint); to kill them at once: pkill -KILL -s $launcher" >&2
+[ -z "$pending" ] || forward "$pending"
 # wait returns early when a trapped signal arrives: wait again until mpiexec has ended.
 while :; do
+  signalled=
   wait "$launcher"
   status=$?
-  kill -0 "$launcher" 2>/dev/null || exit "$status"
+  [ -n "$signalled" ] || exit "$status"
 done

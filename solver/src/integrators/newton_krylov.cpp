@@ -25,13 +25,19 @@ LinearSolverChoice choose_linear_solver(const ForceOperator& op, const Case& c, 
     return {false, "as the case file asks"};
   }
   if (choice == "cg") return {true, "as the case file asks"};
-  if (decomposed)
-    // Said in run.log, since a user adds ranks to go faster: CG's iterations cost more than the
-    // factorisation's solves on a problem one process holds (traction's quasi_static to 0.3 ms:
-    // 1.2 s on one rank with CHOLMOD, 19 s on two with CG; README "Several processes").
+  if (decomposed) {
+    // Said in run.log when one rank's auto would factorise, since a user adds ranks to go faster:
+    // CG's iterations then cost more than the factorisation's solves on a problem one process holds
+    // (traction's quasi_static to 0.3 ms: 1.2 s on one rank with CHOLMOD, 19 s on two with CG;
+    // README "Several processes").
+    const bool one_rank_factorises = missing.empty() && !(dimension == 3 && free >= kCgFromDofs3d);
     return {true, "auto: decomposed over " + std::to_string(decomposed->ranks()) +
-                      " MPI ranks (a factorisation stays on one process; a problem that fits one process is "
-                      "usually solved faster by one rank with it)"};
+                      " MPI ranks (a factorisation stays on one process" +
+                      (one_rank_factorises ? "; a problem that fits one process is usually solved faster by one rank "
+                                             "with it"
+                                           : "") +
+                      ")"};
+  }
   if (!missing.empty())
     return {true, missing == "contact" ? "auto: a term (contact) has no assembled tangent"
                                        : "auto: the material " + op.model().bond_model->name() + " has no assembled tangent"};

@@ -341,9 +341,8 @@ void log_setup(RunLog& log, const Prepared& p) {
     }
   for (const auto& text : p.integrator->describe(p.dt_exact_configured)) log.line(text);
   log.line("end time " + format("%.6g", c.time.end) + " s, steps expected " + std::to_string(p.steps_expected) +
-           (p.steps_for_end > p.max_steps ? " (capped by max_steps)" : "") +
-           (p.integrator->controls_step() ? " at the initial step (the integrator sets its own)" : "") + ", threads " +
-           std::to_string(p.threads));
+           (p.integrator->controls_step() ? " at the initial step (the integrator sets its own)" : "") +
+           (p.steps_for_end > p.max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(p.threads));
 }
 
 }  // namespace pd
