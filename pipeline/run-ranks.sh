@@ -19,15 +19,21 @@ launcher=
 pending=
 signalled=
 # The signal, to the ranks; before mpiexec exists, kept for when it does. Ranks still being started
-# are waited for (pkill -P finds none yet), as long as mpiexec runs.
+# are waited for (pkill -P finds none yet) while mpiexec runs, for up to 10 s: once the ranks have
+# ended mpiexec may linger, and then end as a zombie (not reaped while this runs), state Z.
+running() {
+  kill -0 "$launcher" 2>/dev/null && [ "$(cut -d ' ' -f 3 "/proc/$launcher/stat" 2>/dev/null)" != Z ]
+}
 forward() {
   signalled=1
   if [ -z "$launcher" ]; then
     pending=$1
     return
   fi
-  while kill -0 "$launcher" 2>/dev/null; do
+  tries=0
+  while [ $tries -lt 100 ] && running; do
     pkill -"$1" -P "$launcher" && return
+    tries=$((tries + 1))
     sleep 0.1
   done
 }
