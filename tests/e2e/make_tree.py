@@ -61,9 +61,10 @@ def default_sigint():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
-def start_make(tree, name, *targets, prefix=()):
-    """make in a session (and process group) of its own, as a CI job or a batch script runs it."""
-    return subprocess.Popen([*prefix, *make_command(tree, name, *targets)], env=make_env(),
+def start_make(tree, name, *targets, prefix=(), env=None):
+    """make in a session (and process group) of its own, as a CI job or a batch script runs it;
+    env: variables added to make_env()'s."""
+    return subprocess.Popen([*prefix, *make_command(tree, name, *targets)], env=dict(make_env(), **(env or {})),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             stdin=subprocess.DEVNULL, start_new_session=True, preexec_fn=default_sigint)
 

@@ -16,7 +16,7 @@ import time
 import pytest
 
 from e2e_support import SOLVER, new_case_folder  # noqa: E402
-from make_tree import default_sigint, make_command, make_env, make_tree, start_make, wait_for_steps
+from make_tree import default_sigint, make_tree, start_make, wait_for_steps
 
 NAME = "sig"
 
@@ -109,9 +109,7 @@ needs_mpiexec = pytest.mark.skipif(shutil.which("mpiexec") is None,
 
 
 def start_ranked_make(tree, *extra):
-    return subprocess.Popen(make_command(tree, NAME, f"out/{NAME}/.solved") + ["RANKS=2", *extra],
-                            env=dict(make_env(), **MPI_ENV), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, stdin=subprocess.DEVNULL, start_new_session=True, preexec_fn=default_sigint)
+    return start_make(tree, NAME, f"out/{NAME}/.solved", "RANKS=2", *extra, env=MPI_ENV)
 
 
 @pytest.fixture
