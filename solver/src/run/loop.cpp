@@ -323,9 +323,9 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   end.steps = loop.step - first_step;
   // What the ranks exchanged, per step of this run (issue 15's measures; bench/mpi_ranks.py reads them).
   if (dec)
-    for (const std::string& text : dec->traffic_report(loop.step - first_step)) log.line(text);
+    for (const std::string& text : dec->traffic_report(end.steps)) log.line(text);
   if (dec && model.contact.pairs)
-    for (const std::string& text : dec->contact_traffic_report(loop.step - first_step)) log.line(text);
+    for (const std::string& text : dec->contact_traffic_report(end.steps)) log.line(text);
   return end;
 }
 
