@@ -15,9 +15,11 @@
 // --law lps: the LPS law (ν = 0.25; each rank cuts its piece from the whole model, as pdsolve does
 // for LPS, whose m_i need whole rows); --alpha A: LAMMPS's breaking order and α rule (per-node s0,
 // whose ghosts travel with u); --blocking: every owned row a boundary row, so that every sweep
-// waits for its exchange first (the exchange without the overlap, in the same binary: a before/after).
+// waits for its exchange first (the exchange without the overlap, in the same binary: a before/after);
+// --kernel portable: PMB rows by the portable code even where the CPU has AVX2 (the same bits).
 //
 //   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T] [--law pmb|lps] [--alpha A] [--blocking]
+//   [--kernel auto|portable]
 #include <mpi.h>
 #include <omp.h>
 #include <sys/resource.h>
@@ -34,6 +36,7 @@
 #include "core/stability.hpp"
 #include "integrators/integrator.hpp"
 #include "lattice.hpp"
+#include "materials/pmb/pmb.hpp"
 #include "operator/force_operator.hpp"
 #include "parallel/local_model.hpp"
 #include "parallel/mpi_decomposed.hpp"
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
     else if (a == "--threads") threads = std::atoi(argv[k + 1]);
     else if (a == "--law") law = argv[k + 1];
     else if (a == "--alpha") alpha = std::atof(argv[k + 1]);
+    else if (a == "--kernel") pd::set_pmb_avx2_rows(std::string(argv[k + 1]) != "portable");
     ++k;
   }
   if (threads > 0) omp_set_num_threads(threads);

@@ -3,7 +3,7 @@
 // free faces, the top layers given an initial velocity, advanced by the velocity-Verlet integrator
 // pdsolve uses (bond breaking on). Prints one CSV row (header with --header).
 //
-//   pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps]
+//   pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] [--kernel auto|portable]
 //
 // --nodes FILE reads the brick from a node file instead of writing the x-fastest lattice (the
 // brick must be the side³ lattice of spacing 1 mm at the origin, in any node order): speed.py uses
@@ -12,6 +12,9 @@
 //
 // --model lps: the same brick in the linear peridynamic solid (ν = 0.25, ω = 1: PMB's elastic constants),
 // for LPS's rate per directed bond beside PMB's (materials/lps).
+//
+// --kernel portable: PMB rows by the portable code even where the CPU has AVX2 (the same bits;
+// docs/performance.md §7 measures what the AVX2 rows gain with it, side by side).
 //
 // set-up = reading the node file (written to D first, not timed) + build_model (bonds, material);
 // loop = S integrator steps, timed; directed bond updates/s = directed bonds × S / loop time, each
@@ -50,7 +53,7 @@ const char* const kHeader =
     "broken_bonds,model";
 
 int usage() {
-  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] | --header\n");
+  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] [--kernel auto|portable] | --header\n");
   return 2;
 }
 
@@ -60,6 +63,7 @@ int main(int argc, char** argv) {
   int side = 0, steps = 20, threads = 0;
   std::filesystem::path dir = "out/bench/tmp", nodes;
   std::string material = "pmb";
+  std::string kernel = "auto";
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--header") {
@@ -73,9 +77,11 @@ int main(int argc, char** argv) {
     else if (a == "--dir") dir = argv[++k];
     else if (a == "--nodes") nodes = argv[++k];
     else if (a == "--model") material = argv[++k];
+    else if (a == "--kernel") kernel = argv[++k];
     else return usage();
   }
-  if (side < 4 || steps < 1) return usage();
+  if (side < 4 || steps < 1 || (kernel != "auto" && kernel != "portable")) return usage();
+  pd::set_pmb_avx2_rows(kernel == "auto");
   if (threads > 0) omp_set_num_threads(threads);
   threads = omp_get_max_threads();
 

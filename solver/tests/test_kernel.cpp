@@ -143,6 +143,73 @@ TEST(Kernel, UniformVolumePathIsBitwiseTheGeneralPath) {
   EXPECT_GT(broke, 0) << "nothing broke: the rounds would not test the flags";
 }
 
+// The AVX2 rows (materials/pmb/pmb_row_avx2.hpp) give the portable rows' bits in every variant
+// the kernel has: one block of equal full volumes (the uniform path), partial volumes (ν from |ξ|),
+// two blocks with a no-fail set, unequal volumes, a surface correction, LAMMPS's order (force
+// first) and its per-node s0; rows whose lengths are not multiples of 4; a bond crushed to a
+// point; over rounds that break bonds. Forces, W, flags, counts and lost energy are compared.
+TEST(Kernel, Avx2RowIsBitwiseThePortableRow) {
+  if (!pd::pmb_avx2_rows()) GTEST_SKIP() << "this CPU has no AVX2: every row is the portable code";
+  struct Variant {
+    const char* name;
+    bool two_blocks;
+    const char* partial_volume;
+    bool unequal_volumes, corrected, lammps_rules;
+  };
+  const Variant variants[] = {
+      {"uniform", false, "none", false, false, false},         {"partial volumes", false, "lammps", false, false, false},
+      {"two blocks", true, "none", false, false, false},       {"unequal volumes", false, "none", true, false, false},
+      {"surface correction", true, "hhb", false, true, false}, {"lammps rules", true, "lammps", true, true, true},
+  };
+  std::int64_t rows_not_multiple_of_4 = 0;
+  for (const Variant& v : variants) {
+    pd::Model models[2] = {brick(v.two_blocks, v.partial_volume), brick(v.two_blocks, v.partial_volume)};
+    for (pd::Model& m : models) {
+      if (v.unequal_volumes)
+        for (std::size_t i = 0; i < m.nodes.size(); ++i) m.nodes.volume[i] *= 1.0 + 0.01 * static_cast<double>(i % 7);
+      if (v.corrected) {
+        m.bonds.surface_factor.resize(m.bonds.directed());
+        for (std::size_t k = 0; k < m.bonds.directed(); ++k) m.bonds.surface_factor[k] = 1.0 + 1e-3 * static_cast<double>(k % 13);
+      }
+      if (v.lammps_rules) {
+        m.break_after_force = true;
+        m.node_critical_stretch.assign(m.nodes.size(), m.material.critical_pair[0]);
+      }
+    }
+    const std::size_t n = models[0].nodes.size();
+    for (std::size_t i = 0; i < n; ++i) rows_not_multiple_of_4 += (models[0].bonds.offsets[i + 1] - models[0].bonds.offsets[i]) % 4 != 0;
+    EXPECT_EQ(pd::pmb_arrays(models[0], pd::make_vec3(n)).uniform, std::string(v.name) == "uniform") << v.name;
+    std::int64_t broke = 0;
+    for (unsigned round = 0; round < 3; ++round) {
+      pd::Vec3Array u = shaken(models[0], 21 + round, (0.005 + 0.01 * round) * kDx);
+      if (round == 1) {  // node 100's first neighbour moved onto it: y = 0, 1/y replaced by 1
+        const auto j = static_cast<std::size_t>(models[0].bonds.neighbour[static_cast<std::size_t>(models[0].bonds.offsets[100])]);
+        for (std::size_t d = 0; d < 3; ++d) u[d][j] = models[0].nodes.x[d][100] + u[d][100] - models[0].nodes.x[d][j];
+      }
+      pd::Vec3Array f[2] = {pd::make_vec3(n), pd::make_vec3(n)};
+      std::vector<double> w[2] = {std::vector<double>(n), std::vector<double>(n)};
+      double lost[2] = {0.0, 0.0};
+      std::int64_t count[2] = {0, 0};
+      for (int r = 0; r < 2; ++r) {
+        pd::set_pmb_avx2_rows(r == 0);
+        ASSERT_EQ(pd::pmb_arrays(models[r], u).avx2, r == 0);
+        count[r] = v.lammps_rules ? pd::break_bonds_lammps_rules(models[r], u, &f[r], w[r].data(), &lost[r], nullptr, nullptr)
+                                  : pd::break_bonds_and_add_pmb_force(models[r], u, f[r], w[r].data(), &lost[r]);
+      }
+      pd::set_pmb_avx2_rows(true);
+      broke += count[0];
+      EXPECT_EQ(count[0], count[1]) << v.name;
+      EXPECT_EQ(std::memcmp(&lost[0], &lost[1], sizeof(double)), 0) << v.name;
+      EXPECT_EQ(models[0].bonds.broken, models[1].bonds.broken) << v.name;
+      EXPECT_EQ(models[0].node_critical_stretch, models[1].node_critical_stretch) << v.name;
+      for (std::size_t d = 0; d < 3; ++d) EXPECT_TRUE(same_bits(f[0][d], f[1][d])) << v.name << " component " << d;
+      EXPECT_TRUE(same_bits(w[0], w[1])) << v.name;
+    }
+    EXPECT_GT(broke, 0) << v.name << ": nothing broke, the rounds would not test the flags";
+  }
+  EXPECT_GT(rows_not_multiple_of_4, 0) << "every row a multiple of 4 bonds: the portable tail went untested";
+}
+
 TEST(Kernel, MatchesTheTextbookFormulaBondByBond) {
   // f_i = Σ c s ν V_j (y_j − y_i)/|y_j − y_i|, s = (|y_j − y_i| − |ξ|)/|ξ| (thesis eqs. 1.9–1.10,
   // 2.1), W_i = Σ ¼ c s² |ξ| ν V_j, written the plain way with the partial-volume rule's own factor,

@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "core/exact_sum.hpp"
+#include "materials/pmb/pmb_row.hpp"
+#include "materials/pmb/pmb_row_avx2.hpp"
 
 namespace pd {
 
@@ -29,40 +31,23 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
   // 122 bonds per node in the kernel.
   a.uniform = a.blocks == 1 && !a.factor && a.volume_weight.outer == HUGE_VAL && a.nodes > 0;
   for (std::int64_t i = 1; a.uniform && i < a.nodes; ++i) a.uniform = a.volume[i] == a.volume[0];
+  a.avx2 = pmb_avx2_rows();
   return a;
 }
 
 namespace {
+#ifdef PD_HAVE_AVX2_ROW
+const bool kCpuHasAvx2 = __builtin_cpu_supports("avx2");
+#else
+const bool kCpuHasAvx2 = false;
+#endif
+bool avx2_rows_enabled = true;
+}  // namespace
 
-// What every pass needs of bond i→j: the reference length |ξ| (recomputed exactly as
-// build_bonds computed it), the current bond vector e = y_j − y_i, its length y, and the stretch
-// s = (y − |ξ|)/|ξ| (thesis eq. 1.9), zeroed near machine precision (thesis §2.2). Every pass
-// computes it this one way, so both copies of a bond (y_j − y_i is the exact negative of y_i − y_j)
-// and the force and breaking passes see bitwise the same stretch.
-struct BondTerms {
-  double e0, e1, e2, y, length, s, inv_y;  // inv_y = 1/y (1 for a bond crushed to a point, y = 0)
-};
+void set_pmb_avx2_rows(bool enabled) { avx2_rows_enabled = enabled; }
+bool pmb_avx2_rows() { return avx2_rows_enabled && kCpuHasAvx2; }
 
-inline BondTerms bond_terms(const PmbArrays& a, const double xi[3], const double yi[3], std::int64_t j) {
-  BondTerms b;
-  const double d0 = a.x[0][j] - xi[0], d1 = a.x[1][j] - xi[1], d2 = a.x[2][j] - xi[2];
-  b.length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);  // core/bonds.hpp bond_length
-  b.e0 = (a.x[0][j] + a.u[0][j]) - yi[0];
-  b.e1 = (a.x[1][j] + a.u[1][j]) - yi[1];
-  b.e2 = (a.x[2][j] + a.u[2][j]) - yi[2];
-  b.y = std::sqrt(b.e0 * b.e0 + b.e1 * b.e1 + b.e2 * b.e2);
-  const double s = (b.y - b.length) / b.length;
-  b.s = std::fabs(s) > kStretchZero ? s : 0.0;
-  // A bond crushed to a point (y = 0) has e = 0 and no direction: 1/y is replaced by 1, so its
-  // force is 0, without a branch around the division.
-  b.inv_y = 1.0 / (b.y > 0.0 ? b.y : 1.0);
-  return b;
-}
-
-// A candidate for breaking: an intact bond stretched beyond s0 of its block pair. Bitwise &, so
-// that the force loop stays free of branches; no-fail ends are left to break_row (a byte gather
-// would keep the force loop from vectorising).
-inline bool over_critical(bool intact, double s, double s0) { return intact & (s > s0); }
+namespace {
 
 // The breaking criterion, in one place (every pass that breaks or asks whether a bond would break
 // calls these two): bond i→j is compared with s0 of its block pair, or by LAMMPS's α rule with
@@ -115,86 +100,14 @@ std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i
   return set;
 }
 
-// Bonds per chunk of a row: the chunk's terms are computed by a loop the compiler vectorises
-// (no reduction in it), then summed in bond order by a short scalar loop.
-constexpr int kChunk = 64;
-
-// One binary for every x86-64 machine, each running the widest code it can: GCC compiles the row
-// three times, for baseline x86-64 (SSE2), x86-64-v2 (SSE4.2: 64-bit lane extracts, so the loop
-// vectorises) and x86-64-v3 (AVX2, 4 lanes), and picks one at load time. All do the same IEEE
-// operations in the same order (no FMA contraction, no reassociation), so results are bitwise the
-// same on any CPU — unlike -march=native, whose binary may not run on the CI machine and whose FMAs
-// would change the last bits (docs/performance.md).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PD_KERNEL_CLONES __attribute__((target_clones("default", "arch=x86-64-v2", "arch=x86-64-v3")))
-#else
-#define PD_KERNEL_CLONES
-#endif
-
-struct RowSums {
-  double f0, f1, f2, w;    // Σ over the row of the force density components and of W_i's terms
-  std::int64_t over = 0;   // bonds over their critical stretch (kBreaking only)
-};
-
-// Row i of the kernel from the current flags; kBreaking also counts the bonds over their critical
-// stretch, kOneBlock skips the gathers of the far end's block, kCorrected multiplies each bond's c
-// by its surface-correction factor g_k (core/surface_correction), kUniform (PmbArrays::uniform: one
-// block, no correction, full volumes, one V for every node) skips the gather of V_j and ν = 1:
-// c ν V_j = ((intact·c)·V)·1 is intact·(c·V) bit for bit, intact being 0 or 1. Compile-time
-// switches, so that the loop has no branch in it and vectorises in every variant (and without a
-// correction it is the same code, bitwise, as before there was one).
+// Row i with the given switches: the AVX2 code where pmb_arrays chose it, else the portable code;
+// the same bits either way.
 template <bool kBreaking, bool kOneBlock, bool kCorrected = false, bool kUniform = false>
-PD_KERNEL_CLONES RowSums pmb_row(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
-  const double* c_row = a.c_pair + a.block[i] * a.blocks;
-  const double c_v = kUniform ? c_row[0] * a.volume[0] : 0.0;  // c·V of every bond (kUniform)
-  const double* s0_row = kBreaking ? s0_pair + a.block[i] * a.blocks : nullptr;
-  const double xi[3] = {a.x[0][i], a.x[1][i], a.x[2][i]};
-  const double yi[3] = {xi[0] + a.u[0][i], xi[1] + a.u[1][i], xi[2] + a.u[2][i]};
-  double sum0 = 0.0, sum1 = 0.0, sum2 = 0.0, energy = 0.0;
-  std::int64_t over = 0;
-  const std::int64_t end = a.offsets[i + 1];
-  for (std::int64_t k0 = a.offsets[i]; k0 < end; k0 += kChunk) {
-    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - k0));
-    // The chunk's bytes and 32-bit indices, widened first: GCC sizes the vector loop by its
-    // narrowest type, so one byte load in it would make it 32 bonds wide under AVX2 and spill
-    // most of its registers; with only 64-bit types it is 4 bonds wide (docs/performance.md §2).
-    std::int64_t j_q[kChunk], block_q[kChunk];
-    double intact_q[kChunk], g_q[kChunk];
-    for (int q = 0; q < m; ++q) {
-      j_q[q] = a.neighbour[k0 + q];
-      intact_q[q] = a.broken[k0 + q] == 0 ? 1.0 : 0.0;
-      if constexpr (!kOneBlock) block_q[q] = a.block[j_q[q]];
-      if constexpr (kCorrected) g_q[q] = a.factor[k0 + q];
-    }
-    // A bond's four terms side by side, so that the in-order sum below adds them as one vector
-    // per bond; rows of 8 rather than 4, so that GCC stores them lane by lane instead of
-    // transposing four vectors with shuffles (the port the gathers above already keep busy).
-    alignas(64) double t[kChunk][8];
-    for (int q = 0; q < m; ++q) {
-      const std::int64_t j = j_q[q];
-      const BondTerms b = bond_terms(a, xi, yi, j);
-      const std::int64_t bj = kOneBlock ? 0 : block_q[q];
-      const double intact = intact_q[q];
-      if constexpr (kBreaking) over += over_critical(intact > 0.0, b.s, s0_row[bj]);
-      // Broken bonds are multiplied by 0 rather than skipped: no branch, so the loop vectorises.
-      double c_vj;
-      if constexpr (kUniform) c_vj = intact * c_v;
-      else c_vj = intact * c_row[bj] * a.volume[j] * a.volume_weight(b.length);
-      if constexpr (kCorrected) c_vj *= g_q[q];
-      const double scale = c_vj * b.s * b.inv_y;  // c s ν V_j / y
-      t[q][0] = scale * b.e0;
-      t[q][1] = scale * b.e1;
-      t[q][2] = scale * b.e2;
-      t[q][3] = 0.25 * c_vj * b.s * b.s * b.length;
-    }
-    for (int q = 0; q < m; ++q) {  // in bond order: the same sums for any thread count
-      sum0 += t[q][0];
-      sum1 += t[q][1];
-      sum2 += t[q][2];
-      energy += t[q][3];
-    }
-  }
-  return RowSums{sum0, sum1, sum2, energy, over};
+RowSums pmb_row(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
+#ifdef PD_HAVE_AVX2_ROW
+  if (a.avx2) return pmb_row_avx2<kBreaking, kOneBlock, kCorrected, kUniform>(a, i, s0_pair);
+#endif
+  return pmb_row_part<kBreaking, kOneBlock, kCorrected, kUniform>(a, i, s0_pair, a.offsets[i], RowSums{});
 }
 
 // pmb_row with the switches of this row and model.
