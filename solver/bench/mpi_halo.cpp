@@ -61,7 +61,15 @@ int main(int argc, char** argv) {
     else if (a == "--threads") threads = std::atoi(argv[k + 1]);
     else if (a == "--law") law = argv[k + 1];
     else if (a == "--alpha") alpha = std::atof(argv[k + 1]);
-    else if (a == "--kernel") pd::set_pmb_avx2_rows(std::string(argv[k + 1]) != "portable");
+    else if (a == "--kernel") {
+      const std::string kernel = argv[k + 1];
+      if (kernel != "auto" && kernel != "portable") {
+        std::fprintf(stderr, "pd_mpi_halo: --kernel takes auto or portable, not %s\n", kernel.c_str());
+        MPI_Finalize();
+        return 2;
+      }
+      pd::set_pmb_avx2_rows(kernel == "auto");
+    }
     ++k;
   }
   if (threads > 0) omp_set_num_threads(threads);

@@ -144,12 +144,16 @@ TEST(Kernel, UniformVolumePathIsBitwiseTheGeneralPath) {
 }
 
 // The AVX2 rows (materials/pmb/pmb_row_avx2.hpp) give the portable rows' bits in every variant
-// the kernel has: one block of equal full volumes (the uniform path), partial volumes (ν from |ξ|),
-// two blocks with a no-fail set, unequal volumes, a surface correction, LAMMPS's order (force
-// first) and its per-node s0; rows whose lengths are not multiples of 4; a bond crushed to a
+// the kernel has (every brick has a no-fail bottom layer): one block of equal full volumes (the
+// uniform path), partial volumes (ν from |ξ|), two blocks, unequal volumes, a surface correction
+// with one block and with two, LAMMPS's order (force first) and its per-node s0; rows whose lengths are not multiples of 4; a bond crushed to a
 // point; over rounds that break bonds. Forces, W, flags, counts and lost energy are compared.
 TEST(Kernel, Avx2RowIsBitwiseThePortableRow) {
-  if (!pd::pmb_avx2_rows()) GTEST_SKIP() << "this CPU has no AVX2: every row is the portable code";
+  if (!pd::pmb_avx2_rows()) GTEST_SKIP() << "no AVX2 rows here (a CPU without AVX2, or a build other than GCC on x86-64)";
+  // The switch back on whatever happens below (an ASSERT returns early).
+  struct Restore {
+    ~Restore() { pd::set_pmb_avx2_rows(true); }
+  } restore;
   struct Variant {
     const char* name;
     bool two_blocks;
@@ -160,6 +164,7 @@ TEST(Kernel, Avx2RowIsBitwiseThePortableRow) {
       {"uniform", false, "none", false, false, false},         {"partial volumes", false, "lammps", false, false, false},
       {"two blocks", true, "none", false, false, false},       {"unequal volumes", false, "none", true, false, false},
       {"surface correction", true, "hhb", false, true, false}, {"lammps rules", true, "lammps", true, true, true},
+      {"one block, corrected", false, "hhb", false, true, false},
   };
   std::int64_t rows_not_multiple_of_4 = 0;
   for (const Variant& v : variants) {

@@ -2,6 +2,7 @@
 #include "materials/pmb/pmb.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -36,16 +37,20 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
 }
 
 namespace {
+// Asked once, on first use (not by a static initialiser, whose order across files is unspecified).
+bool cpu_has_avx2() {
 #ifdef PD_HAVE_AVX2_ROW
-const bool kCpuHasAvx2 = __builtin_cpu_supports("avx2");
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
 #else
-const bool kCpuHasAvx2 = false;
+  return false;  // this build has no AVX2 row (not GCC on x86-64)
 #endif
-bool avx2_rows_enabled = true;
+}
+std::atomic<bool> avx2_rows_enabled{true};
 }  // namespace
 
-void set_pmb_avx2_rows(bool enabled) { avx2_rows_enabled = enabled; }
-bool pmb_avx2_rows() { return avx2_rows_enabled && kCpuHasAvx2; }
+void set_pmb_avx2_rows(bool enabled) { avx2_rows_enabled.store(enabled, std::memory_order_relaxed); }
+bool pmb_avx2_rows() { return avx2_rows_enabled.load(std::memory_order_relaxed) && cpu_has_avx2(); }
 
 namespace {
 
@@ -126,8 +131,8 @@ std::int64_t add_pmb_force_density(const PmbArrays& a, double* f0, double* f1, d
   const double* s0_pair = breaking ? breaking->s0_pair : nullptr;
   const std::int64_t count = rows.size(a.nodes);
 #pragma omp parallel for schedule(static) reduction(+ : newly)
-  for (std::int64_t r = 0; r < count; ++r) {
-    const std::int64_t i = rows.at(r);
+  for (std::int64_t r_at = 0; r_at < count; ++r_at) {
+    const std::int64_t i = rows.at(r_at);
     const bool test_breaking = breaking != nullptr && breaking->no_fail[i] == 0;
     RowSums r = test_breaking ? pmb_row_of<true>(a, i, s0_pair) : pmb_row_of<false>(a, i, s0_pair);
     if (r.over > 0) {  // rare: near a crack tip or a no-fail set

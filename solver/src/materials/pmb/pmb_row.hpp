@@ -64,13 +64,14 @@ struct RowSums {
 };
 
 // Row i of the kernel from the current flags, its bonds from `begin` on, added to `sums` (the
-// AVX2 row, pmb_row_avx2.hpp, leaves its last 0–3 bonds to this one); kBreaking also counts the bonds over their critical
-// stretch, kOneBlock skips the gathers of the far end's block, kCorrected multiplies each bond's c
-// by its surface-correction factor g_k (core/surface_correction), kUniform (PmbArrays::uniform: one
-// block, no correction, full volumes, one V for every node) skips the gather of V_j and ν = 1:
-// c ν V_j = ((intact·c)·V)·1 is intact·(c·V) bit for bit, intact being 0 or 1. Compile-time
-// switches, so that the loop has no branch in it and vectorises in every variant (and without a
-// correction it is the same code, bitwise, as before there was one).
+// AVX2 row, pmb_row_avx2.hpp, leaves its last 0–3 bonds to this one); kBreaking also counts the
+// bonds over their critical stretch, kOneBlock skips the gathers of the far end's block,
+// kCorrected multiplies each bond's c by its surface-correction factor g_k
+// (core/surface_correction), kUniform (PmbArrays::uniform: one block, no correction, full volumes,
+// one V for every node) skips the gather of V_j and ν = 1: c ν V_j = ((intact·c)·V)·1 is
+// intact·(c·V) bit for bit, intact being 0 or 1. Compile-time switches, so that the loop has no
+// branch in it and vectorises in every variant (and without a correction it is the same code,
+// bitwise, as before there was one).
 template <bool kBreaking, bool kOneBlock, bool kCorrected = false, bool kUniform = false>
 PD_KERNEL_CLONES RowSums pmb_row_part(const PmbArrays& a, std::int64_t i, const double* s0_pair, std::int64_t begin,
                                       RowSums sums) {

@@ -1,5 +1,5 @@
 // One row of the PMB kernel written with AVX2 intrinsics: bitwise the portable row (pmb_row.hpp),
-// about 10 % less time per bond on the machines of docs/performance.md §7. Internal to the PMB
+// 11–16 % less CPU time per step on the Intel guest of docs/performance.md §7. Internal to the PMB
 // kernel (pmb_kernel.cpp includes it and picks this row when the CPU has AVX2).
 //
 // Why by hand: GCC's vectorised portable row stores each bond's four terms lane by lane into a
@@ -8,7 +8,10 @@
 // per component into one vector per bond, added to the row's sums in bond order. Every bond does
 // the same IEEE operations in the same order as bond_terms and pmb_row_part (no FMA: the target is
 // "avx2", not "fma"), so the sums and flags are bit for bit those of the portable row; the test
-// Kernel.Avx2RowIsBitwiseThePortableRow compares the two over every variant.
+// Kernel.Avx2RowIsBitwiseThePortableRow compares the two over every variant. (Where an input is
+// already NaN or infinite, a NaN sum may come out with the other sign: the two rows pass NaN
+// operands through in another order. A run stops at the first non-finite u or v anyway:
+// run/loop.cpp.)
 #pragma once
 
 #include "materials/pmb/pmb_row.hpp"
