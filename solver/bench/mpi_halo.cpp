@@ -16,7 +16,7 @@
 // for LPS, whose m_i need whole rows); --alpha A: LAMMPS's breaking order and α rule (per-node s0,
 // whose ghosts travel with u); --blocking: every owned row a boundary row, so that every sweep
 // waits for its exchange first (the exchange without the overlap, in the same binary: a before/after);
-// --kernel portable: PMB rows by the portable code even where the CPU has AVX2 (the same bits).
+// --kernel portable: PMB and LPS rows by the portable code even where the CPU has AVX2 (the same bits).
 //
 //   mpiexec -np R pd_mpi_halo --side N [--steps S] [--threads T] [--law pmb|lps] [--alpha A] [--blocking]
 //   [--kernel auto|portable]
@@ -36,6 +36,7 @@
 #include "core/stability.hpp"
 #include "integrators/integrator.hpp"
 #include "lattice.hpp"
+#include "materials/lps/lps.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "operator/force_operator.hpp"
 #include "parallel/local_model.hpp"
@@ -69,6 +70,7 @@ int main(int argc, char** argv) {
         return 2;
       }
       pd::set_pmb_avx2_rows(kernel == "auto");
+      pd::set_lps_avx2_rows(kernel == "auto");
     }
     ++k;
   }

@@ -4,6 +4,7 @@
 // pdsolve uses (bond breaking on). Prints one CSV row (header with --header).
 //
 //   pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] [--kernel auto|portable]
+//            [--influence one|inverse_length|gaussian]
 //
 // --nodes FILE reads the brick from a node file instead of writing the x-fastest lattice (the
 // brick must be the side³ lattice of spacing 1 mm at the origin, in any node order): speed.py uses
@@ -11,10 +12,10 @@
 // writes it: preprocess/ordering.py).
 //
 // --model lps: the same brick in the linear peridynamic solid (ν = 0.25, ω = 1: PMB's elastic constants),
-// for LPS's rate per directed bond beside PMB's (materials/lps).
+// for LPS's rate per directed bond beside PMB's (materials/lps); --influence sets its ω (one by default).
 //
-// --kernel portable: PMB rows by the portable code even where the CPU has AVX2 (the same bits;
-// docs/performance.md §7 measures what the AVX2 rows gain with it, side by side).
+// --kernel portable: PMB and LPS rows by the portable code even where the CPU has AVX2 (the same
+// bits; docs/performance.md §7 measures what the AVX2 rows gain with it, side by side).
 //
 // set-up = reading the node file (written to D first, not timed) + build_model (bonds, material);
 // loop = S integrator steps, timed; directed bond updates/s = directed bonds × S / loop time, each
@@ -30,6 +31,7 @@
 #include <string>
 
 #include "core/model.hpp"
+#include "materials/lps/lps.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "integrators/integrator.hpp"
 #include "io/node_file.hpp"
@@ -53,7 +55,7 @@ const char* const kHeader =
     "broken_bonds,model";
 
 int usage() {
-  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] [--kernel auto|portable] | --header\n");
+  std::fprintf(stderr, "usage: pd_speed --side N [--steps S] [--threads T] [--dir D] [--nodes FILE] [--model pmb|lps] [--kernel auto|portable] [--influence one|inverse_length|gaussian] | --header\n");
   return 2;
 }
 
@@ -64,6 +66,7 @@ int main(int argc, char** argv) {
   std::filesystem::path dir = "out/bench/tmp", nodes;
   std::string material = "pmb";
   std::string kernel = "auto";
+  std::string influence = "one";
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--header") {
@@ -78,10 +81,12 @@ int main(int argc, char** argv) {
     else if (a == "--nodes") nodes = argv[++k];
     else if (a == "--model") material = argv[++k];
     else if (a == "--kernel") kernel = argv[++k];
+    else if (a == "--influence") influence = argv[++k];
     else return usage();
   }
   if (side < 4 || steps < 1 || (kernel != "auto" && kernel != "portable")) return usage();
   pd::set_pmb_avx2_rows(kernel == "auto");
+  pd::set_lps_avx2_rows(kernel == "auto");
   if (threads > 0) omp_set_num_threads(threads);
   threads = omp_get_max_threads();
 
@@ -91,6 +96,7 @@ int main(int argc, char** argv) {
   if (material == "lps") {
     c.blocks[0].model = "lps";
     c.blocks[0].parameters["poisson_ratio"] = 0.25;
+    c.blocks[0].choices["influence"] = influence;
   } else if (material != "pmb") {
     return usage();
   }

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <random>
 
 #include "core/stability.hpp"
 #include "jacobian_check.hpp"
@@ -18,6 +20,7 @@
 #include "lps_lattice.hpp"
 #include "materials/bond_model.hpp"
 #include "materials/lps/lps.hpp"
+#include "materials/lps/lps_kernel.hpp"
 #include "integrators/integrator.hpp"
 #include "one_thread.hpp"
 #include "static_tension.hpp"
@@ -463,6 +466,123 @@ TEST(Lps, FusedBreakingAndForceEqualBreakingThenForceBitwise) {
   for (int d = 0; d < 3; ++d) EXPECT_EQ(fa[d], fb[d]);
   EXPECT_EQ(wa, wb);
   EXPECT_EQ(wa, b.bond_model->strain_energy_density(b, s.u));
+}
+
+namespace {
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+TEST(Lps, Avx2RowsAreBitwiseThePortableRows) {
+  // The AVX2 rows of both sweeps (materials/lps/lps_row_avx2.hpp) give the portable rows' bits
+  // (lps_row.hpp) for every influence function and every variant of the kernel's input: one block
+  // of equal full volumes, partial volumes (ν from |ξ|), two blocks with a no-fail set, unequal
+  // volumes, an energy surface correction (g per bond) with HHB's partial volumes; rows whose
+  // lengths are not multiples of 4 (a 9×8×7 brick: the portable tail); a bond crushed to a point;
+  // three rounds of random displacements that break bonds. Compared bit for bit: θ (the sweep
+  // without breaking), f and W without breaking, then with breaking: the counts, flags, f, W and
+  // the lost energy per node.
+  if (!pd::lps_avx2_rows()) GTEST_SKIP() << "no AVX2 rows here (a CPU without AVX2, or a build other than GCC on x86-64)";
+  struct Restore {  // the AVX2 rows on again for the tests after this one, even if an ASSERT ends it
+    ~Restore() { pd::set_lps_avx2_rows(true); }
+  } restore;
+  struct Variant {
+    const char* name;
+    bool two_blocks;
+    const char* partial_volume;
+    bool unequal_volumes;
+    const char* correction;
+  };
+  const Variant variants[] = {
+      {"uniform", false, "none", false, "none"},       {"partial volumes", false, "lammps", false, "none"},
+      {"two blocks", true, "none", false, "none"},     {"unequal volumes", false, "none", true, "none"},
+      {"surface correction", false, "hhb", false, "energy"},
+  };
+  std::int64_t rows_not_multiple_of_4 = 0;
+  for (const char* w : {"one", "inverse_length", "gaussian"})
+    for (const Variant& v : variants) {
+      const std::string what = std::string(w) + ", " + v.name;
+      const auto make = [&] {
+        // s0 of a few 1e-3 (G0 = 100 J/m²): the random stretches below break a part of the bonds per round.
+        pd::Case c = lps_case(3, "3d", {0.3, w, 100.0});
+        c.partial_volume = v.partial_volume;
+        c.surface_correction = v.correction;
+        pd::Nodes nodes = pdtest::cubic_lattice(9, 8, 7, kDx, 3, 1e-3);
+        if (v.unequal_volumes)
+          for (std::size_t i = 0; i < nodes.size(); ++i) nodes.volume[i] *= 1.0 + 0.01 * static_cast<double>(i % 7);
+        if (v.two_blocks) {  // the upper half stiffer and tougher; the bottom layer a no-fail set
+          pd::BlockMaterial stiff = c.blocks[0];
+          stiff.name = "stiff";
+          stiff.parameters["youngs_modulus"] = 3 * kE;
+          stiff.parameters["fracture_energy"] = 400.0;
+          c.blocks.push_back(stiff);
+          for (std::size_t i = 0; i < nodes.size(); ++i)
+            if (nodes.x[2][i] > 3.5 * kDx) nodes.block[i] = 2;
+          pd::NodeSet bottom{"bottom", std::vector<std::uint8_t>(nodes.size(), 0)};
+          for (std::size_t i = 0; i < nodes.size(); ++i) bottom.member[i] = nodes.x[2][i] < 0.5 * kDx;
+          nodes.sets.push_back(bottom);
+          c.no_fail_sets = {"bottom"};
+        }
+        return pd::build_model(c, std::move(nodes));
+      };
+      pd::Model models[2] = {make(), make()};  // [0] AVX2 rows, [1] portable rows
+      const std::size_t n = models[0].nodes.size();
+      ASSERT_EQ(models[0].bonds.corrected(), std::string(v.correction) != "none") << what;
+      for (std::size_t i = 0; i < n; ++i)
+        rows_not_multiple_of_4 += (models[0].bonds.offsets[i + 1] - models[0].bonds.offsets[i]) % 4 != 0;
+      std::int64_t broke[3] = {0, 0, 0};
+      for (unsigned round = 0; round < 3; ++round) {
+        std::mt19937 rng(31 + round);
+        std::uniform_real_distribution<double> d(-(0.001 + 0.002 * round) * kDx, (0.001 + 0.002 * round) * kDx);
+        pd::Vec3Array u = pd::make_vec3(n);
+        for (auto& c : u)
+          for (double& x : c) x = d(rng);
+        if (round == 1) {  // node 100's first neighbour moved onto it: y = 0, 1/y replaced by 1
+          const auto j = static_cast<std::size_t>(models[0].bonds.neighbour[static_cast<std::size_t>(models[0].bonds.offsets[100])]);
+          for (std::size_t c = 0; c < 3; ++c) u[c][j] = models[0].nodes.x[c][100] + u[c][100] - models[0].nodes.x[c][j];
+        }
+        std::vector<double> theta[2], w_plain[2], w_break[2], lost[2];
+        pd::Vec3Array f_plain[2], f_break[2];
+        pd::BreakReport report[2];
+        for (int r = 0; r < 2; ++r) {
+          pd::set_lps_avx2_rows(r == 0);
+          pd::Model& m = models[r];
+          ASSERT_EQ(pd::LpsKernel(law(m), m, u).avx2, r == 0) << what;
+          theta[r] = m.bond_model->dilatation(m, u);
+          f_plain[r] = pd::make_vec3(n);
+          w_plain[r].assign(n, 0.0);
+          m.bond_model->add_force(m, u, f_plain[r], w_plain[r].data());
+          f_break[r] = pd::make_vec3(n);
+          w_break[r].assign(n, 0.0);
+          lost[r].assign(n, 0.0);
+          report[r] = m.bond_model->break_bonds_and_add_force(m, u, f_break[r], w_break[r].data(), true, lost[r].data());
+        }
+        broke[round] = report[0].broken;
+        const std::string at = what + ", round " + std::to_string(round);
+        EXPECT_TRUE(same_bits(theta[0], theta[1])) << at << ": θ";
+        for (std::size_t c = 0; c < 3; ++c) {
+          EXPECT_TRUE(same_bits(f_plain[0][c], f_plain[1][c])) << at << ": f without breaking, component " << c;
+          EXPECT_TRUE(same_bits(f_break[0][c], f_break[1][c])) << at << ": f with breaking, component " << c;
+        }
+        EXPECT_TRUE(same_bits(w_plain[0], w_plain[1])) << at << ": W without breaking";
+        EXPECT_TRUE(same_bits(w_break[0], w_break[1])) << at << ": W with breaking";
+        EXPECT_TRUE(same_bits(lost[0], lost[1])) << at << ": lost energy";
+        EXPECT_EQ(report[0].broken, report[1].broken) << at;
+        EXPECT_EQ(models[0].bonds.broken, models[1].bonds.broken) << at << ": flags";
+      }
+      std::int64_t intact = 0;
+      for (std::uint8_t b : models[0].bonds.broken) intact += b == 0;
+      EXPECT_GT(broke[1], 0) << what << ": nothing broke in round 1, the rounds would not test the flags";
+      EXPECT_GT(broke[2], 0) << what << ": nothing broke in round 2, the rounds would not test the flags";
+      EXPECT_GT(intact, 0) << what << ": everything broke, the last rounds tested nothing";
+      std::printf("[ lps      ] %s: bonds broken per round %lld %lld %lld; %lld of %zu directed bonds intact\n",
+                  what.c_str(), static_cast<long long>(broke[0]), static_cast<long long>(broke[1]),
+                  static_cast<long long>(broke[2]), static_cast<long long>(intact), models[0].bonds.broken.size());
+    }
+  EXPECT_GT(rows_not_multiple_of_4, 0) << "every row a multiple of 4 bonds: the portable tail went untested";
 }
 
 TEST(Lps, VerletFreeVibrationConservesEnergyToSecondOrder) {

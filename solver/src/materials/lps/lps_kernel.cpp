@@ -1,129 +1,61 @@
 // The LPS kernel in two sweeps over the bonds (materials/lps/lps.hpp): the first computes every
 // node's dilatation θ_i (breaking bonds first where asked), the second the force from θ of both
 // ends. Each sweep is parallel over nodes and a node writes only its own row and its own θ, f, W,
-// summing its bonds in row order: bitwise the same for any thread count.
+// summing its bonds in row order: bitwise the same for any thread count. The sweeps' fast rows are in
+// lps_row.hpp (portable) and lps_row_avx2.hpp (AVX2 intrinsics, taken where the CPU has AVX2: the
+// same bits, fewer stores; docs/performance.md §7).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
 #include "core/exact_sum.hpp"
 #include "materials/lps/lps_kernel.hpp"
+#include "materials/lps/lps_row.hpp"
+#include "materials/lps/lps_row_avx2.hpp"
 #include "parallel/decomposed.hpp"
 
 namespace pd {
 
 namespace {
-
-// Bonds per chunk of a row: the chunk's terms are computed by loops the compiler vectorises (no
-// reduction in them), then summed in bond order by a short scalar loop, so the sums are those of
-// a plain loop over the row in order (and the slow exact paths of lps_kernel.hpp give bitwise the same).
-constexpr int kChunk = 64;
-
-// One binary for every x86-64 machine, each running its widest code with the same IEEE operations
-// (no FMA contraction: solver/CMakeLists.txt), as PMB's kernel (docs/performance.md).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PD_LPS_CLONES __attribute__((target_clones("default", "arch=x86-64-v2", "arch=x86-64-v3")))
+// Asked once, on first use (not by a static initialiser, whose order across files is unspecified),
+// as PMB's kernel does.
+bool cpu_has_avx2() {
+#ifdef PD_HAVE_LPS_AVX2_ROW
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
 #else
-#define PD_LPS_CLONES
+  return false;  // this build has no AVX2 rows (not GCC on x86-64)
 #endif
+}
+std::atomic<bool> avx2_rows_enabled{true};
+}  // namespace
 
-// Sweep 1, row i from the current flags: Σ ω|ξ| ext V_j and m'_i; kBreaking also counts the intact
-// bonds over s0 (candidates: no-fail ends are left to dilatation_row); kOneBlock skips the gather of
-// the far end's block (one s0 for every bond).
+void set_lps_avx2_rows(bool enabled) { avx2_rows_enabled.store(enabled, std::memory_order_relaxed); }
+bool lps_avx2_rows() { return avx2_rows_enabled.load(std::memory_order_relaxed) && cpu_has_avx2(); }
+
+namespace {
+
+// The fast rows of the two sweeps: the AVX2 code where the kernel chose it (LpsKernel::avx2), else
+// the portable code (lps_row.hpp); the same bits either way. Every sweep that uses a fast row goes
+// through these two: dilatation_sweep_of and force_sweep_of, which the plain, the breaking and the
+// overlapped (decomposed) paths and dilatation() all call. The other row loops (the exact redo of
+// a row that breaks, dilatation_row; stretch_ratio; strain_energy_density; J·x's two sweeps; the
+// tangent's blocks) are per-bond code on LpsKernel::bond, not these rows.
 template <Influence kKind, bool kBreaking, bool kOneBlock>
-PD_LPS_CLONES void dilatation_row_fast(const LpsKernel& k, std::int64_t i, const double* s0_row,
-                                       const std::int32_t* block, double& sum_theta, double& m_intact,
-                                       std::int64_t& over) {
-  const double xi0 = k.x[0][i], xi1 = k.x[1][i], xi2 = k.x[2][i];
-  const double yi0 = xi0 + k.u[0][i], yi1 = xi1 + k.u[1][i], yi2 = xi2 + k.u[2][i];
-  double st = 0.0, sm = 0.0;
-  std::int64_t ov = 0;
-  const std::int64_t end = k.offsets[i + 1];
-  for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
-    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
-    std::int64_t jq[kChunk];
-    double intact[kChunk], s0q[kChunk], ta[kChunk], tb[kChunk], gq[kChunk];
-    for (int q = 0; q < m; ++q) {
-      jq[q] = k.neighbour[base + q];
-      intact[q] = k.broken[base + q] ? 0.0 : 1.0;
-      gq[q] = k.factor ? k.factor[base + q] : 1.0;  // ×1 is exact: without a correction, the same bits
-      if constexpr (kBreaking) s0q[q] = kOneBlock ? s0_row[0] : s0_row[block[jq[q]]];
-    }
-    for (int q = 0; q < m; ++q) {
-      const std::int64_t j = jq[q];
-      const double d0 = k.x[0][j] - xi0, d1 = k.x[1][j] - xi1, d2 = k.x[2][j] - xi2;
-      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
-      const double e0 = (k.x[0][j] + k.u[0][j]) - yi0, e1 = (k.x[1][j] + k.u[1][j]) - yi1,
-                   e2 = (k.x[2][j] + k.u[2][j]) - yi2;
-      const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-      const double raw = y - length;
-      const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
-      const double omega = influence_of<kKind>(length, k.horizon);
-      const double vj = k.volume[j] * k.volume_weight(length) * gq[q];
-      ta[q] = intact[q] * (omega * length * ext * vj);
-      tb[q] = intact[q] * (omega * length * length * vj);
-      if constexpr (kBreaking) ov += (intact[q] > 0.0) & (raw > s0q[q] * length);  // Bond::over
-    }
-    for (int q = 0; q < m; ++q) {
-      st += ta[q];
-      sm += tb[q];
-    }
-  }
-  sum_theta = st;
-  m_intact = sm;
-  over = ov;
+DilatationSums dilatation_row_fast(const LpsKernel& k, std::int64_t i, const double* s0_row, const std::int32_t* block) {
+#ifdef PD_HAVE_LPS_AVX2_ROW
+  if (k.avx2) return dilatation_row_avx2<kKind, kBreaking, kOneBlock>(k, i, s0_row, block);
+#endif
+  return dilatation_row_part<kKind, kBreaking, kOneBlock>(k, i, s0_row, block, k.offsets[i], DilatationSums{});
 }
 
-// Sweep 2, row i: the force density and W_i (lps.hpp), from θ and P of both ends.
-struct ForceRow {
-  double f0, f1, f2, w;
-};
 template <Influence kKind>
-PD_LPS_CLONES ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const double* theta, const double* p) {
-  const double xi0 = k.x[0][i], xi1 = k.x[1][i], xi2 = k.x[2][i];
-  const double yi0 = xi0 + k.u[0][i], yi1 = xi1 + k.u[1][i], yi2 = xi2 + k.u[2][i];
-  const double pi = p[i], ai = k.a[i], th = theta[i], d = k.d;
-  double f0 = 0.0, f1 = 0.0, f2 = 0.0, dev = 0.0;
-  const std::int64_t end = k.offsets[i + 1];
-  for (std::int64_t base = k.offsets[i]; base < end; base += kChunk) {
-    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, end - base));
-    std::int64_t jq[kChunk];
-    double intact[kChunk], pq[kChunk], aq[kChunk], t0[kChunk], t1[kChunk], t2[kChunk], tw[kChunk], gq[kChunk];
-    for (int q = 0; q < m; ++q) {
-      jq[q] = k.neighbour[base + q];
-      gq[q] = k.factor ? k.factor[base + q] : 1.0;  // ×1 is exact: without a correction, the same bits
-      intact[q] = k.broken[base + q] ? 0.0 : 1.0;
-      pq[q] = p[jq[q]];
-      aq[q] = k.a[jq[q]];
-    }
-    for (int q = 0; q < m; ++q) {
-      const std::int64_t j = jq[q];
-      const double d0 = k.x[0][j] - xi0, d1 = k.x[1][j] - xi1, d2 = k.x[2][j] - xi2;
-      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
-      const double e0 = (k.x[0][j] + k.u[0][j]) - yi0, e1 = (k.x[1][j] + k.u[1][j]) - yi1,
-                   e2 = (k.x[2][j] + k.u[2][j]) - yi2;
-      const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-      const double raw = y - length;
-      const double ext = std::fabs(raw) > kLpsStretchZero * length ? raw : 0.0;
-      const double inv_y = 1.0 / (y > 0.0 ? y : 1.0);
-      const double omega = influence_of<kKind>(length, k.horizon);
-      const double vj = k.volume[j] * k.volume_weight(length) * gq[q];
-      const double tt = omega * (length * (pi + pq[q]) + (ai + aq[q]) * ext);
-      const double scale = intact[q] * (tt * vj * inv_y);
-      t0[q] = scale * e0;
-      t1[q] = scale * e1;
-      t2[q] = scale * e2;
-      const double ed = ext - th * length / d;
-      tw[q] = intact[q] * (omega * ed * ed * vj);
-    }
-    for (int q = 0; q < m; ++q) {  // in bond order: the same sums for any thread count
-      f0 += t0[q];
-      f1 += t1[q];
-      f2 += t2[q];
-      dev += tw[q];
-    }
-  }
-  return ForceRow{f0, f1, f2, 0.5 * k.kappa[i] * th * th + 0.5 * ai * dev};
+ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const double* theta, const double* p) {
+#ifdef PD_HAVE_LPS_AVX2_ROW
+  if (k.avx2) return force_row_avx2<kKind>(k, i, theta, p);
+#endif
+  return force_row_part<kKind>(k, i, theta, p, k.offsets[i], ForceSums{});
 }
 
 // What the breaking sweep needs besides the kernel (the PMB criterion: a bond breaks once its
@@ -187,19 +119,20 @@ std::int64_t dilatation_sweep_of(const LpsKernel& k, const Breaking* br, std::ve
 #pragma omp parallel for schedule(static) reduction(+ : newly)
   for (std::int64_t r = 0; r < count; ++r) {
     const std::int64_t i = rows.at(r);
-    double th = 0.0, st = 0.0, mi = 0.0;
-    std::int64_t over = 0;
+    double th = 0.0;
+    DilatationSums s;
     if (br && !br->no_fail[i]) {
       const double* s0_row = br->s0_pair + br->block[i] * br->blocks;
-      if (br->blocks == 1) dilatation_row_fast<kKind, true, true>(k, i, s0_row, br->block, st, mi, over);
-      else dilatation_row_fast<kKind, true, false>(k, i, s0_row, br->block, st, mi, over);
+      if (br->blocks == 1) s = dilatation_row_fast<kKind, true, true>(k, i, s0_row, br->block);
+      else s = dilatation_row_fast<kKind, true, false>(k, i, s0_row, br->block);
     } else {
-      dilatation_row_fast<kKind, false, true>(k, i, nullptr, nullptr, st, mi, over);
+      s = dilatation_row_fast<kKind, false, true>(k, i, nullptr, nullptr);
     }
-    if (over > 0) {
+    double mi = s.m;
+    if (s.over > 0) {
       newly += dilatation_row(k, i, br, th, mi);
     } else {
-      th = k.theta_of(i, st);
+      th = k.theta_of(i, s.theta);
       if (br && br->lost) br->lost[i] = 0.0;
     }
     theta[static_cast<std::size_t>(i)] = th;
@@ -225,8 +158,8 @@ void force_sweep_of(const LpsKernel& k, const std::vector<double>& theta, const 
                     double* w, RowSubset rows) {
   const std::int64_t count = rows.size(k.nodes);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t r = 0; r < count; ++r) {
-    const std::int64_t i = rows.at(r);
+  for (std::int64_t r_at = 0; r_at < count; ++r_at) {  // not r: the row's sums below are
+    const std::int64_t i = rows.at(r_at);
     const ForceRow r = force_row_fast<kKind>(k, i, theta.data(), p.data());
     const auto iu = static_cast<std::size_t>(i);
     f[0][iu] += r.f0;

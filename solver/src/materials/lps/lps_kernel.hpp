@@ -32,6 +32,7 @@ struct LpsKernel {
   Influence kind;
   double horizon;
   std::int64_t nodes;
+  bool avx2;  // the fast sweeps' rows by the AVX2 code (lps_row_avx2.hpp): lps_avx2_rows() when made
 
   LpsKernel(const LpsModel& law, const Model& model, const Vec3Array& uu) {
     offsets = model.bonds.offsets.data();
@@ -52,6 +53,7 @@ struct LpsKernel {
     kind = law.influence_;
     horizon = law.horizon_;
     nodes = static_cast<std::int64_t>(model.nodes.size());
+    avx2 = lps_avx2_rows();
   }
 
   // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, raw = y − |ξ| and the extension ext = raw but
