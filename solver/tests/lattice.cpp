@@ -70,4 +70,20 @@ pd::Model held_at_left(pd::Case c, pd::Nodes nodes, double dx) {
   return pd::build_model(c, std::move(nodes));
 }
 
+void add_stiff_top_and_no_fail_bottom(pd::Case& c, pd::Nodes& nodes, double dx, double youngs_modulus,
+                                      double fracture_energy) {
+  pd::BlockMaterial stiff = c.blocks[0];
+  stiff.name = "stiff";
+  stiff.parameters["youngs_modulus"] = youngs_modulus;
+  stiff.parameters["fracture_energy"] = fracture_energy;
+  c.blocks.push_back(stiff);
+  pd::NodeSet bottom{"bottom", std::vector<std::uint8_t>(nodes.size(), 0)};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes.x[2][i] > 3.5 * dx) nodes.block[i] = 2;
+    bottom.member[i] = nodes.x[2][i] < 0.5 * dx;
+  }
+  nodes.sets.push_back(bottom);
+  c.no_fail_sets = {"bottom"};
+}
+
 }  // namespace pdtest

@@ -27,6 +27,12 @@ void clamp_left_pull_right(pd::Case& c, double pull, double end, bool right_held
 // in every direction of c's dimension.
 pd::Model held_at_left(pd::Case c, pd::Nodes nodes, double dx);
 
+// The breakable bricks of the kernel tests: the nodes above z = 3.5 dx become a second block
+// "stiff" (c's first block with the given E and G0) and the layer below z = dx/2 the no-fail set
+// "bottom".
+void add_stiff_top_and_no_fail_bottom(pd::Case& c, pd::Nodes& nodes, double dx, double youngs_modulus,
+                                      double fracture_energy);
+
 // Index of lattice node (i, j, k).
 inline std::size_t node_index(int i, int j, int k, int nx, int ny) {
   return static_cast<std::size_t>((k * ny + j) * nx + i);

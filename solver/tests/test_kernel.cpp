@@ -24,18 +24,13 @@ pd::Model brick(bool two_blocks, const std::string& partial_volume = "none") {
   c.partial_volume = partial_volume;
   pd::Nodes nodes = pdtest::cubic_lattice(9, 8, 7, kDx, 3);
   if (two_blocks) {
-    pd::BlockMaterial stiff = c.blocks[0];
-    stiff.name = "stiff";
-    stiff.parameters["youngs_modulus"] = 3e9;
-    stiff.parameters["fracture_energy"] = 0.2;
-    c.blocks.push_back(stiff);
-    for (std::size_t i = 0; i < nodes.size(); ++i)
-      if (nodes.x[2][i] > 3.5 * kDx) nodes.block[i] = 2;
+    pdtest::add_stiff_top_and_no_fail_bottom(c, nodes, kDx, 3e9, 0.2);
+  } else {  // the no-fail bottom layer alone
+    pd::NodeSet bottom{"bottom", std::vector<std::uint8_t>(nodes.size(), 0)};
+    for (std::size_t i = 0; i < nodes.size(); ++i) bottom.member[i] = nodes.x[2][i] < 0.5 * kDx;
+    nodes.sets.push_back(bottom);
+    c.no_fail_sets = {"bottom"};
   }
-  pd::NodeSet bottom{"bottom", std::vector<std::uint8_t>(nodes.size(), 0)};
-  for (std::size_t i = 0; i < nodes.size(); ++i) bottom.member[i] = nodes.x[2][i] < 0.5 * kDx;
-  nodes.sets.push_back(bottom);
-  c.no_fail_sets = {"bottom"};
   return pd::build_model(c, std::move(nodes));
 }
 

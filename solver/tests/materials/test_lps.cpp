@@ -513,19 +513,8 @@ TEST(Lps, Avx2RowsAreBitwiseThePortableRows) {
         pd::Nodes nodes = pdtest::cubic_lattice(9, 8, 7, kDx, 3, 1e-3);
         if (v.unequal_volumes)
           for (std::size_t i = 0; i < nodes.size(); ++i) nodes.volume[i] *= 1.0 + 0.01 * static_cast<double>(i % 7);
-        if (v.two_blocks) {  // the upper half stiffer and tougher; the bottom layer a no-fail set
-          pd::BlockMaterial stiff = c.blocks[0];
-          stiff.name = "stiff";
-          stiff.parameters["youngs_modulus"] = 3 * kE;
-          stiff.parameters["fracture_energy"] = 400.0;
-          c.blocks.push_back(stiff);
-          for (std::size_t i = 0; i < nodes.size(); ++i)
-            if (nodes.x[2][i] > 3.5 * kDx) nodes.block[i] = 2;
-          pd::NodeSet bottom{"bottom", std::vector<std::uint8_t>(nodes.size(), 0)};
-          for (std::size_t i = 0; i < nodes.size(); ++i) bottom.member[i] = nodes.x[2][i] < 0.5 * kDx;
-          nodes.sets.push_back(bottom);
-          c.no_fail_sets = {"bottom"};
-        }
+        if (v.two_blocks)  // the upper half stiffer and tougher; the bottom layer a no-fail set
+          pdtest::add_stiff_top_and_no_fail_bottom(c, nodes, kDx, 3 * kE, 400.0);
         return pd::build_model(c, std::move(nodes));
       };
       pd::Model models[2] = {make(), make()};  // [0] AVX2 rows, [1] portable rows

@@ -18,16 +18,6 @@
 namespace pd {
 
 namespace {
-// Asked once, on first use (not by a static initialiser, whose order across files is unspecified),
-// as PMB's kernel does.
-bool cpu_has_avx2() {
-#ifdef PD_HAVE_LPS_AVX2_ROW
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-#else
-  return false;  // this build has no AVX2 rows (not GCC on x86-64)
-#endif
-}
 std::atomic<bool> avx2_rows_enabled{true};
 }  // namespace
 
@@ -44,7 +34,7 @@ namespace {
 // tangent's blocks) are per-bond code on LpsKernel::bond, not these rows.
 template <Influence kKind, bool kBreaking, bool kOneBlock>
 DilatationSums dilatation_row_fast(const LpsKernel& k, std::int64_t i, const double* s0_row, const std::int32_t* block) {
-#ifdef PD_HAVE_LPS_AVX2_ROW
+#ifdef PD_HAVE_AVX2_ROWS
   if (k.avx2) return dilatation_row_avx2<kKind, kBreaking, kOneBlock>(k, i, s0_row, block);
 #endif
   return dilatation_row_part<kKind, kBreaking, kOneBlock>(k, i, s0_row, block, k.offsets[i], DilatationSums{});
@@ -52,7 +42,7 @@ DilatationSums dilatation_row_fast(const LpsKernel& k, std::int64_t i, const dou
 
 template <Influence kKind>
 ForceRow force_row_fast(const LpsKernel& k, std::int64_t i, const double* theta, const double* p) {
-#ifdef PD_HAVE_LPS_AVX2_ROW
+#ifdef PD_HAVE_AVX2_ROWS
   if (k.avx2) return force_row_avx2<kKind>(k, i, theta, p);
 #endif
   return force_row_part<kKind>(k, i, theta, p, k.offsets[i], ForceSums{});

@@ -16,29 +16,14 @@
 // portable row either way. A run stops at the first non-finite u or v anyway: run/loop.cpp.)
 #pragma once
 
+#include "core/avx2.hpp"
 #include "materials/lps/lps_row.hpp"
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PD_HAVE_LPS_AVX2_ROW 1
-
-#include <immintrin.h>
-
-#include <cstring>
-
+#ifdef PD_HAVE_AVX2_ROWS
 namespace pd {
 namespace {
 
-#define PD_AVX2 __attribute__((target("avx2")))
-
-// p[j[0]], …, p[j[3]] in one vector (4 scalar loads, as PMB's row: hardware gathers were slower there).
-PD_AVX2 inline __m256d lps_gather4(const double* p, const std::int64_t j[4]) {
-  return _mm256_set_pd(p[j[3]], p[j[2]], p[j[1]], p[j[0]]);
-}
-
-// d0·d0 + d1·d1 + d2·d2 in the portable row's order, (d0·d0 + d1·d1) + d2·d2.
-PD_AVX2 inline __m256d lps_squared_norm(__m256d d0, __m256d d1, __m256d d2) {
-  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
-}
+using avx2::gather4;
 
 // What both rows compute of bonds k … k+3 alike (the portable rows' first lines): |ξ|, e = y_j − y_i,
 // y, raw = y − |ξ|, ext = raw but 0 where |raw| ≤ kLpsStretchZero·|ξ| (a NaN compares false and
@@ -62,18 +47,15 @@ PD_AVX2 inline LpsBonds4 lps_bonds4(const LpsKernel& k, const LpsRowFrame& r, st
   const __m256d one = _mm256_set1_pd(1.0);
   const __m256d abs_mask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
   LpsBonds4 b;
-  std::int32_t flags;
-  std::memcpy(&flags, k.broken + q, 4);
-  b.intact_mask = _mm256_castsi256_pd(
-      _mm256_cmpeq_epi64(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128(flags)), _mm256_setzero_si256()));
+  b.intact_mask = avx2::intact_mask4(k.broken + q);
   b.intact = _mm256_and_pd(b.intact_mask, one);  // broken ? 0.0 : 1.0
-  const __m256d xj0 = lps_gather4(k.x[0], j), xj1 = lps_gather4(k.x[1], j), xj2 = lps_gather4(k.x[2], j);
+  const __m256d xj0 = gather4(k.x[0], j), xj1 = gather4(k.x[1], j), xj2 = gather4(k.x[2], j);
   b.length = _mm256_sqrt_pd(
-      lps_squared_norm(_mm256_sub_pd(xj0, r.xi0), _mm256_sub_pd(xj1, r.xi1), _mm256_sub_pd(xj2, r.xi2)));
-  b.e0 = _mm256_sub_pd(_mm256_add_pd(xj0, lps_gather4(k.u[0], j)), r.yi0);
-  b.e1 = _mm256_sub_pd(_mm256_add_pd(xj1, lps_gather4(k.u[1], j)), r.yi1);
-  b.e2 = _mm256_sub_pd(_mm256_add_pd(xj2, lps_gather4(k.u[2], j)), r.yi2);
-  b.y = _mm256_sqrt_pd(lps_squared_norm(b.e0, b.e1, b.e2));
+      avx2::squared_norm(_mm256_sub_pd(xj0, r.xi0), _mm256_sub_pd(xj1, r.xi1), _mm256_sub_pd(xj2, r.xi2)));
+  b.e0 = _mm256_sub_pd(_mm256_add_pd(xj0, gather4(k.u[0], j)), r.yi0);
+  b.e1 = _mm256_sub_pd(_mm256_add_pd(xj1, gather4(k.u[1], j)), r.yi1);
+  b.e2 = _mm256_sub_pd(_mm256_add_pd(xj2, gather4(k.u[2], j)), r.yi2);
+  b.y = _mm256_sqrt_pd(avx2::squared_norm(b.e0, b.e1, b.e2));
   b.raw = _mm256_sub_pd(b.y, b.length);
   const __m256d zero_below = _mm256_mul_pd(_mm256_set1_pd(kLpsStretchZero), b.length);
   b.ext = _mm256_and_pd(_mm256_cmp_pd(_mm256_and_pd(b.raw, abs_mask), zero_below, _CMP_GT_OQ), b.raw);
@@ -113,7 +95,7 @@ PD_AVX2 inline __m256d lps_weighted_volume4(const LpsKernel& k, std::int64_t q, 
   const __m256d outer = _mm256_set1_pd(k.volume_weight.outer), inv_dx = _mm256_set1_pd(k.volume_weight.inv_dx);
   const __m256d nu = _mm256_min_pd(
       _mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(outer, length), inv_dx), _mm256_setzero_pd()), _mm256_set1_pd(1.0));
-  __m256d vj = _mm256_mul_pd(lps_gather4(k.volume, j), nu);
+  __m256d vj = _mm256_mul_pd(gather4(k.volume, j), nu);
   if (k.factor) vj = _mm256_mul_pd(vj, _mm256_loadu_pd(k.factor + q));
   return vj;
 }
@@ -140,7 +122,7 @@ PD_AVX2 DilatationSums dilatation_row_avx2(const LpsKernel& k, std::int64_t i, c
       __m256d s0 = s0_one;
       if constexpr (!kOneBlock) {
         const std::int64_t bj[4] = {block[j[0]], block[j[1]], block[j[2]], block[j[3]]};
-        s0 = lps_gather4(s0_row, bj);
+        s0 = gather4(s0_row, bj);
       }
       const __m256d over_mask = _mm256_cmp_pd(b.raw, _mm256_mul_pd(s0, b.length), _CMP_GT_OQ);
       over += __builtin_popcount(_mm256_movemask_pd(_mm256_and_pd(b.intact_mask, over_mask)));
@@ -174,7 +156,7 @@ PD_AVX2 ForceRow force_row_avx2(const LpsKernel& k, std::int64_t i, const double
     const __m256d inv_y = _mm256_div_pd(one, _mm256_blendv_pd(one, b.y, _mm256_cmp_pd(b.y, zero, _CMP_GT_OQ)));
     const __m256d omega = lps_influence4<kKind>(b.length, k.horizon);
     const __m256d vj = lps_weighted_volume4(k, q, j, b.length);
-    const __m256d pq = lps_gather4(p, j), aq = lps_gather4(k.a, j);
+    const __m256d pq = gather4(p, j), aq = gather4(k.a, j);
     // tt = ω·(|ξ|·(P_i + P_j) + (a_i + a_j)·ext)
     const __m256d tt = lps_weigh<kKind>(
         omega, _mm256_add_pd(_mm256_mul_pd(b.length, _mm256_add_pd(pi, pq)), _mm256_mul_pd(_mm256_add_pd(ai, aq), b.ext)));
@@ -182,21 +164,13 @@ PD_AVX2 ForceRow force_row_avx2(const LpsKernel& k, std::int64_t i, const double
     const __m256d t0 = _mm256_mul_pd(scale, b.e0), t1 = _mm256_mul_pd(scale, b.e1), t2 = _mm256_mul_pd(scale, b.e2);
     const __m256d ed = _mm256_sub_pd(b.ext, _mm256_div_pd(_mm256_mul_pd(th, b.length), d));  // ext − (θ|ξ|)/d
     const __m256d tw = _mm256_mul_pd(b.intact, _mm256_mul_pd(_mm256_mul_pd(lps_weigh<kKind>(omega, ed), ed), vj));
-    // (t0, t1, t2, tw) of bonds q … q+3 → one vector per bond, added in bond order.
-    const __m256d lo01 = _mm256_unpacklo_pd(t0, t1), hi01 = _mm256_unpackhi_pd(t0, t1);
-    const __m256d lo23 = _mm256_unpacklo_pd(t2, tw), hi23 = _mm256_unpackhi_pd(t2, tw);
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(lo01, lo23, 0x20));
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(hi01, hi23, 0x20));
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(lo01, lo23, 0x31));
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(hi01, hi23, 0x31));
+    sums = avx2::add_in_bond_order(sums, t0, t1, t2, tw);  // bonds q … q+3, in order
   }
   alignas(32) double out[4];
   _mm256_store_pd(out, sums);
   // The last 0–3 bonds, and W_i from the deviatoric sum: the portable row, from these sums.
   return force_row_part<kKind>(k, i, theta, p, q, ForceSums{out[0], out[1], out[2], out[3]});
 }
-
-#undef PD_AVX2
 
 }  // namespace
 }  // namespace pd

@@ -37,15 +37,6 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
 }
 
 namespace {
-// Asked once, on first use (not by a static initialiser, whose order across files is unspecified).
-bool cpu_has_avx2() {
-#ifdef PD_HAVE_AVX2_ROW
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-#else
-  return false;  // this build has no AVX2 row (not GCC on x86-64)
-#endif
-}
 std::atomic<bool> avx2_rows_enabled{true};
 }  // namespace
 
@@ -109,7 +100,7 @@ std::int64_t break_row(const PmbArrays& a, const PmbBreaking& br, std::int64_t i
 // the same bits either way.
 template <bool kBreaking, bool kOneBlock, bool kCorrected = false, bool kUniform = false>
 RowSums pmb_row(const PmbArrays& a, std::int64_t i, const double* s0_pair) {
-#ifdef PD_HAVE_AVX2_ROW
+#ifdef PD_HAVE_AVX2_ROWS
   if (a.avx2) return pmb_row_avx2<kBreaking, kOneBlock, kCorrected, kUniform>(a, i, s0_pair);
 #endif
   return pmb_row_part<kBreaking, kOneBlock, kCorrected, kUniform>(a, i, s0_pair, a.offsets[i], RowSums{});

@@ -14,29 +14,15 @@
 // run/loop.cpp.)
 #pragma once
 
+#include "core/avx2.hpp"
 #include "materials/pmb/pmb_row.hpp"
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PD_HAVE_AVX2_ROW 1
-
-#include <immintrin.h>
-
-#include <cstring>
-
+#ifdef PD_HAVE_AVX2_ROWS
 namespace pd {
 namespace {
 
-#define PD_AVX2 __attribute__((target("avx2")))
-
-// p[j[0]], …, p[j[3]] in one vector (4 loads; hardware gathers were 0.6× on this kernel, §7).
-PD_AVX2 inline __m256d gather4(const double* p, const std::int64_t j[4]) {
-  return _mm256_set_pd(p[j[3]], p[j[2]], p[j[1]], p[j[0]]);
-}
-
-// a + b + c in the order (a + b) + c of the portable row's e0·e0 + e1·e1 + e2·e2.
-PD_AVX2 inline __m256d squared_norm(__m256d d0, __m256d d1, __m256d d2) {
-  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
-}
+using avx2::gather4;
+using avx2::squared_norm;
 
 // The same switches and result as pmb_row_part over the whole of row i.
 template <bool kBreaking, bool kOneBlock, bool kCorrected = false, bool kUniform = false>
@@ -61,10 +47,7 @@ PD_AVX2 RowSums pmb_row_avx2(const PmbArrays& a, std::int64_t i, const double* s
   std::int64_t k = a.offsets[i];
   for (; k + 4 <= end; k += 4) {
     const std::int64_t j[4] = {a.neighbour[k], a.neighbour[k + 1], a.neighbour[k + 2], a.neighbour[k + 3]};
-    std::int32_t flags;
-    std::memcpy(&flags, a.broken + k, 4);
-    const __m256d intact_mask = _mm256_castsi256_pd(
-        _mm256_cmpeq_epi64(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128(flags)), _mm256_setzero_si256()));
+    const __m256d intact_mask = avx2::intact_mask4(a.broken + k);
     const __m256d intact = _mm256_and_pd(intact_mask, one);  // 1.0 or 0.0, the portable row's intact_q
     // bond_terms, operation by operation.
     const __m256d xj0 = gather4(a.x[0], j), xj1 = gather4(a.x[1], j), xj2 = gather4(a.x[2], j);
@@ -101,13 +84,7 @@ PD_AVX2 RowSums pmb_row_avx2(const PmbArrays& a, std::int64_t i, const double* s
     const __m256d scale = _mm256_mul_pd(_mm256_mul_pd(c_vj, s), inv_y);  // c s ν V_j / y
     const __m256d t0 = _mm256_mul_pd(scale, e0), t1 = _mm256_mul_pd(scale, e1), t2 = _mm256_mul_pd(scale, e2);
     const __m256d t3 = _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(quarter, c_vj), s), s), length);
-    // (t0, t1, t2, t3) of bonds k … k+3 → one vector per bond, added in bond order.
-    const __m256d lo01 = _mm256_unpacklo_pd(t0, t1), hi01 = _mm256_unpackhi_pd(t0, t1);
-    const __m256d lo23 = _mm256_unpacklo_pd(t2, t3), hi23 = _mm256_unpackhi_pd(t2, t3);
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(lo01, lo23, 0x20));
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(hi01, hi23, 0x20));
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(lo01, lo23, 0x31));
-    sums = _mm256_add_pd(sums, _mm256_permute2f128_pd(hi01, hi23, 0x31));
+    sums = avx2::add_in_bond_order(sums, t0, t1, t2, t3);  // bonds k … k+3, in order
   }
   alignas(32) double out[4];
   _mm256_store_pd(out, sums);
@@ -115,8 +92,6 @@ PD_AVX2 RowSums pmb_row_avx2(const PmbArrays& a, std::int64_t i, const double* s
   return pmb_row_part<kBreaking, kOneBlock, kCorrected, kUniform>(a, i, s0_pair, k,
                                                                    RowSums{out[0], out[1], out[2], out[3], over});
 }
-
-#undef PD_AVX2
 
 }  // namespace
 }  // namespace pd
