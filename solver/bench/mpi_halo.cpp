@@ -32,12 +32,11 @@
 #include <string>
 #include <vector>
 
+#include "core/avx2.hpp"
 #include "core/model.hpp"
 #include "core/stability.hpp"
 #include "integrators/integrator.hpp"
 #include "lattice.hpp"
-#include "materials/lps/lps.hpp"
-#include "materials/pmb/pmb.hpp"
 #include "operator/force_operator.hpp"
 #include "parallel/local_model.hpp"
 #include "parallel/mpi_decomposed.hpp"
@@ -69,8 +68,7 @@ int main(int argc, char** argv) {
         MPI_Finalize();
         return 2;
       }
-      pd::set_pmb_avx2_rows(kernel == "auto");
-      pd::set_lps_avx2_rows(kernel == "auto");
+      pd::set_avx2_rows(kernel == "auto");
     }
     ++k;
   }

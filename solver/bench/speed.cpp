@@ -30,8 +30,8 @@
 #include <filesystem>
 #include <string>
 
+#include "core/avx2.hpp"
 #include "core/model.hpp"
-#include "materials/lps/lps.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "integrators/integrator.hpp"
 #include "io/node_file.hpp"
@@ -85,8 +85,7 @@ int main(int argc, char** argv) {
     else return usage();
   }
   if (side < 4 || steps < 1 || (kernel != "auto" && kernel != "portable")) return usage();
-  pd::set_pmb_avx2_rows(kernel == "auto");
-  pd::set_lps_avx2_rows(kernel == "auto");
+  pd::set_avx2_rows(kernel == "auto");
   if (threads > 0) omp_set_num_threads(threads);
   threads = omp_get_max_threads();
 

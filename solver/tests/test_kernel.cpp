@@ -8,6 +8,7 @@
 #include <cstring>
 #include <random>
 
+#include "core/avx2.hpp"
 #include "core/partial_volume.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "lattice.hpp"
@@ -144,10 +145,10 @@ TEST(Kernel, UniformVolumePathIsBitwiseTheGeneralPath) {
 // with one block and with two, LAMMPS's order (force first) and its per-node s0; rows whose lengths are not multiples of 4; a bond crushed to a
 // point; over rounds that break bonds. Forces, W, flags, counts and lost energy are compared.
 TEST(Kernel, Avx2RowIsBitwiseThePortableRow) {
-  if (!pd::pmb_avx2_rows()) GTEST_SKIP() << "no AVX2 rows here (a CPU without AVX2, or a build other than GCC on x86-64)";
+  if (!pd::avx2_rows()) GTEST_SKIP() << "no AVX2 rows here (a CPU without AVX2, or a build other than GCC on x86-64)";
   // The switch back on whatever happens below (an ASSERT returns early).
   struct Restore {
-    ~Restore() { pd::set_pmb_avx2_rows(true); }
+    ~Restore() { pd::set_avx2_rows(true); }
   } restore;
   struct Variant {
     const char* name;
@@ -191,12 +192,12 @@ TEST(Kernel, Avx2RowIsBitwiseThePortableRow) {
       double lost[2] = {0.0, 0.0};
       std::int64_t count[2] = {0, 0};
       for (int r = 0; r < 2; ++r) {
-        pd::set_pmb_avx2_rows(r == 0);
+        pd::set_avx2_rows(r == 0);
         ASSERT_EQ(pd::pmb_arrays(models[r], u).avx2, r == 0);
         count[r] = v.lammps_rules ? pd::break_bonds_lammps_rules(models[r], u, &f[r], w[r].data(), &lost[r], nullptr, nullptr)
                                   : pd::break_bonds_and_add_pmb_force(models[r], u, f[r], w[r].data(), &lost[r]);
       }
-      pd::set_pmb_avx2_rows(true);
+      pd::set_avx2_rows(true);
       broke += count[0];
       EXPECT_EQ(count[0], count[1]) << v.name;
       EXPECT_EQ(std::memcmp(&lost[0], &lost[1], sizeof(double)), 0) << v.name;

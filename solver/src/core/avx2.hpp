@@ -1,8 +1,10 @@
 // What the bond kernels' hand-written AVX2 rows share (materials/pmb/pmb_row_avx2.hpp,
 // materials/lps/lps_row_avx2.hpp; docs/performance.md §7): whether this build and this CPU have
-// them, and the few vector steps both rows take alike. Every step is the IEEE operation of the
+// them, the switch that turns them off, and the few vector steps both rows take alike. Every step is the IEEE operation of the
 // portable rows, in their order: the rows' results are bitwise those of the portable code.
 #pragma once
+
+#include <atomic>
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 // GCC on x86-64: the rows are compiled for AVX2 (target "avx2" without "fma", so no product and
@@ -62,5 +64,13 @@ inline bool cpu_has_avx2() {
   return false;
 #endif
 }
+
+// Whether the PMB and LPS kernels may use their AVX2 rows: on by default; off, every row is the
+// portable code. The results are the same bits either way: the switch is for the tests that say so
+// and for `pd_speed`/`pd_mpi_halo --kernel portable`, which measure what the AVX2 rows gain. Read
+// when a kernel's arrays are made (PmbArrays::avx2, LpsKernel::avx2).
+inline std::atomic<bool> avx2_rows_enabled{true};
+inline void set_avx2_rows(bool enabled) { avx2_rows_enabled.store(enabled, std::memory_order_relaxed); }
+inline bool avx2_rows() { return avx2_rows_enabled.load(std::memory_order_relaxed) && cpu_has_avx2(); }
 
 }  // namespace pd

@@ -19,6 +19,7 @@
 #include "lattice.hpp"
 #include "lps_lattice.hpp"
 #include "materials/bond_model.hpp"
+#include "core/avx2.hpp"
 #include "materials/lps/lps.hpp"
 #include "materials/lps/lps_kernel.hpp"
 #include "integrators/integrator.hpp"
@@ -485,9 +486,9 @@ TEST(Lps, Avx2RowsAreBitwiseThePortableRows) {
   // three rounds of random displacements that break bonds. Compared bit for bit: θ (the sweep
   // without breaking), f and W without breaking, then with breaking: the counts, flags, f, W and
   // the lost energy per node.
-  if (!pd::lps_avx2_rows()) GTEST_SKIP() << "no AVX2 rows here (a CPU without AVX2, or a build other than GCC on x86-64)";
+  if (!pd::avx2_rows()) GTEST_SKIP() << "no AVX2 rows here (a CPU without AVX2, or a build other than GCC on x86-64)";
   struct Restore {  // the AVX2 rows on again for the tests after this one, even if an ASSERT ends it
-    ~Restore() { pd::set_lps_avx2_rows(true); }
+    ~Restore() { pd::set_avx2_rows(true); }
   } restore;
   struct Variant {
     const char* name;
@@ -537,7 +538,7 @@ TEST(Lps, Avx2RowsAreBitwiseThePortableRows) {
         pd::Vec3Array f_plain[2], f_break[2];
         pd::BreakReport report[2];
         for (int r = 0; r < 2; ++r) {
-          pd::set_lps_avx2_rows(r == 0);
+          pd::set_avx2_rows(r == 0);
           pd::Model& m = models[r];
           ASSERT_EQ(pd::LpsKernel(law(m), m, u).avx2, r == 0) << what;
           theta[r] = m.bond_model->dilatation(m, u);

@@ -68,14 +68,6 @@ inline double influence(Influence kind, double length, double horizon) {
   return influence_of<Influence::one>(length, horizon);
 }
 
-// Whether the LPS sweeps may use their AVX2 rows (lps_row_avx2.hpp; on by default where the CPU
-// has AVX2; off, every row is the portable code). The results are the same bits either way: the
-// switch is for the test that says so and for `pd_speed --kernel portable`, which measures what the
-// AVX2 rows gain. PMB's kernel has its own switch (set_pmb_avx2_rows, pmb.hpp), so that each test
-// turns off only the rows it compares; --kernel sets both.
-void set_lps_avx2_rows(bool enabled);
-bool lps_avx2_rows();  // on and available on this CPU
-
 // The moduli of one block for the analysis: κ (3D bulk, or in-plane bulk in 2D) and μ [Pa].
 struct LpsModuli {
   double kappa = 0.0;

@@ -5,7 +5,6 @@
 // lps_row.hpp (portable) and lps_row_avx2.hpp (AVX2 intrinsics, taken where the CPU has AVX2: the
 // same bits, fewer stores; docs/performance.md §7).
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -16,13 +15,6 @@
 #include "parallel/decomposed.hpp"
 
 namespace pd {
-
-namespace {
-std::atomic<bool> avx2_rows_enabled{true};
-}  // namespace
-
-void set_lps_avx2_rows(bool enabled) { avx2_rows_enabled.store(enabled, std::memory_order_relaxed); }
-bool lps_avx2_rows() { return avx2_rows_enabled.load(std::memory_order_relaxed) && cpu_has_avx2(); }
 
 namespace {
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/avx2.hpp"
 #include "materials/lps/lps.hpp"
 
 namespace pd {
@@ -32,7 +33,7 @@ struct LpsKernel {
   Influence kind;
   double horizon;
   std::int64_t nodes;
-  bool avx2;  // the fast sweeps' rows by the AVX2 code (lps_row_avx2.hpp): lps_avx2_rows() when made
+  bool avx2;  // the fast sweeps' rows by the AVX2 code (lps_row_avx2.hpp): avx2_rows() (core/avx2.hpp) when made
 
   LpsKernel(const LpsModel& law, const Model& model, const Vec3Array& uu) {
     offsets = model.bonds.offsets.data();
@@ -53,7 +54,7 @@ struct LpsKernel {
     kind = law.influence_;
     horizon = law.horizon_;
     nodes = static_cast<std::int64_t>(model.nodes.size());
-    avx2 = lps_avx2_rows();
+    avx2 = avx2_rows();
   }
 
   // Bond k = i→j at u: |ξ|, e = y_j − y_i, y = |e|, raw = y − |ξ| and the extension ext = raw but

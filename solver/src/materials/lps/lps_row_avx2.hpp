@@ -1,6 +1,6 @@
 // The fast rows of the LPS kernel's two sweeps written with AVX2 intrinsics: bitwise the portable
 // rows (lps_row.hpp). Internal to the LPS kernel (lps_kernel.cpp includes it and picks these rows
-// when the CPU has AVX2 and lps_avx2_rows() is on).
+// when avx2_rows() is on: core/avx2.hpp).
 //
 // Why by hand, as PMB's row (materials/pmb/pmb_row_avx2.hpp, docs/performance.md §7): GCC's
 // vectorised portable rows store each bond's terms lane by lane into per-chunk arrays and sum them

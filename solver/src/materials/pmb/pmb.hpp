@@ -34,18 +34,12 @@ struct PmbArrays {
   // One block, no surface correction, full volumes (ν = 1) and the same V_i for every node: the
   // kernel then reads no V_j and computes no ν (bitwise the same terms).
   bool uniform = false;
-  // Rows by the AVX2 code (pmb_row_avx2.hpp), bitwise the portable rows: set by pmb_arrays when
-  // the CPU has AVX2 and pmb_avx2_rows is on.
+  // Rows by the AVX2 code (pmb_row_avx2.hpp), bitwise the portable rows: set by pmb_arrays from
+  // avx2_rows() (core/avx2.hpp: the CPU has AVX2 and the switch is on).
   bool avx2 = false;
 };
 
 PmbArrays pmb_arrays(const Model& model, const Vec3Array& u);
-
-// Whether the kernel may use its AVX2 rows (on by default where the CPU has AVX2; off, every row is
-// the portable code). The results are the same bits either way: the switch is for the test that
-// says so and for `pd_speed --kernel portable`, which measures what the AVX2 rows gain.
-void set_pmb_avx2_rows(bool enabled);
-bool pmb_avx2_rows();  // on and available on this CPU
 
 // Bond breaking fused into the force pass (see add_pmb_force_density).
 struct PmbBreaking {

@@ -2,10 +2,10 @@
 #include "materials/pmb/pmb.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 
+#include "core/avx2.hpp"
 #include "core/exact_sum.hpp"
 #include "materials/pmb/pmb_row.hpp"
 #include "materials/pmb/pmb_row_avx2.hpp"
@@ -32,16 +32,9 @@ PmbArrays pmb_arrays(const Model& m, const Vec3Array& u) {
   // 122 bonds per node in the kernel.
   a.uniform = a.blocks == 1 && !a.factor && a.volume_weight.outer == HUGE_VAL && a.nodes > 0;
   for (std::int64_t i = 1; a.uniform && i < a.nodes; ++i) a.uniform = a.volume[i] == a.volume[0];
-  a.avx2 = pmb_avx2_rows();
+  a.avx2 = avx2_rows();
   return a;
 }
-
-namespace {
-std::atomic<bool> avx2_rows_enabled{true};
-}  // namespace
-
-void set_pmb_avx2_rows(bool enabled) { avx2_rows_enabled.store(enabled, std::memory_order_relaxed); }
-bool pmb_avx2_rows() { return avx2_rows_enabled.load(std::memory_order_relaxed) && cpu_has_avx2(); }
 
 namespace {
 
