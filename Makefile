@@ -111,6 +111,9 @@ else
 
 .PHONY: all run figures help test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
 .DELETE_ON_ERROR:
+# `make case=X` with no goal runs the pipeline: said, since the first rule below is help's (and the
+# locked make above re-runs this one with no goal either).
+.DEFAULT_GOAL := all
 
 # The list at the top of this file.
 help:
