@@ -27,9 +27,46 @@ case    ?= membrane
 # $(value) and := never expand the text they hold, so a `$(shell …)` in the value stays text.
 SAFE_NAME_CHARS := a b c d e f g h i j k l m n o p q r s t u v w x y z \
                    A B C D E F G H I J K L M N O P Q R S T U V W X Y Z 0 1 2 3 4 5 6 7 8 9 _ -
-# $(call unsafe_name,VAR): empty if the unexpanded value of VAR matches [A-Za-z0-9_-]+.
-unsafe_name = $(strip $(eval _pd_rest := $$(value $(1)))$(foreach c,$(SAFE_NAME_CHARS),$(eval \
-    _pd_rest := $$(subst $(c),,$$(_pd_rest))))$(if $(filter-out 1,$(words $(value $(1))))$(_pd_rest),bad))
+# $(call unsafe_chars,VAR,CHARS): empty if the unexpanded value of VAR is made of CHARS (and spaces)
+# alone. None of the shell's special characters is in any list given to it, so a checked value
+# that reaches a recipe is words and nothing else.
+unsafe_chars = $(strip $(eval _pd_rest := $$(value $(1)))$(foreach c,$(2),$(eval \
+    _pd_rest := $$(subst $$(c),,$$(_pd_rest))))$(_pd_rest))
+# $(call unsafe_name,VAR): empty if the unexpanded value of VAR matches [A-Za-z0-9_-]+ (one word).
+unsafe_name = $(strip $(call unsafe_chars,$(1),$(SAFE_NAME_CHARS))$(if $(filter-out 1,$(words $(value $(1)))),bad))
+DIGITS := 0 1 2 3 4 5 6 7 8 9
+# $(call not_count,VAR): empty if VAR is one word of digits (a whole number ≥ 0).
+not_count = $(strip $(call unsafe_chars,$(1),$(DIGITS))$(if $(filter-out 1,$(words $(value $(1)))),bad))
+
+# Issue 36, item 4: every variable of this file that reaches a shell is either computed here and
+# refused from the command line (`make clean-case OUT=/tmp/x` ran `rm -rf -- '/tmp/x'`), or a
+# setting checked like case= below (`LOCK_WAIT="0' …; touch /tmp/pwn; echo '"` ran the touch).
+# `override` keeps them ours under `make -e` too. SOLVER_SOURCES (tests set it empty) reaches no shell.
+INTERNAL_VARIABLES := OUT CASEDIR YAML MESH GIVEN_MESH CHECKPOINT MPIRUN RANK_THREADS PY PYTEST DEPS \
+    ASAN_DIR FUZZ_DIR FUZZ_TARGETS BENCH_DEPS PD_CASE_LOCK LOCKED_GOALS DRY_RUN MAKE SHELL .SHELLFLAGS
+$(foreach v,$(INTERNAL_VARIABLES),$(if $(filter command line,$(origin $(v))),$(error $(v) is set by \
+    this Makefile, not on the command line: $(if $(filter OUT CASEDIR YAML MESH CHECKPOINT,$(v)),the output \
+    folder follows from case= and config= (out/<case>[-<config>]/),give case=, config=, RANKS=, SOLVER=, LOCK_WAIT= and \
+    the other settings of `make help` instead))))
+# Settings of numbers: digits only (LOCK_WAIT may have a decimal point, as flock -w takes).
+ifneq ($(call unsafe_chars,LOCK_WAIT,$(DIGITS) .)$(filter-out 0 1,$(words $(value LOCK_WAIT))),)
+  $(error LOCK_WAIT='$(value LOCK_WAIT)' is not a number of seconds: digits and '.' only, e.g. LOCK_WAIT=600)
+endif
+$(foreach v,JOBS FUZZ_SECONDS,$(if $(and $(value $(v)),$(call not_count,$(v))),$(error \
+    $(v)='$(value $(v))' is not a whole number: digits only, e.g. $(v)=2)))
+$(foreach v,BENCH_SIDES BENCH_MPI_SIDES,$(if $(call unsafe_chars,$(v),$(DIGITS)),$(error \
+    $(v)='$(value $(v))' is not a list of brick sides: numbers separated by spaces, e.g. $(v)="40 100")))
+# Free-form options of the benchmarks and the path of another solver: words of these characters only.
+SAFE_ARG_CHARS := $(SAFE_NAME_CHARS) . , = : / +
+$(foreach v,ACCURACY_ARGS IMPLICIT_ARGS SOLVER,$(if $(call unsafe_chars,$(v),$(SAFE_ARG_CHARS)),$(error \
+    $(v)='$(value $(v))' holds a character a shell would read: letters, digits and _ - . , = : / + only)))
+# Goals reach a shell too (the lock's recipe below names them): words of the same characters.
+ifneq ($(call unsafe_chars,MAKECMDGOALS,$(SAFE_ARG_CHARS)),)
+  $(error goal '$(value MAKECMDGOALS)' holds a character a shell would read: see `make help` for the goals)
+endif
+ifneq ($(filter-out 0 1,$(words $(value SOLVER))),)
+  $(error SOLVER='$(value SOLVER)' is not one path: give the solver's path without spaces)
+endif
 CASE_NAMES = $(patsubst cases/%/,%,$(wildcard cases/*/))
 ifneq ($(call unsafe_name,case),)
   $(error case='$(value case)' is not a case name: a case is a folder cases/<name>/ with <name> made of \
@@ -48,16 +85,22 @@ ifneq ($(strip $(filter-out 0 1 2 3 4 5 6 7 8 9,$(subst 0,0 ,$(subst 1,1 ,$(subs
         $(subst 5,5 ,$(subst 6,6 ,$(subst 7,7 ,$(subst 8,8 ,$(subst 9,9 ,$(RANKS)))))))))))) $(filter 0 00 000,$(RANKS))),)
   $(error RANKS=$(RANKS) is not a number of MPI ranks ≥ 1: digits only, e.g. RANKS=2)
 endif
+# RANKS=1000 started a thousand processes on 2 cores without a word (issue 36, item 10): at most 4
+# ranks per core, as pdsolve's --threads allows at most 4 threads per core.
+ifneq ($(shell [ '$(RANKS)' -le $$(( 4 * $$(nproc) )) ] 2>/dev/null || echo over),)
+  $(error RANKS=$(RANKS) is more than 4 ranks per core on this machine ($(shell nproc) cores): give RANKS=$(shell nproc) or fewer \
+      (each rank runs OMP_NUM_THREADS threads); on a cluster, start pdsolve with the cluster's own launcher)
+endif
 # One rank: pdsolve alone (the serial path). More: under mpiexec; --oversubscribe lets a small machine
 # run more ranks than it has cores (for tests; a cluster's launcher places ranks itself).
 # Threads per rank: OMP_NUM_THREADS if it is set, else the cores shared out among the ranks (at
 # least 1), passed to every rank with -x: R ranks each starting as many threads as cores would put
 # R × cores threads on the cores (2 ranks × 2 spinning threads on 2 cores: 0.8–0.9 × 10⁸ bond
 # updates/s at 40³ against 4.3 × 10⁸ for 2 ranks × 1 thread, docs/performance.md §7).
-RANK_THREADS := $(if $(filter-out 1,$(RANKS)),$(if $(OMP_NUM_THREADS),,$(shell t=$$(( $$(nproc) / $(RANKS) )); [ $$t -ge 1 ] || t=1; echo $$t)))
+override RANK_THREADS := $(if $(filter-out 1,$(RANKS)),$(if $(OMP_NUM_THREADS),,$(shell t=$$(( $$(nproc) / $(RANKS) )); [ $$t -ge 1 ] || t=1; echo $$t)))
 # Through pipeline/run-ranks.sh: it passes a Ctrl-C or SIGTERM to the ranks themselves, which finish
 # their step and write checkpoint.bin; Open MPI's mpirun would kill them 2 s after the signal.
-MPIRUN := $(if $(filter-out 1,$(RANKS)),sh pipeline/run-ranks.sh mpiexec --oversubscribe -np $(RANKS)$(if $(RANK_THREADS), -x OMP_NUM_THREADS=$(RANK_THREADS)))
+override MPIRUN := $(if $(filter-out 1,$(RANKS)),sh pipeline/run-ranks.sh mpiexec --oversubscribe -np $(RANKS)$(if $(RANK_THREADS), -x OMP_NUM_THREADS=$(RANK_THREADS)))
 
 ifeq ($(origin config),undefined)
   config := $(case)
@@ -71,42 +114,48 @@ ifeq ($(wildcard cases/$(case)/$(config).yaml),)
       $(patsubst cases/$(case)/%.yaml,%,$(wildcard cases/$(case)/*.yaml)))
 endif
 
-PY      := /usr/bin/python3
-PYTEST  := /usr/bin/python3 -m pytest
+override PY      := /usr/bin/python3
+override PYTEST  := /usr/bin/python3 -m pytest
 JOBS    ?= 2
-CASEDIR := cases/$(case)
-YAML    := $(CASEDIR)/$(config).yaml
-OUT     := out/$(case)$(if $(filter-out $(case),$(config)),-$(config))
+override CASEDIR := cases/$(case)
+override YAML    := $(CASEDIR)/$(config).yaml
+override OUT     := out/$(case)$(if $(filter-out $(case),$(config)),-$(config))
 SOLVER  := build/solver/pdsolve
-DEPS    := build/.deps-ok
+override DEPS    := build/.deps-ok
 
 # A case either brings its own mesh (cases/<case>/<case>.unv or .msh) or is meshed from its .geo.
-GIVEN_MESH := $(firstword $(wildcard $(CASEDIR)/$(case).unv $(CASEDIR)/$(case).msh))
-MESH       := $(if $(GIVEN_MESH),$(GIVEN_MESH),$(OUT)/mesh.msh)
+override GIVEN_MESH := $(firstword $(wildcard $(CASEDIR)/$(case).unv $(CASEDIR)/$(case).msh))
+override MESH       := $(if $(GIVEN_MESH),$(GIVEN_MESH),$(OUT)/mesh.msh)
 
 PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
 POST_SOURCES   := $(wildcard postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
 
-# One make at a time per case output folder (issue 17, item 8): two `make case=X` in one tree drew
-# each other's frames in progress and read half-written history rows. A goal that writes out/<case>/
-# re-runs make under flock(1) (util-linux) on $(OUT)/.lock, held until that make ends; a second
-# make fails at once saying who holds it, or waits LOCK_WAIT seconds for it (LOCK_WAIT=600).
+# One writer at a time per case output folder (issue 17, item 8; issue 36, items 5-7): two
+# `make case=X` in one tree drew each other's frames in progress and read half-written history rows.
+# A goal that writes out/<case>/ takes flock(2) on $(OUT)/.lock, the lock peridyn's Case.run,
+# validation and bench take too (pipeline/output_lock.py), and re-runs make holding it; a second
+# writer fails at once saying who holds it, or waits LOCK_WAIT seconds for it (LOCK_WAIT=600).
+# The shell opens the lock as fd 9, locks it and then *becomes* the inner make (exec), which hands fd
+# 9 down to the solver: so (a) the lock is held exactly as long as a process of this run lives, and
+# (b) no process stands between this make and the inner one. Before, flock(1) stood there: a SIGTERM
+# to this make's pid alone (`kill <pid>`) killed flock, not the run, and orphaned the solver with no
+# checkpoint; a SIGTERM to the group let this make return while the solver was still writing its
+# checkpoint. Now GNU make passes SIGTERM to its child and waits for it, at each level.
 UNLOCKED_GOALS := help test test-asan fuzz solver deps check clean bench bench-accuracy bench-implicit validate
-LOCKED_GOALS   := $(filter-out $(UNLOCKED_GOALS),$(or $(MAKECMDGOALS),all))
+override LOCKED_GOALS   := $(filter-out $(UNLOCKED_GOALS),$(or $(MAKECMDGOALS),all))
 LOCK_WAIT      ?= 0
-DRY_RUN        := $(findstring n,$(firstword -$(MAKEFLAGS)))# make -n writes nothing: no lock
+override DRY_RUN        := $(findstring n,$(firstword -$(MAKEFLAGS)))# make -n writes nothing: no lock
 ifneq ($(and $(LOCKED_GOALS),$(if $(PD_CASE_LOCK)$(DRY_RUN),,locked)),)
 .PHONY: $(or $(MAKECMDGOALS),all) pd-case-lock
 $(or $(MAKECMDGOALS),all): pd-case-lock ; @:
 pd-case-lock:
 	@mkdir -p '$(OUT)'
-	+@flock -w '$(LOCK_WAIT)' -E 75 '$(OUT)/.lock' true || { \
-	  echo "error: $(OUT)/ is in use by another make ($$(cat '$(OUT)/.lock' 2>/dev/null || echo unknown)); wait \
-	for it to finish (or stop it: its Ctrl-C writes a checkpoint), or give LOCK_WAIT=<seconds> to wait" >&2; exit 75; }
-	+@PD_CASE_LOCK=1 exec flock -w '$(LOCK_WAIT)' -E 75 '$(OUT)/.lock' sh -c \
-	    'echo "pid $$$$, make $(MAKECMDGOALS) case=$(case) config=$(config), since $$(date +%T)" > "$$1"; shift; exec "$$@"' \
-	    sh '$(OUT)/.lock' $(MAKE) --no-print-directory $(MAKECMDGOALS)
+	+@exec 9>>'$(OUT)/.lock'; flock -w '$(LOCK_WAIT)' -E 75 9 || { \
+	  echo "error: $(OUT)/ is in use by another run ($$(cat '$(OUT)/.lock' 2>/dev/null || echo unknown)); wait \
+	for it to finish (or stop it: its Ctrl-C writes a checkpoint), or give LOCK_WAIT=<seconds> to wait" >&2; exit 75; }; \
+	echo "pid $$$$, make $(MAKECMDGOALS) case=$(case) config=$(config), since $$(date +%T)" > '$(OUT)/.lock'; \
+	PD_CASE_LOCK=1 exec $(MAKE) --no-print-directory $(MAKECMDGOALS)
 else
 
 .PHONY: all run figures help test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
@@ -154,7 +203,7 @@ $(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
 # it had never stopped, as long as the checkpoint is newer than the case, the nodes and the solver.
 # exec: the solver replaces the shell, so a SIGTERM that make passes to its child reaches the solver
 # (which then writes its checkpoint) instead of killing a shell and orphaning the solver.
-CHECKPOINT := $(OUT)/checkpoint.bin
+override CHECKPOINT := $(OUT)/checkpoint.bin
 $(OUT)/.solved: $(OUT)/case.json $(OUT)/nodes.vtu $(SOLVER)
 	@if [ -f '$(CHECKPOINT)' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/case.json' ] && [ '$(CHECKPOINT)' -nt '$(OUT)/nodes.vtu' ] \
 	    && [ '$(CHECKPOINT)' -nt '$(SOLVER)' ]; then \
@@ -186,7 +235,7 @@ test: $(SOLVER) | $(DEPS)
 # than -O1 (31.6 against 13.0 CPU s for test_quasi_static.cpp), and its build was most of make
 # test's time. Asserts stay on. LpsTension's C3 lattices (138 s of the 247 s under ASan at -O1, 2
 # threads) run in the Release ctest only: their kernels are the LPS tests' here too.
-ASAN_DIR := build/solver-asan
+override ASAN_DIR := build/solver-asan
 test-asan: | $(DEPS)
 	cmake -S solver -B $(ASAN_DIR) -DPD_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g"
@@ -201,9 +250,9 @@ test-asan: | $(DEPS)
 # command line (pipeline/fuzz_cli.py): every run ends with a documented exit code, no signal.
 # The binary checkpoint has no dictionary: its few constants are in the seeds, and libFuzzer
 # picks up the ones the reader compares against.
-FUZZ_DIR     := build/solver-fuzz
+override FUZZ_DIR     := build/solver-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case pd_fuzz_checkpoint
+override FUZZ_TARGETS := pd_fuzz_node_file pd_fuzz_vtu pd_fuzz_case pd_fuzz_checkpoint
 fuzz: $(SOLVER) | $(DEPS)
 	cmake -S solver -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DPD_FUZZ=ON -DPD_BUILD_TESTS=OFF \
 	    -DCMAKE_BUILD_TYPE=RelWithDebInfo
@@ -230,7 +279,7 @@ fuzz: $(SOLVER) | $(DEPS)
 BENCH_SIDES ?= 40 46 100
 # MPI rows (issue 15): 1 and 2 ranks × 1 and 2 threads beside LAMMPS on 2 ranks (bench/mpi_ranks.py).
 BENCH_MPI_SIDES ?= 40 100
-BENCH_DEPS  := build/.bench-deps-ok
+override BENCH_DEPS  := build/.bench-deps-ok
 $(BENCH_DEPS): pipeline/install-deps.sh
 	sh pipeline/install-deps.sh lammps openmpi-bin
 	@mkdir -p $(@D) && touch $@

@@ -49,6 +49,7 @@ from postprocess.series import read_frame, read_series  # noqa: E402
 from preprocess.cloud import NodeCloud  # noqa: E402
 from preprocess.node_file import write_node_file  # noqa: E402
 from bench import quasi_static_cases, tension  # noqa: E402
+from pipeline.output_lock import exit_code, output_lock  # noqa: E402
 
 DX = 1.0e-3
 PROBLEMS = ("wave", "fracture", "tension", "traction", "plate_with_hole")
@@ -345,6 +346,13 @@ def main(argv=None) -> int:
                      f"choose from {', '.join(PROBLEMS)}")
     if not os.path.isfile(args.solver):
         parser.error(f"{args.solver} is missing: build it with `make solver`")
+    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    with output_lock(args.out, "make bench-accuracy (bench.accuracy)"):
+        return measure(args)
+
+
+def measure(args):
+    """The runs of main(), with the output folder locked."""
     repeat = 1 if args.quick else max(1, args.repeat)
     os.makedirs(args.out, exist_ok=True)
     load = os.getloadavg()[0]
@@ -433,4 +441,4 @@ def plot(rows: list[dict], path: str, threads: int):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(exit_code(main))

@@ -49,6 +49,7 @@ from bench.accuracy import machine, run, stable_dt  # noqa: E402  (read-only use
 from postprocess.series import read_frame, read_series  # noqa: E402
 from preprocess.cloud import NodeCloud  # noqa: E402
 from preprocess.node_file import write_node_file  # noqa: E402
+from pipeline.output_lock import exit_code, output_lock  # noqa: E402
 
 L = 0.05           # m: free span, as cases/drum
 EPS0 = 1.0e-3      # pre-strain
@@ -221,6 +222,13 @@ def main(argv=None) -> int:
     parser.add_argument("--tols", default="1e-2,1e-3,1e-4,1e-5", help="implicit.tol values")
     parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
     args = parser.parse_args(argv)
+    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    with output_lock(args.out, "make bench-implicit (bench.implicit_dynamics)"):
+        return measure(args)
+
+
+def measure(args):
+    """The runs of main(), with the output folder locked."""
     rows = []
     for load in args.loads.split(","):
         rows += bench_load(args, load)
@@ -234,4 +242,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(exit_code(main))

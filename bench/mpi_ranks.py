@@ -24,7 +24,10 @@ import csv
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
+
+from pipeline.output_lock import exit_code, output_lock
 
 # 40³: 100 steps, a timed window of ~1.5 s on 2 ranks; at 40 steps (~0.6 s) one preemption by another
 # process moved the 2-rank row by 10 % or more.
@@ -72,6 +75,13 @@ def main():
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--out", default="out/bench/mpi.csv")
     args = ap.parse_args()
+    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    with output_lock(os.path.dirname(args.out) or ".", "make bench (bench.mpi_ranks)"):
+        return measure(args)
+
+
+def measure(args):
+    """The MPI rows of main(), with the output folder locked."""
     exe = os.path.join(args.build, "pd_mpi_halo")
     if not os.path.exists(exe) or shutil.which("mpiexec") is None:
         print(f"MPI rows skipped: {exe} or mpiexec missing (pdsolve built without PD_MPI, or no openmpi-bin)")
@@ -135,4 +145,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(exit_code(main))

@@ -25,6 +25,8 @@ import subprocess
 import sys
 import tempfile
 
+from pipeline.output_lock import exit_code, output_lock
+
 STEPS = {40: 40, 46: 30, 100: 10}  # ~0.1–1 s of loop per run at the target rate
 
 
@@ -153,6 +155,13 @@ def main():
     ap.add_argument("--order-side", type=int, default=40,
                     help="brick side of the node-order study (0: skip it)")
     args = ap.parse_args()
+    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    with output_lock(os.path.dirname(args.out) or ".", "make bench (bench.speed)"):
+        return measure(args)
+
+
+def measure(args):
+    """The measurements of main(), with the output folder locked."""
     exe = os.path.join(args.build, "pd_speed")
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     workdir = os.path.join(os.path.dirname(args.out), "tmp")
@@ -221,4 +230,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(exit_code(main))

@@ -11,6 +11,7 @@ import subprocess
 import yaml
 
 from pipeline.case import CaseError, load_case
+from pipeline.output_lock import FolderInUse, output_lock
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3"
@@ -102,12 +103,23 @@ class Case:
         parameters changed (as make does); the solver's output goes to <out_dir>/solver.log.
         solver: pdsolve's path (default: PDSOLVE, else build/solver/pdsolve); threads: its --threads.
         """
+        say = log or (lambda text: None)
+        out_dir = os.path.abspath(out_dir)
+        # The lock make takes too (pipeline/output_lock.py): two runs into one folder, or a run beside
+        # `make case=X` into out/X/, wrote each other's files (issue 36, item 5).
+        try:
+            with output_lock(out_dir, f"peridyn Case.run of {self.source}") as lock_fd:
+                return self._run_locked(out_dir, lock_fd, figures, threads, solver, say)
+        except FolderInUse as error:
+            raise RunError(str(error)) from None
+
+    def _run_locked(self, out_dir, lock_fd, figures, threads, solver, say):
+        """run()'s stages, with out_dir locked by lock_fd (handed to the solver: the folder stays
+        locked while it runs, even if this process is killed)."""
         from pipeline import run as stages
 
         from .results import Run
 
-        say = log or (lambda text: None)
-        out_dir = os.path.abspath(out_dir)
         name = os.path.basename(out_dir)
         yaml_path = self.write(os.path.join(out_dir, name + ".yaml"))
         kind, mesh = self.mesh_source()
@@ -129,7 +141,7 @@ class Case:
         command = [solver, os.path.join(out_dir, "case.json")] + (["--threads", str(threads)] if threads else [])
         say("solve: " + " ".join(command))
         with open(os.path.join(out_dir, "solver.log"), "w", encoding="utf-8") as stream:
-            status = subprocess.run(command, stdout=stream, stderr=subprocess.STDOUT).returncode
+            status = subprocess.run(command, stdout=stream, stderr=subprocess.STDOUT, pass_fds=(lock_fd,)).returncode
         if status != 0:
             raise RunError(f"{' '.join(command)} failed (exit {status}); see {out_dir}/solver.log and run.log")
         if figures:

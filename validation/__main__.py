@@ -15,6 +15,7 @@ import time
 from . import branching, c3_lps, convergence, drum, plate_with_hole, static, three_point_bending, traction, wave, wave_lps
 from .figures import FIGURES
 from .runner import ROOT
+from pipeline.output_lock import exit_code, output_lock
 
 CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks,
           "branching-lps": functools.partial(branching.checks, case="branching-lps"), "drum": drum.checks,
@@ -28,6 +29,14 @@ MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.vali
 
 
 def main(argv: list[str]) -> int:
+    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py); the
+    # cases' own folders are locked by the make that runs each.
+    with output_lock(os.path.join(ROOT, "out", "validate"), "make validate"):
+        return validate(argv)
+
+
+def validate(argv: list[str]) -> int:
+    """main()'s runs and checks, with out/validate/ locked."""
     cases = argv or list(CHECKS) + list(MODEL_CHECKS)
     begin = time.monotonic()
     report_dir = os.path.join(ROOT, "out", "validate")
@@ -90,4 +99,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(exit_code(lambda: main(sys.argv[1:])))

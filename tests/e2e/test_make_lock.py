@@ -32,7 +32,7 @@ def test_a_second_make_of_the_same_case_fails_at_once_naming_the_first(tree):
             os.killpg(second.pid, signal.SIGKILL)
             raise AssertionError("the second make ran instead of stopping at the lock")
         assert second.returncode != 0
-        assert f"error: out/{NAME}/ is in use by another make (pid " in err, err
+        assert f"error: out/{NAME}/ is in use by another run (pid " in err, err
         assert f"make out/{NAME}/.solved case={NAME} config={NAME}, since " in err
         assert "give LOCK_WAIT=<seconds> to wait" in err
         assert first.poll() is None                                     # the first goes on

@@ -169,3 +169,95 @@ def test_ctrl_c_to_a_two_rank_make_writes_a_checkpoint(tree, ranks_killed_after)
     assert "2 MPI ranks" in (out / "run.log").read_text()
     assert_whole_checkpoint(out, "SIGINT")
     assert not (out / ".solved").exists()
+
+
+# Issue 36, items 6 and 7: a supervisor's `kill <make's pid>` (SIGTERM to make alone, not its group)
+# orphaned the solver: flock(1) stood between the two makes and died of it, the run went on with the
+# lock held and no checkpoint. And after a SIGTERM to the group, make returned 1-2 s before its
+# solver had written the checkpoint (flock again), so a batch system that kills what is left when
+# the job script ends lost it. Now make returns only when every process of the run is gone.
+
+def solver_pids(out):
+    """pids of the processes (not zombies) whose command line names this run's case.json (make
+    gives it relative to the tree: out/<case>/case.json)."""
+    wanted = f"{out.parent.name}/{out.name}/case.json".encode()
+    pids = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/cmdline", "rb") as stream:
+                cmdline = stream.read().split(b"\0")
+            with open(f"/proc/{entry}/stat", "rb") as stream:
+                state = stream.read().rsplit(b")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if any(arg.endswith(wanted) for arg in cmdline) and state != b"Z":
+            pids.append(int(entry))
+    return pids
+
+
+def lock_is_free(out):
+    """True if this process can take out/<case>/.lock at once (what the next make would do)."""
+    import fcntl
+    with open(out / ".lock", "a") as stream:
+        try:
+            fcntl.flock(stream, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return False
+        fcntl.flock(stream, fcntl.LOCK_UN)
+        return True
+
+
+def test_sigterm_to_makes_pid_alone_writes_a_checkpoint_and_leaves_nothing_running(tree):
+    out = fresh(tree)
+    process = start_make(tree, NAME, f"out/{NAME}/.solved")
+    wait_for_steps(out, process)
+    solvers = solver_pids(out)
+    assert solvers, "no solver process found"
+    try:
+        os.kill(process.pid, signal.SIGTERM)       # `kill <pid>`: make alone, not its group
+        code, err = finish(process)
+        assert code != 0
+        assert solver_pids(out) == [], "the solver runs on after make returned"
+        assert lock_is_free(out)
+        assert_whole_checkpoint(out, "SIGTERM")
+        assert "checkpoint written to" in err      # what make's run prints as it ends says so
+    finally:
+        for pid in solvers:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+
+@pytest.mark.parametrize("to_group", [False, True], ids=["make-alone", "group"])
+def test_make_returns_only_after_its_solver_has_stopped(tree, tmp_path, to_group):
+    out = fresh(tree)
+    # SLOW_STOP alone, not under mpiexec: its marks are started. and stopped. (no rank number).
+    for mark in ("started.", "stopped."):
+        (out / mark).unlink(missing_ok=True)
+    solver = tmp_path / "slow_stop.sh"
+    solver.write_text(SLOW_STOP)
+    solver.chmod(0o755)
+    process = start_make(tree, NAME, f"out/{NAME}/.solved", f"SOLVER={solver}")
+    deadline = time.monotonic() + 60
+    while not (out / "started.").exists():
+        if process.poll() is not None or time.monotonic() > deadline:
+            os.killpg(process.pid, signal.SIGKILL)
+            pytest.fail("the stand-in solver did not start: " + process.communicate(timeout=30)[1])
+        time.sleep(0.05)
+    stand_in = int((out / "started.").read_text())
+    try:
+        if to_group:
+            os.killpg(process.pid, signal.SIGTERM)
+        else:
+            os.kill(process.pid, signal.SIGTERM)
+        finish(process)
+        assert (out / "stopped.").exists(), "make returned before its solver had stopped"
+        assert lock_is_free(out)                   # an immediate re-run is not refused with 75
+    finally:
+        try:
+            os.kill(stand_in, signal.SIGKILL)
+        except ProcessLookupError:
+            pass

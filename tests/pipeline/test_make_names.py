@@ -147,3 +147,56 @@ def test_make_help_lists_the_commands():
     assert any(line.startswith("make case=X RANKS=R ") for line in lines)
     assert any(line.startswith("make test ") for line in lines)
     assert not any(line.startswith("#") for line in lines) and result.stderr == ""
+
+
+# Issue 36, item 4: every other make variable that reaches a shell is checked, or not settable.
+@pytest.mark.parametrize("setting", [
+    "LOCK_WAIT=0' -E 75 /x true; touch {marker}; echo '",
+    "JOBS=2; touch {marker}",
+    "FUZZ_SECONDS=$$(touch {marker})",
+    "BENCH_SIDES=40 `touch {marker}`",
+    "ACCURACY_ARGS=--quick; touch {marker}",
+    "IMPLICIT_ARGS=--loads blow && touch {marker}",
+    "SOLVER=x';touch {marker};'",
+])
+def test_a_command_in_a_setting_never_runs(tmp_path, setting):
+    marker = tmp_path / "pwned"
+    name = setting.split("=", 1)[0]
+    result = make("check", "case=membrane", setting.replace("{marker}", str(marker)))
+    assert result.returncode != 0
+    assert f"{name}='" in result.stderr, result.stderr
+    assert not marker.exists()
+
+
+@pytest.mark.parametrize("variable", ["OUT", "PY", "MPIRUN", "CHECKPOINT", "MAKE", "SHELL"])
+def test_internal_variables_are_not_settable_from_the_command_line(tmp_path, variable):
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (victim / "keep.txt").write_text("precious\n")
+    result = make("clean-case", "case=membrane", f"{variable}={victim}")
+    assert result.returncode != 0
+    assert f"{variable} is set by this Makefile, not on the command line" in result.stderr, result.stderr
+    assert (victim / "keep.txt").read_text() == "precious\n"
+
+
+def test_a_goal_with_shell_characters_never_runs(tmp_path):
+    marker = tmp_path / "pwned"
+    result = make(f"x';touch {marker};'", "case=membrane")
+    assert result.returncode != 0
+    assert "holds a character a shell would read" in result.stderr, result.stderr
+    assert not marker.exists()
+
+
+def test_good_settings_pass():
+    result = make("-n", "clean-case", "case=membrane", "LOCK_WAIT=1.5", "JOBS=3", "BENCH_SIDES=40 100",
+                  "ACCURACY_ARGS=--quick --coarsen 4", "SOLVER=build/solver/pdsolve")
+    assert result.returncode == 0, result.stderr
+    assert "rm -rf -- 'out/membrane'" in result.stdout
+
+
+def test_ranks_beyond_the_machine_are_refused():
+    result = make("-n", "case=membrane", "RANKS=1000")
+    assert result.returncode != 0
+    assert "RANKS=1000 is more than 4 ranks per core on this machine" in result.stderr, result.stderr
+    huge = make("-n", "case=membrane", "RANKS=" + "9" * 40)
+    assert huge.returncode != 0 and "more than 4 ranks per core" in huge.stderr
