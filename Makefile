@@ -42,7 +42,7 @@ not_count = $(strip $(call unsafe_chars,$(1),$(DIGITS))$(if $(filter-out 1,$(wor
 # refused from the command line (`make clean-case OUT=/tmp/x` ran `rm -rf -- '/tmp/x'`), or a
 # setting checked like case= below (`LOCK_WAIT="0' …; touch /tmp/pwn; echo '"` ran the touch).
 # `override` keeps them ours under `make -e` too. SOLVER_SOURCES (tests set it empty) reaches no shell.
-INTERNAL_VARIABLES := OUT CASEDIR YAML MESH GIVEN_MESH CHECKPOINT MPIRUN RANK_THREADS PY PYTEST DEPS \
+INTERNAL_VARIABLES := ALL_SOLVER_TARGETS OUT CASEDIR YAML MESH GIVEN_MESH CHECKPOINT MPIRUN RANK_THREADS PY PYTEST DEPS \
     ASAN_DIR FUZZ_DIR FUZZ_TARGETS BENCH_DEPS PD_CASE_LOCK LOCKED_GOALS DRY_RUN MAKE SHELL .SHELLFLAGS
 $(foreach v,$(INTERNAL_VARIABLES),$(if $(filter command line,$(origin $(v))),$(error $(v) is set by \
     this Makefile, not on the command line: $(if $(filter OUT CASEDIR YAML MESH CHECKPOINT,$(v)),the output \
@@ -177,11 +177,14 @@ $(DEPS): pipeline/install-deps.sh
 	sh pipeline/install-deps.sh
 	@mkdir -p $(@D) && touch $@
 
+# A case needs pdsolve alone: building every test and benchmark too was ~8 of the first
+# `make case=membrane`'s 10 minutes (issue 39, item 4). test, bench and validate build the rest.
 solver: $(SOLVER)
 $(SOLVER): $(SOLVER_SOURCES) | $(DEPS)
 	cmake -S solver -B build/solver -DCMAKE_BUILD_TYPE=Release
-	cmake --build build/solver -j$(JOBS)
+	cmake --build build/solver -j$(JOBS) --target pdsolve
 	@touch $@
+override ALL_SOLVER_TARGETS := cmake --build build/solver -j$(JOBS)
 
 # With the mesh at hand (given, or made by an earlier run), material and node-set names are checked
 # against its physical groups too: a misspelt set is caught here, not only at preprocess.
@@ -225,6 +228,7 @@ figures: | $(DEPS)
 	@touch '$(OUT)/figures/.done'
 
 test: $(SOLVER) | $(DEPS)
+	$(ALL_SOLVER_TARGETS)
 	ctest --test-dir build/solver --output-on-failure -j$(JOBS)
 	$(PYTEST) -q tests
 	@$(MAKE) --no-print-directory test-asan
@@ -284,6 +288,7 @@ $(BENCH_DEPS): pipeline/install-deps.sh
 	sh pipeline/install-deps.sh lammps openmpi-bin
 	@mkdir -p $(@D) && touch $@
 bench: $(SOLVER) | $(DEPS) $(BENCH_DEPS)
+	$(ALL_SOLVER_TARGETS)
 	$(PY) -m bench.speed --build build/solver --sides $(BENCH_SIDES) --out out/bench/speed.csv
 	$(PY) -m bench.mpi_ranks --build build/solver --sides $(BENCH_MPI_SIDES) --out out/bench/mpi.csv
 
@@ -308,6 +313,7 @@ bench-implicit: $(SOLVER) | $(DEPS)
 # The full cases and validation/models/ runs with quantitative checks (validation/README.md):
 # out/validate/report.md, a PNG per check and convergence.png.
 validate: $(SOLVER) | $(DEPS)
+	$(ALL_SOLVER_TARGETS)
 	$(PY) -m validation
 
 clean-case:

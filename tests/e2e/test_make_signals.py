@@ -178,8 +178,8 @@ def test_ctrl_c_to_a_two_rank_make_writes_a_checkpoint(tree, ranks_killed_after)
 # the job script ends lost it. Now make returns only when every process of the run is gone.
 
 def solver_pids(out):
-    """pids of the processes (not zombies) whose command line names this run's case.json (make
-    gives it relative to the tree: out/<case>/case.json)."""
+    """pids of the solvers (not zombies) whose command line names this run's case.json (make gives
+    it relative to the tree: out/<case>/case.json)."""
     wanted = f"{out.parent.name}/{out.name}/case.json".encode()
     pids = []
     for entry in os.listdir("/proc"):
@@ -192,7 +192,8 @@ def solver_pids(out):
                 state = stream.read().rsplit(b")", 1)[1].split()[0]
         except OSError:
             continue
-        if any(arg.endswith(wanted) for arg in cmdline) and state != b"Z":
+        if os.path.basename(cmdline[0]) == b"pdsolve" and any(arg.endswith(wanted) for arg in cmdline) \
+                and state != b"Z":
             pids.append(int(entry))
     return pids
 
@@ -261,3 +262,39 @@ def test_make_returns_only_after_its_solver_has_stopped(tree, tmp_path, to_group
             os.kill(stand_in, signal.SIGKILL)
         except ProcessLookupError:
             pass
+
+
+def mpiexec_pids(out):
+    """pids of the mpiexec whose command line names this run's case.json."""
+    wanted = f"{out.parent.name}/{out.name}/case.json".encode()
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/cmdline", "rb") as stream:
+                    cmdline = stream.read().split(b"\0")
+            except OSError:
+                continue
+            if cmdline and os.path.basename(cmdline[0]) in (b"mpiexec", b"mpirun", b"orterun", b"prterun") \
+                    and any(arg.endswith(wanted) for arg in cmdline):
+                found.append(int(entry))
+    return found
+
+
+@needs_mpiexec
+@pytest.mark.parametrize("target", ["one-rank", "mpiexec"])
+def test_sigterm_to_one_rank_or_to_mpiexec_stops_the_run_with_a_checkpoint(tree, target, ranks_killed_after):
+    """What a supervisor that knows only one of the run's processes sends (issue 36, item 6): every
+    rank stops after the same step, rank 0 writes a whole checkpoint, and nothing of the run is
+    left when make returns."""
+    out = fresh(tree)
+    process = start_ranked_make(tree)
+    wait_for_steps(out, process)
+    ranks = solver_pids(out)
+    launchers = mpiexec_pids(out)
+    assert len(ranks) >= 2 and launchers, (ranks, launchers)
+    os.kill(ranks[-1] if target == "one-rank" else launchers[0], signal.SIGTERM)
+    code, err = finish(process)
+    assert code != 0
+    assert solver_pids(out) == [] and mpiexec_pids(out) == [], "processes of the run outlived make"
+    assert_whole_checkpoint(out, "SIGTERM")
