@@ -25,7 +25,8 @@ def frame_arrays(run, k):
 def test_gmsh_opens_results_with_a_view_per_point_array_and_one_time_step_per_frame(run2d, gmsh_session):
     gmsh = gmsh_session
     gmsh_dir = export(run2d)
-    assert sorted(p.name for p in gmsh_dir.iterdir()) == ["damage_final.pos", "results.msh"]
+    assert sorted(p.name for p in gmsh_dir.iterdir()) == ["damage_final.pos", "results.msh", "results.msh.opt"]
+    assert (gmsh_dir / "results.msh").read_bytes().startswith(b"$MeshFormat\n4.1 1 8\n")  # binary
     gmsh.open(str(gmsh_dir / "results.msh"))
     n_frames, n_nodes = len(run2d.times), len(run2d.points)
     tags = list(gmsh.view.getTags())
@@ -141,8 +142,12 @@ def test_output_gmsh_figures_copies_only_the_figure_frames_and_none_writes_no_gm
     views = read_msh_node_data(str(export(run2d) / "results.msh"))
     wanted = select_frames(run2d.times.tolist(), default_times(run2d.times.tolist()))
     assert sorted(wanted) != list(range(len(run2d.times)))  # the test would not tell the modes apart
+    times = [run2d.times[k] for k in sorted(set(wanted))]
     for name in ARRAYS:
-        assert [b[1] for b in views[name]] == sorted(set(wanted))  # frame indices of the figures only
+        # the figures' frames only, as time steps 0…n-1 with their own times (issue 39: tagged with
+        # the frames' indices, Gmsh made a step for every index up to the largest, most of them empty)
+        assert [b[1] for b in views[name]] == list(range(len(times)))
+        assert [b[0] for b in views[name]] == times
     pos = (run2d.out / "gmsh" / "damage_final.pos").read_text()
     assert f"TIME{{{float(run2d.times[-1])!r}}}" in pos  # still the last frame
     _set_gmsh(run2d, "none")
@@ -193,3 +198,22 @@ def test_damage_pos_fixes_the_damage_range_and_hides_the_constant_legend_of_brok
     assert gmsh.option.getNumber(f"View[{damage}].ShowScale") == 1
     assert gmsh.option.getString(f"View[{bonds}].Name") == "broken bonds"
     assert gmsh.option.getNumber(f"View[{bonds}].ShowScale") == 0  # its legend read "1 1 1"
+
+
+def test_a_subset_of_frames_opens_in_gmsh_with_no_empty_step_and_no_stray_points(run2d, gmsh_session):
+    """Issue 39, item 1: output.gmsh: figures wrote frames 0, 15, 30, 43 tagged so, and Gmsh made 44
+    time steps of which 40 were empty; the corner entities showed as two dots."""
+    gmsh = gmsh_session
+    _set_gmsh(run2d, "figures")
+    path = export(run2d) / "results.msh"
+    gmsh.open(str(path))
+    assert gmsh.option.getNumber("Geometry.Points") == 0     # results.msh.opt, merged by Gmsh itself
+    views = read_msh_node_data(str(path))
+    steps = len(views["damage"])
+    assert 1 < steps < len(run2d.times)
+    for tag in gmsh.view.getTags():
+        index = gmsh.view.getIndex(tag)
+        assert gmsh.option.getNumber(f"View[{index}].NbTimeStep") == steps
+        for k in range(steps):
+            _, node_tags, data, _, _ = gmsh.view.getModelData(tag, k)
+            assert len(node_tags) == len(run2d.points) and len(data) == len(run2d.points)
