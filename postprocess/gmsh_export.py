@@ -1,8 +1,9 @@
 """Gmsh views of the results, written by our own code:
 
-- results.msh: MSH 4.1 *binary* (8-byte size_t, little-endian as the machine writes it; 3-4 times
-  smaller than ASCII and read faster: issue 39 measured 15.7 MB of ASCII for 4 frames of a
-  23,000-node bar). $Entities: one point entity per block (physical group = the block, named after
+- results.msh: MSH 4.1 *binary* (8-byte size_t, little-endian). Values are float64 whatever their
+  digits, so it is smaller than the shortest-repr ASCII by less than one would think (membrane's 4
+  frames of 2,500 nodes: 1.22 MB ASCII, 0.92 MB binary), but written 15 times faster (0.46 s against
+  0.03 s, 7 Dec 2026) and read by Gmsh without parsing text. $Entities: one point entity per block (physical group = the block, named after
   it) that holds the block's nodes and their 1-node point elements (type 15, so that Gmsh draws
   point data), and two empty point entities at the lower and upper corners of the cloud's bounding
   box. Gmsh frames a view on the model's bounding box, the union of its entities' boxes, and a point
