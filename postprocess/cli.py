@@ -26,7 +26,7 @@ from .crack_tip import DAMAGED
 from .history import read_history
 from .series import read_frame, read_series
 from .plotting import say
-from .selection import default_times, probe_nodes, select_frames
+from .selection import default_times, event_times, probe_nodes, select_frames
 
 MAP_NAME = re.compile(r"(damage|displacement)_(\d+)\.png$")
 
@@ -94,6 +94,16 @@ def _crack_outputs(out_dir, fig_dir, case, times, points, crack_masks) -> list[s
     return paths
 
 
+def _default_times(out_dir: str, times: list, history) -> list:
+    """figures.times: null → the crack's growth when bonds break (selection.event_times), else
+    times evenly spread over the run."""
+    path = os.path.join(out_dir, "history.csv")
+    if history is None and os.path.isfile(path):
+        history = read_history(path)
+    event = event_times(times, history["time"], history["broken_bonds"]) if history is not None else None
+    return event or default_times(times)
+
+
 def run(out_dir: str, case_json: str | None = None, only: str | None = None, log=print) -> list[str]:
     """Write the outputs of one case; returns the paths written."""
     case_json = case_json or os.path.join(out_dir, "case.json")
@@ -107,7 +117,7 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
     # output.gmsh: every frame into results.msh, only the frames of the figures (the default: a
     # copy of all 55 frames of plate_with_hole was 533 MB), or no Gmsh files at all.
     do_gmsh = do_gmsh and case.gmsh != "none"
-    requested = case.times if case.times is not None else default_times(times)
+    requested = case.times if case.times is not None else _default_times(out_dir, times, history)
     selected = select_frames(times, requested)
     if do_figures:
         # A relative slack of 1e-9: the last frame's time is the sum of the steps, which may land
