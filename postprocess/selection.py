@@ -24,21 +24,28 @@ EVENT_FRACTIONS = (0.1, 0.5, 0.9)
 
 
 def event_times(frame_times: Sequence[float], history_times: Sequence[float],
-                broken_bonds: Sequence[float]) -> list[float] | None:
-    """Times for `figures.times: null` when bonds break: the first frame at or after each moment the
-    broken-bond count (history.csv) reaches a fraction EVENT_FRACTIONS of its final value, then the
-    last frame (repeats dropped). None when no bond breaks (use default_times then)."""
+                broken_bonds: Sequence[float], count: int = DEFAULT_MAP_COUNT) -> list[float] | None:
+    """Times for `figures.times: null` when bonds break, `count` distinct frames (fewer only if the
+    run has fewer), chosen in this order: the first frame at or after each moment the broken-bond
+    count (history.csv) reaches a fraction EVENT_FRACTIONS of its final value, the last frame, the
+    frame before the crack's start, default_times', then the latest frames left. None when no bond
+    breaks."""
     broken = np.asarray(broken_bonds, dtype=np.float64)
     if broken.size == 0 or broken[-1] <= 0:
         return None
     frames = np.asarray(frame_times, dtype=np.float64)
-    chosen: list[float] = []
+    candidates: list[int] = []
     for fraction in EVENT_FRACTIONS:
         row = int(np.argmax(broken >= fraction * broken[-1]))
-        at = min(int(np.searchsorted(frames, history_times[row], side="left")), frames.size - 1)
-        chosen.append(float(frames[at]))
-    chosen.append(float(frames[-1]))
-    return sorted(set(chosen))
+        candidates.append(min(int(np.searchsorted(frames, history_times[row], side="left")), frames.size - 1))
+    candidates += [frames.size - 1, max(candidates[0] - 1, 0)]
+    candidates += select_frames(frames, default_times(frames, count))
+    candidates += range(frames.size - 1, -1, -1)        # any frame left, latest first
+    chosen: list[int] = []
+    for index in candidates:
+        if index not in chosen and len(chosen) < count:
+            chosen.append(index)
+    return [float(frames[index]) for index in sorted(chosen)]
 
 
 def select_frames(frame_times: Sequence[float], requested: Sequence[float]) -> list[int]:

@@ -63,12 +63,15 @@ def test_every_figure_is_a_real_png(run2d, map_calls):
     assert not [n for n in os.listdir(figures) if n.startswith(".tmp")]
 
 
-def test_default_times_draw_four_frames_ending_with_the_last(run2d, map_calls):
+def test_default_times_of_a_run_that_breaks_follow_its_broken_bonds(run2d, map_calls):
+    """The synthetic history breaks 1 bond per 10 of its 40 steps (4 at 0.5 ms): 10 % of them are
+    broken at 0.125 ms, 50 % at 0.25 ms, 90 % at 0.5 ms, so the frames at or after (every 0.1 ms) are
+    2, 3 and 5, and the frame before the first break, 1, makes the fourth (selection.event_times)."""
     synth.set_figures(run2d, times=None)
     run_quietly(run2d.out, only="figures")
     drawn = sorted({(name.split("_")[1], frame) for name, frame, _, _ in map_calls})
     assert drawn == [("0.png", "frame_000001.vtu"), ("1.png", "frame_000002.vtu"),
-                     ("2.png", "frame_000004.vtu"), ("3.png", "frame_000005.vtu")]
+                     ("2.png", "frame_000003.vtu"), ("3.png", "frame_000005.vtu")]
     assert not (run2d.out / "gmsh").exists()
 
 

@@ -137,10 +137,9 @@ def _set_gmsh(run, value):
 
 
 def test_output_gmsh_figures_copies_only_the_figure_frames_and_none_writes_no_gmsh_files(run2d):
-    from postprocess.selection import default_times, select_frames
     _set_gmsh(run2d, "figures")
     views = read_msh_node_data(str(export(run2d) / "results.msh"))
-    wanted = select_frames(run2d.times.tolist(), default_times(run2d.times.tolist()))
+    wanted = [1, 2, 3, 5]  # the figures' frames (test_post_figures: default times of a run that breaks)
     assert sorted(wanted) != list(range(len(run2d.times)))  # the test would not tell the modes apart
     times = [run2d.times[k] for k in sorted(set(wanted))]
     for name in ARRAYS:
