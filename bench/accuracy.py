@@ -245,7 +245,8 @@ def tension_runs(args, repeat: int, rows: list[dict]) -> None:
     # The reference: Verlet with light damping (ζ = 0.1 of critical in the strip's first axial mode),
     # the speed halved until the peak changes by < 0.5 %. Undamped runs do not settle so: every bond
     # that breaks at the notch before the peak sends out waves that never die down, and the peak
-    # moved by 1-2.4 % per halving down to 0.006 m/s (measured; docs/accuracy.md).
+    # moved by 1-2.4 % per halving down to 0.006 m/s (measured;
+    # docs/notes/2026-12-02-accuracy-tension.md).
     reference_alpha = float(f"{2.0 * tension.REFERENCE_ZETA * tension.OMEGA_1:.3g}")
     family, dt = [], None
     speed = first_speed

@@ -26,8 +26,8 @@ force 2.5 %) costs hundreds of force evaluations, and Verlet at its limit is alr
 accurate than the slow motion needs: implicit does not win here.
 
 And cases/membrane on its own lattice (--loads membrane, 2500 nodes, to --membrane-end 2 ms): measured
-4 Dec 2026 (docs/accuracy.md), Verlet at 0.8 × eq. 2.5 7.1e-3 in 1.1 s; implicit at tol 1e-2
-6.3e-2 in 8.7 s, at 1e-5 8.9e-4 in 54.7 s: Verlet wins here too.
+4 Dec 2026 (docs/notes/2026-12-02-implicit-dynamics.md), Verlet at 0.8 × eq. 2.5 7.1e-3 in 1.1 s;
+implicit at tol 1e-2 6.3e-2 in 8.7 s, at 1e-5 8.9e-4 in 54.7 s: Verlet wins here too.
 
     /usr/bin/python3 -m bench.implicit_dynamics [--solver build/solver/pdsolve] [--threads 1]
         [--repeat 3] [--span 30] [--periods 2] [--loads blow,pulse,membrane] [--membrane-end 2e-3]

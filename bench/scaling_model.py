@@ -1,5 +1,6 @@
 """A model of strong and weak scaling of a decomposed Verlet run on a cluster (issue 15), from
-per-step numbers measured on this machine (docs/performance.md §7 says which and how).
+per-step numbers measured on this machine (docs/notes/2026-12-03-scaling-model-largest-run.md says
+which and how).
 
     /usr/bin/python3 -m bench.scaling_model [--nodes 1e8] [--rate 2.7e8] [--sums 2]
 

@@ -15,7 +15,7 @@
 // for LPS's rate per directed bond beside PMB's (materials/lps); --influence sets its ω (one by default).
 //
 // --kernel portable: PMB and LPS rows by the portable code even where the CPU has AVX2 (the same
-// bits; docs/performance.md §7 measures what the AVX2 rows gain with it, side by side).
+// bits; docs/performance.md §3 gives what the AVX2 rows gain with it, side by side).
 //
 // set-up = reading the node file (written to D first, not timed) + build_model (bonds, material);
 // loop = S integrator steps, timed; directed bond updates/s = directed bonds × S / loop time, each

@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
   const Ranks ranks(&argc, &argv);
   // Keep freed memory in the heap. A frame of 10⁵ nodes is built in buffers of ~10 MB; glibc would
   // map and unmap them at every frame, and touching fresh pages costs more than writing the file
-  // (cases/branching: output 44 % → 9.5 % of the time loop, docs/performance.md §3). Buffers over
+  // (cases/branching: output 44 % → 9.5 % of the time loop, docs/notes/2026-12-01-bond-kernel.md §3). Buffers over
   // 256 MB (the bond list of a big model, allocated once) are still mapped on their own.
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);

@@ -1,6 +1,7 @@
 // SparseCholesky (linalg/cholesky.hpp) runs CHOLMOD on at most our --threads threads: CHOLMOD 3
 // asks for teams of 4 with a num_threads clause, which on a 2-core machine cost 60 % of a
-// factorisation in thread wake-ups (docs/accuracy.md, "CHOLMOD's threads").
+// factorisation in thread wake-ups (docs/notes/2026-12-03-mixed-cut-cholmod.md,
+// "CHOLMOD's threads").
 #include <gtest/gtest.h>
 #include <omp.h>
 

@@ -758,7 +758,8 @@ namespace {
 
 // The bar cut through between x = 5 dx and 6 dx (each half held by its grip only, so unloaded),
 // with a mechanism at the cut that is neither a node on one line nor a free piece, as the cracks of
-// plate_with_hole leave at dx = 0.25 mm (docs/accuracy.md, "Linkages and strands"):
+// plate_with_hole leave at dx = 0.25 mm (docs/notes/2026-12-03-mixed-hanging-nodes-pause-rule.md,
+// "Linkages and strands"):
 // - linkage: P = (5, 3, 3) keeps its bonds to (3, 3, 3), (4, 2, 2) and Q = (5, 1, 3); Q keeps its
 //   bonds to (3, 1, 3), (4, 0, 2) and P. Each has three bonds in three directions, but together they
 //   have 6 dofs and 5 bonds: a four-bar linkage in space, with no stiffness in its mode while the

@@ -1,5 +1,5 @@
 // What the bond kernels' hand-written AVX2 rows share (materials/pmb/pmb_row_avx2.hpp,
-// materials/lps/lps_row_avx2.hpp; docs/performance.md §7): whether this build and this CPU have
+// materials/lps/lps_row_avx2.hpp; docs/performance.md §2): whether this build and this CPU have
 // them, the switch that turns them off, and the few vector steps both rows take alike. Every step is the IEEE operation of the
 // portable rows, in their order: the rows' results are bitwise those of the portable code.
 #pragma once

@@ -9,8 +9,9 @@
 // along the line leaves them at s ≈ 0, so its lateral stiffness vanishes there: the lateral force is
 // cubic in the offset h (each bond's stretch grows as h²/(2|ξ|²)), a triple root, on which Newton
 // converges only linearly (by 2/3 per full step); the line search halves the whole body's step
-// for it and every iteration refactorises (docs/accuracy.md, "Why plate_with_hole's tentative
-// load step does not converge": 10 iterations, ω = 1.1e-3 against TOL 1e-6).
+// for it and every iteration refactorises (docs/notes/2026-12-03-mixed-dx4-dx2.md, "Why
+// plate_with_hole's tentative load step does not converge": 10 iterations, ω = 1.1e-3 against
+// TOL 1e-6).
 //
 // What. Such a node carries no load in statics: the sum of its bonds' forces on it is zero, so
 // their forces on the body are a self-equilibrated pair (zero for a single bond). So the static
@@ -40,15 +41,15 @@
 // Its nodes are left out of the solve too and stay where they are (their bonds as the explicit
 // phase left them: the static answer for a free piece is any rigid position; it is not relaxed).
 //
-// Links of linkages and strands (measured on plate_with_hole at dx = 0.25 mm: docs/accuracy.md,
-// "Linkages and strands"): in a round where no node hangs, a node with at most `dimension` intact
-// bonds to the body is weak; a weak node with fewer than `dimension` of them, or bonded to another
-// weak node, is a link of a linkage (Maxwell: a connected set W of weak nodes has fewer bonds than
-// dim·|W| dofs, so a mechanism) and is left out too, placed after the solve at its reference place
-// among its anchors translated by their weighted mean displacement. With `strands` (mixed, once the
-// cracks have cut the load path: no piece carries load) a node whose bonds lie on one line on both
-// sides (a link of an unloaded strand) is left out as well, placed on its anchors' line where their
-// axial forces balance.
+// Links of linkages and strands (measured on plate_with_hole at dx = 0.25 mm:
+// docs/notes/2026-12-03-mixed-hanging-nodes-pause-rule.md, "Linkages and strands"): in a round
+// where no node hangs, a node with at most `dimension` intact bonds to the body is weak; a weak
+// node with fewer than `dimension` of them, or bonded to another weak node, is a link of a linkage
+// (Maxwell: a connected set W of weak nodes has fewer bonds than dim·|W| dofs, so a mechanism) and
+// is left out too, placed after the solve at its reference place among its anchors translated by
+// their weighted mean displacement. With `strands` (mixed, once the cracks have cut the load path:
+// no piece carries load) a node whose bonds lie on one line on both sides (a link of an unloaded
+// strand) is left out as well, placed on its anchors' line where their axial forces balance.
 //
 // Collinear: the reference directions ξ/|ξ| (so the verdict is a function of the broken flags
 // only: the same before and after a restart) with |e × ξ/|ξ|| ≤ kCollinearSine of the first

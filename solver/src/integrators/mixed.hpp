@@ -26,7 +26,8 @@
 //   the cut is the ringing's overshoot at the crack faces, which the load steps do without; on
 //   plate_with_hole at its own dx the 200 steps after the cut were 1.8 s of a 22 s run, and
 //   returning 4 steps after it moved each half's crack centroid by 1 µm (bench/quasi_static_cases.py's
-//   case, 1 thread; docs/accuracy.md "After the cut").
+//   case, 1 thread; docs/notes/2026-12-04-mixed-full-resolution.md,
+//   "After the cut: δ/c, not 200 steps").
 //   From that return on, every load step starts with each piece carried by the one grip that
 //   holds it alone (LoadPath::held_by_one_group, QuasiStatic::carry_rigidly): unstrained, which is
 //   its equilibrium when nothing else loads it, so Newton accepts it without a tangent (measured on
@@ -47,7 +48,8 @@
 //   phase is undamped, and after the crack has run its released energy rings in the pieces for
 //   ever; a slowly loaded test (the benchmark's reference: Verlet with ζ = 0.1 of light damping)
 //   loses that ringing to damping, and the pieces do not crack again. Measured on cases/traction at
-//   dx × 2 (docs/accuracy.md, "The pause rule"): without it the middle piece between the two
+//   dx × 2 (docs/notes/2026-12-03-mixed-hanging-nodes-pause-rule.md,
+//   "The pause rule"): without it the middle piece between the two
 //   cracks, still linked to the halves by ligaments at the specimen's edges, cracks a third time 52
 //   steps after the cracks ran and 48 steps before the ligaments break, so that no rule that waits
 //   for the cut can return before it; undamped Verlet at 0.0625 m/s does the same, damped Verlet

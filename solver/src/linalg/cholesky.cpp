@@ -15,13 +15,14 @@ namespace pd {
 namespace {
 
 // CHOLMOD 3 (SuiteSparse 5.12, Debian 12) opens its parallel loops with
-// num_threads(CHOLMOD_OMP_NUM_THREADS), a compile-time 4 (cholmod_core.h) that ignores --threads:
-// 4 threads on this 2-core machine, whose wake-ups and futex waits took 60 % of the factorisation
-// time of plate_with_hole-mixed at dx × 2 with --threads 1 (docs/accuracy.md, "CHOLMOD's
-// threads"). With the dynamic adjustment on, libgomp gives a team at most nthreads-var (our
-// --threads) threads, fewer when the machine's load average says the cores are busy. Only the
-// calls into CHOLMOD run with it: our own loops keep exactly --threads. CHOLMOD's loops write
-// disjoint entries, so the factor is the same bits for any team size (the hash runs check it).
+// num_threads(CHOLMOD_OMP_NUM_THREADS), a compile-time 4 (cholmod_core.h) that ignores --threads: 4
+// threads on this 2-core machine, whose wake-ups and futex waits took 60 % of the factorisation
+// time of plate_with_hole-mixed at dx × 2 with --threads 1
+// (docs/notes/2026-12-03-mixed-cut-cholmod.md, "CHOLMOD's threads"). With the dynamic adjustment
+// on, libgomp gives a team at most nthreads-var (our --threads) threads, fewer when the machine's
+// load average says the cores are busy. Only the calls into CHOLMOD run with it: our own loops keep
+// exactly --threads. CHOLMOD's loops write disjoint entries, so the factor is the same bits for any
+// team size (the hash runs check it).
 class AtMostOurThreads {
  public:
   AtMostOurThreads() : was_dynamic_(omp_get_dynamic()) { omp_set_dynamic(1); }

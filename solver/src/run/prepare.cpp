@@ -183,7 +183,7 @@ void release_whole_node_data(Prepared& p) {
   for (auto& fixed : m.conditions.fixed) release(fixed);
   // Freed heap pages inside the heap stay resident until reused or trimmed: hand them back now, so
   // that they do not add to the peak while the operator, the integrator and the state are made
-  // (glibc; measured in docs/performance.md §7).
+  // (glibc; measured in docs/notes/2026-12-03-mpi-memory-exact-sums-overlap.md).
 #ifdef __GLIBC__
   malloc_trim(0);
 #endif

@@ -3,7 +3,7 @@
 // ends. Each sweep is parallel over nodes and a node writes only its own row and its own θ, f, W,
 // summing its bonds in row order: bitwise the same for any thread count. The sweeps' fast rows are in
 // lps_row.hpp (portable) and lps_row_avx2.hpp (AVX2 intrinsics, taken where the CPU has AVX2: the
-// same bits, fewer stores; docs/performance.md §7).
+// same bits, fewer stores; docs/performance.md §2).
 #include <algorithm>
 #include <cmath>
 #include <limits>

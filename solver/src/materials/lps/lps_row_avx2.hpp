@@ -2,7 +2,7 @@
 // rows (lps_row.hpp). Internal to the LPS kernel (lps_kernel.cpp includes it and picks these rows
 // when avx2_rows() is on: core/avx2.hpp).
 //
-// Why by hand, as PMB's row (materials/pmb/pmb_row_avx2.hpp, docs/performance.md §7): GCC's
+// Why by hand, as PMB's row (materials/pmb/pmb_row_avx2.hpp, docs/performance.md §2): GCC's
 // vectorised portable rows store each bond's terms lane by lane into per-chunk arrays and sum them
 // in bond order in a second loop. Here the terms of 4 bonds stay in registers and are added to the
 // row's sums in bond order directly: sweep 1's two sums (Σ ω|ξ| ext V_j, m'_i) as one 128-bit

@@ -1,5 +1,5 @@
 // One row of the PMB kernel written with AVX2 intrinsics: bitwise the portable row (pmb_row.hpp),
-// 11–16 % less CPU time per step on the Intel guest of docs/performance.md §7. Internal to the PMB
+// 11–16 % less CPU time per step on the Intel guest of docs/performance.md §3. Internal to the PMB
 // kernel (pmb_kernel.cpp includes it and picks this row when the CPU has AVX2).
 //
 // Why by hand: GCC's vectorised portable row stores each bond's four terms lane by lane into a
