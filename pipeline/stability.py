@@ -10,6 +10,7 @@ naming the file, the line and the key. Messages that could be false alarms are w
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -315,13 +316,23 @@ def check_discretized_case(case: dict, resolved: dict, cloud) -> list[str]:
                         f"no force acts on them: refine the mesh there or enlarge the horizon")
 
     # A horizon of about one spacing leaves a node 4 (2D) or 6 (3D) bonds: a lattice of springs,
-    # not the peridynamic continuum (thesis §2.1 uses δ ≈ 3·dx; issue 17, item 10).
+    # not the peridynamic continuum (thesis §2.1 uses δ ≈ 3·dx; issue 17, item 10). An error since
+    # issue 39 (item 7): a case with `horizon` in metres, coarsened by changing dx alone, ran at
+    # δ = 1 dx after this was only a warning, and its result meant nothing. FORCE=1 runs it anyway.
     if horizon < MIN_HORIZON_RATIO * dx:
         sample = np.linspace(0, len(points) - 1, min(len(points), 5000)).astype(np.int64)
         bonds = tree.query_ball_point(points[sample], horizon * BOND_SLACK, return_length=True) - 1
-        warnings.append(f"{_where(case, *horizon_key)}: the horizon {horizon:.6g} m is {horizon / dx:.3g} × the node "
-                        f"spacing: {float(np.mean(bonds)):.3g} bonds per node on average; the peridynamic model "
-                        f"needs a horizon of about 3 × the spacing (thesis §2.1): use horizon_factor: 3.015")
+        fixed = horizon_key[1] == "horizon"
+        text = (f"{_where(case, *horizon_key)}: the horizon {horizon:.6g} m is {horizon / dx:.3g} × the node "
+                f"spacing {dx:.6g} m: {float(np.mean(bonds)):.3g} bonds per node on average; the peridynamic "
+                f"model needs a horizon of about 3 × the spacing (thesis §2.1): "
+                + (f"discretization.horizon is fixed in metres, so it did not follow dx: remove it and let "
+                   f"horizon_factor (3.015 by default) set δ = 3.015 dx = {3.015 * dx:.6g} m, or give a horizon "
+                   f"≥ {MIN_HORIZON_RATIO * dx:.6g} m" if fixed else "use horizon_factor: 3.015"))
+        if os.environ.get("FORCE") == "1":
+            warnings.append(text + " (run anyway: FORCE=1)")
+        else:
+            raise CaseError(text + "; FORCE=1 (make FORCE=1 case=...) runs it anyway")
 
     dt_stable, node = case_stable_time_step(case, resolved, cloud, tree)
     if node < 0:  # no sampled node has a bond; the isolated-node warning says so

@@ -81,20 +81,41 @@ def test_a_body_moving_with_its_edge_held_is_no_mistake(tmp_path):
     assert check_condition_overlaps(case, cloud().sets) == []
 
 
-def test_a_horizon_of_one_spacing_is_warned_about_with_the_bond_count(tmp_path):
+def test_a_horizon_of_one_spacing_stops_the_run_with_the_bond_count(tmp_path, monkeypatch):
     text = CASE.replace("  dx: 0.001\n", "  dx: 0.001\n  horizon_factor: 1.0\n")
     path = tmp_path / "plate.yaml"
     path.write_text(text)
     case = load_case(str(path))
     c = cloud()
     resolved = resolve(case, node_sets=list(c.sets), grid_spacing=DX, nodes_file="nodes.vtu")
-    warnings = check_discretized_case(case, resolved, c)
-    [warning] = [w for w in warnings if "horizon" in w]
     # at δ = dx: 80 interior nodes have 4 bonds, 36 edge nodes 3, the 4 corners 2; 120 nodes
     mean = (4 * 10 * 8 + 3 * 2 * (10 + 8) + 2 * 4) / 120
-    assert warning == (f"{path}:5: discretization.horizon_factor: the horizon 0.001 m is 1 × the node spacing: "
-                       f"{mean:.3g} bonds per node on average; the peridynamic model needs a horizon of about "
-                       "3 × the spacing (thesis §2.1): use horizon_factor: 3.015")
+    message = (f"{path}:5: discretization.horizon_factor: the horizon 0.001 m is 1 × the node spacing 0.001 m: "
+               f"{mean:.3g} bonds per node on average; the peridynamic model needs a horizon of about "
+               "3 × the spacing (thesis §2.1): use horizon_factor: 3.015")
+    monkeypatch.delenv("FORCE", raising=False)
+    with pytest.raises(CaseError) as error:
+        check_discretized_case(case, resolved, c)
+    assert str(error.value) == message + "; FORCE=1 (make FORCE=1 case=...) runs it anyway"
+    monkeypatch.setenv("FORCE", "1")                  # a warning then, and the run goes on
+    [warning] = [w for w in check_discretized_case(case, resolved, c) if "horizon" in w]
+    assert warning == message + " (run anyway: FORCE=1)"
+
+
+def test_a_horizon_in_metres_left_behind_by_a_coarser_dx_names_the_key_to_change(tmp_path, monkeypatch):
+    """Issue 39, item 7: `horizon` fixed in metres, dx coarsened alone: δ = 1 dx ran after a warning."""
+    text = CASE.replace("  dx: 0.001\n", "  dx: 0.001\n  horizon: 0.0015\n")
+    path = tmp_path / "plate.yaml"
+    path.write_text(text)
+    case = load_case(str(path))
+    c = cloud()
+    resolved = resolve(case, node_sets=list(c.sets), grid_spacing=DX, nodes_file="nodes.vtu")
+    monkeypatch.delenv("FORCE", raising=False)
+    with pytest.raises(CaseError, match=r"plate.yaml:5: discretization.horizon: the horizon 0.0015 m is 1.5 × the node "
+                                        r"spacing 0.001 m: .* discretization.horizon is fixed in metres, so it did not "
+                                        r"follow dx: remove it and let horizon_factor \(3.015 by default\) set "
+                                        r"δ = 3.015 dx = 0.003015 m, or give a horizon ≥ 0.002 m; FORCE=1"):
+        check_discretized_case(case, resolved, c)
 
 
 @pytest.mark.parametrize("factor, rule, expected", [
