@@ -126,8 +126,7 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     ax_speed.set_xlim(t_scaled[0], t_scaled[-1])
     ax_speed.set_xlabel(t_label)
     ax_speed.set_ylabel("tip speed [m/s]")
-    ax_speed.set_title(f"crack-tip speed: the tip's advance from frame k−{SPEED_LAG // 2} to k+{SPEED_LAG // 2} "
-                       "over the time between them", fontsize=10)
+    ax_speed.set_title(f"tip speed: its advance from frame k−{SPEED_LAG // 2} to k+{SPEED_LAG // 2}")
     ax_speed.set_ylim(bottom=0.0)
     ax_speed.grid(alpha=0.3)
     plain_ticks(ax_speed)
