@@ -61,7 +61,7 @@ json describe_case() {
   keys["title"] = defaulted("string", c.title);
   keys["source"] = defaulted("string", c.source);
   keys["nodes_file"] = required("string", {{"note", "relative to the directory of case.json; not empty"}});
-  keys["output_dir"] = defaulted("string", kDefaultOutputDir, {{"note", "relative to the directory of case.json"}});
+  keys["output_dir"] = defaulted("string", kDefaultOutputDir, {{"note", "relative to the directory of case.json (the run folder), and inside it: an absolute path, .. out of it or a symbolic link out of it is refused"}});
   keys["dimension"] = required("integer", {{"minimum", 2}, {"maximum", 3}});
   keys["analysis"] = required("string", {{"choices", analysis_registry().keys()}, {"note", "must fit dimension"}});
   keys["thickness"] = defaulted("number", c.thickness,
