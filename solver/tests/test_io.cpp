@@ -367,6 +367,17 @@ TEST(CaseFile, OutputDirMustStayInsideTheRunFolder) {
   fs::remove_all(dir);
 }
 
+// output.restart_every_wall: 600 s of wall time when absent, 0 turns it off, below 0 is refused.
+TEST(CaseFile, RestartEveryWallDefaultsTo600SecondsAndZeroIsOff) {
+  EXPECT_EQ(pd::parse_case(kCase, "out/x/case.json").output.restart_every_wall, 600.0);
+  const std::string out = "\"history_every\": 1";
+  std::string off = kCase;
+  off.replace(off.find(out), out.size(), out + R"(, "restart_every_wall": 0)");
+  EXPECT_EQ(pd::parse_case(off, "out/x/case.json").output.restart_every_wall, 0.0);
+  expect_case_error(out, out + R"(, "restart_every_wall": -1)", {"output.restart_every_wall: must be ≥ 0, got -1"});
+  expect_case_error(out, out + R"(, "restart_every_wall": null)", {"output.restart_every_wall: must be a number, got null"});
+}
+
 // A fresh run rewrites frames.pvd (listing no frame) before it deletes the frames of the earlier
 // run, so a run killed in between (kill -9) never leaves a .pvd listing deleted frames (issue 17,
 // item 5). Before, the old .pvd stayed until the new run's first frame.

@@ -505,7 +505,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
-                  "restart_every_steps", "precision", "compression", "fields", "gmsh", "parallel_frames"}},
+                  "restart_every_steps", "restart_every_wall", "precision", "compression", "fields", "gmsh", "parallel_frames"}},
   };
   return keys;
 }
@@ -648,6 +648,8 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(output, "restart_every_steps"); j && !j->is_null())
     c.output.restart_every_steps =
         ck.integer(*j, "output.restart_every_steps", 1, std::numeric_limits<std::int64_t>::max());
+  if (const json* j = ck.optional(output, "restart_every_wall"))
+    c.output.restart_every_wall = ck.non_negative(*j, "output.restart_every_wall");
   if (const json* j = ck.optional(output, "history_every"))
     c.output.history_every = ck.integer(*j, "output.history_every", 1, std::numeric_limits<std::int64_t>::max());
   if (const json* j = ck.optional(output, "reactions")) {
