@@ -203,6 +203,7 @@ TEST_P(Restart, SigtermThenRestartIsBitwiseTheUninterruptedRun) {
   const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
   EXPECT_EQ(ck.loop.step, stop);
   EXPECT_EQ(ck.integrator, v.integrator);
+  EXPECT_EQ(ck.linear_solver, "");  // an explicit scheme solves no linear system
   // LAMMPS's α rule: the per-node s0 is state the checkpoint carries (and has moved off s00).
   EXPECT_EQ(ck.node_critical_stretch.size(), v.lammps ? 16u * 8u : 0u);
   if (v.lammps)
@@ -356,6 +357,13 @@ TEST(Checkpoint, RefusedForAnotherCaseOrWhenDamaged) {
   EXPECT_NE(error_of(dir / "case.json").find("truncated"), std::string::npos) << error_of(dir / "case.json");
   std::ofstream(ck, std::ios::binary) << "not a checkpoint";
   EXPECT_NE(error_of(dir / "case.json").find("not a pdsolve checkpoint"), std::string::npos);
+  // Of version 3, before the linear solver was recorded (issue 36): refused, saying how to start over.
+  std::string old = good;
+  old[8] = 3;  // the uint32 version after the 8-byte magic, little-endian
+  std::ofstream(ck, std::ios::binary) << old;
+  EXPECT_NE(error_of(dir / "case.json").find("checkpoint format version 3, this pdsolve reads version 4; to start the "
+                                             "run over instead, delete"),
+            std::string::npos) << error_of(dir / "case.json");
   // Still good after all that.
   std::ofstream(ck, std::ios::binary) << good;
   EXPECT_EQ(run(dir / "case.json", {}, ck), pd::kOk);
@@ -584,6 +592,7 @@ TEST(Checkpoint, MixedStartedImplicitShowsItsModesInHistoryAndRestartsBitwise) {
     const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
     EXPECT_EQ(ck.loop.step, stop / 7 * 7);
     EXPECT_EQ(ck.integrator, "mixed");
+    EXPECT_EQ(ck.linear_solver, "direct");  // implicit's, on one process (format version 4)
     ASSERT_EQ(run(cut / "case.json", {}, cut / "out" / "checkpoint.bin"), pd::kOk);
     expect_same_output(whole / "out", cut / "out");
   }
