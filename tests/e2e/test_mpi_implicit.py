@@ -244,3 +244,27 @@ def test_a_quasi_static_checkpoint_keeps_its_linear_solver_on_another_rank_count
                "the uninterrupted run")
     assert result.stderr.count(warning) == 1, result.stderr
     assert warning in (folder / "run.log").read_text()
+
+
+def test_an_implicit_checkpoint_of_one_rank_resumed_on_two_drops_its_factor_and_says_so(prepared):
+    """implicit with linear_solver auto factorises on one rank; its checkpoint holds where the factor
+    was made (the whole model's u). Resumed on 2 ranks, which cannot factorise, the run reads past
+    it, goes on with CG and says once that it is not bitwise the uninterrupted run (before: it
+    factorised the saved tangent for nothing and went on with CG without a word; quasi_static's
+    such restart was refused, 'integrator state of the wrong size')."""
+    def implicit_auto(case):
+        implicit(case)
+        case["implicit"]["linear_solver"] = "auto"
+        case["output"]["restart_every_time"] = 1.0e-5
+    serial = copy_case(prepared, "implicit_auto_serial", implicit_auto)
+    result = solve(serial, None)
+    assert result.returncode == 0, result.stderr
+    assert "(direct, auto: " in (serial / "run.log").read_text()
+    folder = prepared[0] / "implicit_auto_serial_to_np2"
+    shutil.copytree(serial, folder)
+    result = restart(folder, 2)
+    assert result.returncode == 0, result.stderr
+    assert restarted_at_step(folder) > 0
+    assert result.stderr.count("was written by a run solving with direct, which this run cannot take (direct "
+                               "factorises the whole tangent on one process, and this run is decomposed over 2 MPI "
+                               "ranks): it goes on with cg block_jacobi") == 1, result.stderr
