@@ -376,7 +376,7 @@ CASE = {
         restart_every_wall=Key("number", "write the checkpoint also every this many seconds of wall time "
                                "(0: never), so that a run killed without warning (kill -9, a machine going "
                                "down) loses at most that much; a slow checkpoint pushes the next one back so "
-                               "that they take at most 3 % of the run; the frames and history.csv are the "
+                               "that they take about 3 % of the run at most; the frames and history.csv are the "
                                "same bits with or without",
                                default=600.0, unit="s", minimum=0.0),
         precision=Key("choice", "frames' point fields (displacement, velocity, damage) as float32 or float64; "

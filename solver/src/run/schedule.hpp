@@ -57,9 +57,10 @@ class Schedule {
 class WallCheckpoints {
  public:
   // Checkpoints may take at most this share of the wall time. A big model on a slow disk can take
-  // longer to write than restart_every_wall allows for (10⁷ nodes: ~1 GB a checkpoint); after one
+  // a good part of restart_every_wall to write (the state and every bond's broken flag); after one
   // that took w seconds the next comes no sooner than w / kMaxShare after it began, so a run spends
-  // at most 3 % of its time on them, whatever the disk.
+  // about 3 % of its time on them at most, whatever the disk (as long as a checkpoint takes about
+  // as long as the one before it).
   static constexpr double kMaxShare = 0.03;
 
   // every: restart_every_wall [s]; start: the clock when the time loop began.
