@@ -23,13 +23,15 @@ prepare: the runs are
     pre-processor's pipeline.stability instead of the solver's run.log, so that prepare needs no
     solver; it may differ from the solver's value in the last bits, which does not matter here,
     since every solver gets the same stored number.
-  Each run gets <runs>/<run>/input/ holding case.json and the node file it names (copied in as
+  Each run gets its folder <runs>/<run>/ holding case.json and the node file it names (copied in as
   nodes.vtu, the only file a case.json refers to); the copy of case.json has nodes_file
-  "nodes.vtu" and output_dir "../output", so that a run writes <runs>/<run>/output/ and nothing
-  outside <runs>. <runs>/manifest.json lists the runs and where they came from (repo, commit).
+  "nodes.vtu" and output_dir "output", so that a run writes <runs>/<run>/output/ and nothing
+  outside it (pdsolve refuses an output_dir outside the folder of case.json). The copy leaves out
+  output.restart_every_wall when it is the default (600 s): a checkpoint changes no result, and
+  without the key the inputs also run on a solver from before it (the baseline of a comparison). <runs>/manifest.json lists the runs and where they came from (repo, commit).
 
 run: for each prepared run (in manifest order; --only / --skip to choose), empty
-  <runs>/<run>/output/, run `SOLVER input/case.json --threads N --quiet` with OMP_WAIT_POLICY=passive
+  <runs>/<run>/output/, run `SOLVER <run>/case.json --threads N --quiet` with OMP_WAIT_POLICY=passive
   unless the environment sets it (much faster on a shared, loaded machine; no effect on results),
   stdout and stderr going to <runs>/<run>/solver.txt (not hashed), then record the SHA-256 of
   - "history.csv": the file with its wall_time column removed (found by name in the header; every
@@ -37,8 +39,9 @@ run: for each prepared run (in manifest order; --only / --skip to choose), empty
   - "frames.pvd" and every "frames/frame_NNNNNN.vtu", byte for byte;
   - any other file the solver leaves in output/, byte for byte (today there is none; a new one
     shows up as a difference), except run.log (timings, paths) and checkpoint.bin (written
-    only on a signal or with output.restart_every_*, and it holds the wall time);
-  - "input/case.json" and "input/nodes.vtu", so that hashes of different input sets are not
+    on a signal, with output.restart_every_*, and every 600 s of wall time; it holds the wall time);
+  - "input/case.json" and "input/nodes.vtu" (<run>/case.json and nodes.vtu), so that hashes of
+    different input sets are not
     compared by mistake;
   - "exit": the solver's exit code (an integer, not a hash).
   --keep DIR copies each run's output/ to DIR/<run>/ for a closer look at a difference (the next
@@ -70,21 +73,26 @@ DROPPED_COLUMN = b"wall_time"
 
 # ---------------------------------------------------------------- prepare
 
+INPUTS = ("case.json", "nodes.vtu")   # in <run>/, hashed as input/<name>
+DEFAULT_RESTART_EVERY_WALL = 600.0   # pipeline/schema.py's default of output.restart_every_wall
+
+
 def install_input(case_path: str, run_dir: str) -> None:
-    """Copy case.json and the node file it names into run_dir/input/, pointing the copy's
-    nodes_file at the copied node file and its output_dir at run_dir/output/."""
+    """Copy case.json and the node file it names into run_dir/, pointing the copy's nodes_file at
+    the copied node file and its output_dir at run_dir/output/."""
     with open(case_path, encoding="utf-8") as stream:
         case = json.load(stream)
-    input_dir = os.path.join(run_dir, "input")
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
-    os.makedirs(input_dir)
+    os.makedirs(run_dir)
     nodes = os.path.join(os.path.dirname(os.path.abspath(case_path)), case["nodes_file"])
-    shutil.copyfile(nodes, os.path.join(input_dir, "nodes.vtu"))
+    shutil.copyfile(nodes, os.path.join(run_dir, "nodes.vtu"))
     case["nodes_file"] = "nodes.vtu"
-    case["output_dir"] = "../output"   # relative to input/, as formats.md §3 says
+    case["output_dir"] = "output"   # relative to the folder of case.json, and inside it (formats.md §3)
+    if case["output"].get("restart_every_wall") == DEFAULT_RESTART_EVERY_WALL:
+        del case["output"]["restart_every_wall"]   # see the module docstring
     # json reads and writes floats as the shortest repr, so every number keeps its exact value.
-    with open(os.path.join(input_dir, "case.json"), "w", encoding="utf-8") as stream:
+    with open(os.path.join(run_dir, "case.json"), "w", encoding="utf-8") as stream:
         stream.write(json.dumps(case, indent=1) + "\n")
 
 
@@ -209,8 +217,8 @@ def history_without_wall_time(data: bytes) -> bytes:
 def hash_run(run_dir: str) -> dict:
     """{file: sha256} of a run's inputs and of every result file but the EXCLUDED ones."""
     hashes = {}
-    for name in ("case.json", "nodes.vtu"):
-        with open(os.path.join(run_dir, "input", name), "rb") as stream:
+    for name in INPUTS:
+        with open(os.path.join(run_dir, name), "rb") as stream:
             hashes[f"input/{name}"] = sha256(stream.read())
     output = os.path.join(run_dir, "output")
     for folder, _dirs, files in os.walk(output):
@@ -247,13 +255,16 @@ def cmd_run(args) -> int:
     start = time.monotonic()
     for name in names:
         run_dir = os.path.join(runs, name)
+        if os.path.isfile(os.path.join(run_dir, "input", "case.json")):
+            raise SystemExit(f"{run_dir} was prepared by an older bench/result_hashes.py (input/case.json with "
+                             "output_dir ../output, which pdsolve refuses now): prepare again with --force")
         output = os.path.join(run_dir, "output")
         if os.path.isdir(output):
             shutil.rmtree(output)
         os.makedirs(output)
         begin = time.monotonic()
         with open(os.path.join(run_dir, "solver.txt"), "wb") as log:
-            code = subprocess.run([solver, os.path.join(run_dir, "input", "case.json"), "--threads",
+            code = subprocess.run([solver, os.path.join(run_dir, "case.json"), "--threads",
                                    str(args.threads), "--quiet"], stdout=log, stderr=subprocess.STDOUT, env=env).returncode
         seconds[name] = round(time.monotonic() - begin, 3)
         results[name] = dict(hash_run(run_dir), exit=code)

@@ -124,13 +124,13 @@ def output_cost(pdsolve, case_dir, repeats=3):
     with tempfile.TemporaryDirectory(prefix="pd-bench-") as tmp:
         c = json.loads(json.dumps(case))
         c["nodes_file"] = os.path.abspath(os.path.join(case_dir, case["nodes_file"]))
-        c["output_dir"] = os.path.join(tmp, "run")
+        c["output_dir"] = "run"   # tmp/run: inside the folder of case.json, as pdsolve requires
         path = os.path.join(tmp, "case.json")
         with open(path, "w") as f:
             json.dump(c, f)
         for _ in range(repeats):
             subprocess.run([pdsolve, path, "--threads", "1", "--quiet"], check=True, capture_output=True)
-            with open(os.path.join(c["output_dir"], "run.log")) as f:
+            with open(os.path.join(tmp, "run", "run.log")) as f:
                 log = f.read()
             steps, loop = loop_seconds(log)
             m = re.search(r"output: frames and history.csv took ([0-9.]+) s wall, ([0-9.]+) % of the time loop", log)

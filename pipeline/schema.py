@@ -373,6 +373,12 @@ CASE = {
                                default=None, unit="s", above=0.0),
         restart_every_steps=Key("integer", "write the checkpoint every this many steps (may be combined "
                                 "with restart_every_time)", default=None, minimum=1),
+        restart_every_wall=Key("number", "write the checkpoint also every this many seconds of wall time "
+                               "(0: never), so that a run killed without warning (kill -9, a machine going "
+                               "down) loses at most that much; a slow checkpoint pushes the next one back so "
+                               "that they take about 3 % of the run at most; the frames and history.csv are the "
+                               "same bits with or without",
+                               default=600.0, unit="s", minimum=0.0),
         precision=Key("choice", "frames' point fields (displacement, velocity, damage) as float32 or float64; "
                       "reference points, TIME and step stay float64, history.csv and checkpoints are exact "
                       "either way", default="float32", choices=("float32", "float64")),

@@ -36,7 +36,8 @@ const char* const kUsage =
     "  --restart CHECKPOINT\n"
     "                  continue the run of CASE.json from CHECKPOINT (its output_dir/checkpoint.bin),\n"
     "                  bitwise as if it had never stopped; refused for another case or node file\n"
-    "  --threads N     OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
+    "  --threads N     OpenMP threads (default: OMP_NUM_THREADS or all cores); at most max(64, 4 × the\n"
+    "                  processors), and OMP_NUM_THREADS is held to the same limit\n"
     "  --end-time T    simulated end time [s], overrides time.end\n"
     "  --max-steps N   stop after step N at most (counted from the start of the run, also on a restart)\n"
     "  --quiet         print nothing on stdout and no progress on stderr (run.log is still written)\n"
@@ -56,8 +57,9 @@ const char* const kUsage =
     "\n"
     "SIGINT (Ctrl-C) or SIGTERM: the run finishes its step, writes output_dir/checkpoint.bin and\n"
     "stops; more signals within 2 s are the same request (make forwards a SIGTERM sent to its\n"
-    "process group), a signal after that kills it at once. output.restart_every_time / _steps\n"
-    "write a checkpoint without stopping.\n"
+    "process group), a signal after that kills it at once. output.restart_every_wall (default\n"
+    "600 s of wall time; 0: none) and output.restart_every_time / _steps write a checkpoint without\n"
+    "stopping.\n"
     "\n"
     "Exit codes: 0 done; 1 bad input (reported before any output file is written); 2 bad command\n"
     "line; 3 the run failed (e.g. the state became non-finite, or the disk is full: \"disk full\n"
@@ -120,7 +122,8 @@ double parse_number(const std::string& option, const std::string& text) {
   return value;
 }
 
-long long parse_integer(const std::string& option, const std::string& text) {
+// The whole of `text` as an integer ≥ 1, or 0 if it is not one.
+long long whole_positive(const std::string& text) {
   std::size_t used = 0;
   long long value = 0;
   try {
@@ -128,23 +131,58 @@ long long parse_integer(const std::string& option, const std::string& text) {
   } catch (...) {
     used = 0;
   }
-  if (used != text.size() || value < 1) usage_error(option + " needs an integer ≥ 1, got '" + text + "'");
+  return used == text.size() && value >= 1 ? value : 0;
+}
+
+long long parse_integer(const std::string& option, const std::string& text) {
+  const long long value = whole_positive(text);
+  if (value < 1) usage_error(option + " needs an integer ≥ 1, got '" + text + "'");
   return value;
 }
 
 // More threads than max(64, 4 × the processors) only slow a run down, and 100000 OpenMP threads
 // crashed the runtime (issue 17, item 9): refused with the limit.
+long long thread_limit() {
+#ifdef _OPENMP
+  return std::max(64, 4 * omp_get_num_procs());
+#else
+  return 64;  // ignored without OpenMP
+#endif
+}
+
+std::string too_many_threads(const std::string& what) {
+  return what + ": at most " + std::to_string(thread_limit()) + " threads here (max(64, 4 × the processors))";
+}
+
 int parse_threads(const std::string& option, const std::string& text) {
   const long long threads = parse_integer(option, text);
-#ifdef _OPENMP
-  const long long limit = std::max(64, 4 * omp_get_num_procs());
-#else
-  const long long limit = 64;  // ignored without OpenMP
-#endif
-  if (threads > limit)
-    usage_error(option + " " + text + ": at most " + std::to_string(limit) + " threads here (max(64, 4 × the " +
-                "processors)); the default uses every core");
+  if (threads > thread_limit()) usage_error(too_many_threads(option + " " + text) + "; the default uses every core");
   return static_cast<int>(threads);
+}
+
+// OMP_NUM_THREADS reaches the OpenMP runtime without passing parse_threads: 100000 there crashed it
+// at the first parallel region, 20000 ran for minutes, and 65–5000 were taken though --threads
+// stops at the limit (issue 36, item 10). So when it decides (no --threads), every entry of its
+// list (the threads of each nesting level, "4,2") gets the same check, and text the runtime would
+// drop with a warning for its default is refused too: a run should not use another thread count
+// than the one asked for without a word. OMP_THREAD_LIMIT is not checked: it only caps the count.
+void check_thread_environment() {
+  const char* value = std::getenv("OMP_NUM_THREADS");
+  if (!value || !*value) return;  // unset or empty (`OMP_NUM_THREADS= pdsolve …`): the default
+  const std::string text = value, shown = "OMP_NUM_THREADS=" + text;
+  const std::string fix = "; unset it, or give --threads N, which overrides it";
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', begin);
+    const std::string entry = text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    const long long threads = whole_positive(entry);
+    if (threads < 1)
+      usage_error(shown + ": needs a thread count ≥ 1, or a list of them for nested levels (such as 4,2); got '" +
+                  entry + "'" + fix);
+    if (threads > thread_limit()) usage_error(too_many_threads(shown) + fix);
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
 }
 
 // --stable-dt: eq. 2.5 on the model built exactly as run() builds it (read_case, read_node_file,
@@ -223,6 +261,7 @@ int main(int argc, char** argv) {
   }
   if (options.case_file.empty()) usage_error("no case file given");
   if (exact && !stable_dt) usage_error("--exact goes with --stable-dt");
+  if (options.threads == 0) check_thread_environment();  // before any parallel region
   try {
     if (stable_dt) {
 #ifdef _OPENMP

@@ -33,6 +33,7 @@ int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryC
                                    s.restarting);
     log_title(*log, opt, p);
     if (s.restarting) log->line(restart_line(opt, s));
+    if (!s.solver_changed.empty()) log->error(s.solver_changed);  // stderr once (rank 0), and run.log
     log_setup(*log, p);
     const LoopEnd end = run_loop(opt, p, s, columns, out, *log);
     return report(opt, p, s.loop, end, out ? out->frames_written() : 0, *log);

@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <set>
 #include <string>
+#include <utility>
 
 namespace fs = std::filesystem;
 
@@ -19,9 +23,10 @@ struct Result {
   std::string out;
 };
 
-Result run_solver(const std::string& args) {
+// env: assignments for the shell before the command, e.g. "OMP_NUM_THREADS=4".
+Result run_solver(const std::string& args, const std::string& env = "") {
   const fs::path log = fs::temp_directory_path() / ("pd_test_cli_" + std::to_string(::getpid()) + ".txt");
-  const std::string command = std::string(PDSOLVE_PATH) + " " + args + " > " + log.string() + " 2>&1";
+  const std::string command = env + " " + std::string(PDSOLVE_PATH) + " " + args + " > " + log.string() + " 2>&1";
   const int status = std::system(command.c_str());
   std::ifstream in(log);
   Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1,
@@ -95,4 +100,36 @@ TEST(CommandLine, TooManyThreadsIsAUsageError) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--threads 100000: at most "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" threads here (max(64, 4 × the processors))"), std::string::npos) << r.out;
+}
+
+// OMP_NUM_THREADS is held to the same limit as --threads (issue 36, item 10): before, 100000 there
+// crashed the OpenMP runtime (exit 139), 20000 ran for minutes and 65–5000 were taken. Every entry
+// of a nested list counts, and text the runtime would ignore is refused, naming the variable, before
+// any work: a case.json that does not exist is never reached (exit 2, not 1).
+TEST(CommandLine, TooManyOrBadThreadsInOmpNumThreadsIsAUsageError) {
+  const std::string limit = std::to_string(std::max(64, 4 * omp_get_num_procs()));
+  const std::string over = std::to_string(std::max(64, 4 * omp_get_num_procs()) + 1);
+  for (const std::string value : {std::string("100000"), over, "4," + over}) {
+    const Result r = run_solver("missing.json", "OMP_NUM_THREADS=" + value);
+    EXPECT_EQ(r.code, 2) << value << ": " << r.out;
+    EXPECT_NE(r.out.find("pdsolve: OMP_NUM_THREADS=" + value + ": at most " + limit +
+                         " threads here (max(64, 4 × the processors)); unset it, or give --threads N, which overrides it"),
+              std::string::npos) << r.out;
+  }
+  for (const auto& [value, entry] : {std::pair<std::string, std::string>{"many", "many"}, {"0", "0"}, {"4,", ""},
+                                     {"4,two", "two"}, {"-3", "-3"}, {"2.5", "2.5"}}) {
+    const Result r = run_solver("missing.json", "OMP_NUM_THREADS='" + value + "'");
+    EXPECT_EQ(r.code, 2) << value << ": " << r.out;
+    EXPECT_NE(r.out.find("pdsolve: OMP_NUM_THREADS=" + value + ": needs a thread count ≥ 1, or a list of them for "
+                         "nested levels (such as 4,2); got '" + entry + "'"),
+              std::string::npos) << r.out;
+  }
+  // Within the limit, as a list, empty, or overridden by --threads: on to the case file (exit 1, missing).
+  for (const auto& [env, args] : {std::pair<std::string, std::string>{"OMP_NUM_THREADS=" + limit, ""},
+                                  {"OMP_NUM_THREADS=4,2", ""}, {"OMP_NUM_THREADS=", ""},
+                                  {"OMP_NUM_THREADS=100000", " --threads 2"}}) {
+    const Result r = run_solver("missing.json" + args, env);
+    EXPECT_EQ(r.code, 1) << env << args << ": " << r.out;
+    EXPECT_NE(r.out.find("missing.json"), std::string::npos) << r.out;
+  }
 }

@@ -326,6 +326,58 @@ TEST(CaseFile, OutputFormatKeysAreCheckedAndDefaultToTheCompactFrames) {
   EXPECT_FALSE(f.zlib);
 }
 
+// output_dir stays inside the run folder, the directory of case.json (issue 36, item 3): before,
+// "/abs/path", "../../../x" and "sub/../../.." were taken, and frames, history.csv and run.log went
+// there. Refused while reading case.json, before any file is written, naming the file and the key.
+TEST(CaseFile, OutputDirMustStayInsideTheRunFolder) {
+  const std::string dot = "\"output_dir\": \".\"";
+  const std::string advice = "give a folder inside the directory of case.json, such as \".\" or \"out\"";
+  expect_case_error(dot, "\"output_dir\": \"/abs/path\"",
+                    {"output_dir: '/abs/path' is an absolute path; pdsolve writes only inside the run folder", advice});
+  for (const std::string up : {"../../../x", "sub/../../..", "..", "./a/../../b"})
+    expect_case_error(dot, "\"output_dir\": \"" + up + "\"",
+                      {"output_dir: '" + up + "' leaves the run folder (the directory of case.json)", advice});
+  // Inside, however written: the same folder the text names.
+  for (const std::string inside : {".", "out", "a/../b", "./out/", "run/../run/frames"}) {
+    std::string text = kCase;
+    text.replace(text.find(dot), dot.size(), "\"output_dir\": \"" + inside + "\"");
+    EXPECT_EQ(pd::parse_case(text, "out/x/case.json").output_dir, fs::path("out/x") / inside) << inside;
+  }
+
+  // A symbolic link in it is followed: out of the run folder it is refused, inside it is taken.
+  const fs::path dir = temp_dir("output_dir_links");
+  fs::create_directories(dir / "run" / "real");
+  fs::create_directories(dir / "elsewhere");
+  fs::create_directory_symlink(dir / "elsewhere", dir / "run" / "away");
+  fs::create_directory_symlink("real", dir / "run" / "near");
+  std::string away = kCase, near = kCase;
+  away.replace(away.find(dot), dot.size(), "\"output_dir\": \"away/frames\"");
+  near.replace(near.find(dot), dot.size(), "\"output_dir\": \"near\"");
+  try {
+    pd::parse_case(away, dir / "run" / "case.json");
+    ADD_FAILURE() << "a link out of the run folder was taken";
+  } catch (const pd::Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find((dir / "run" / "case.json").string() + ": output_dir: 'away/frames' leads through a symbolic "
+                        "link to " + (fs::canonical(dir / "elsewhere") / "frames").string() + ", outside the run folder " +
+                        fs::canonical(dir / "run").string()), std::string::npos) << what;
+  }
+  EXPECT_EQ(pd::parse_case(near, dir / "run" / "case.json").output_dir, dir / "run" / "near");
+  EXPECT_TRUE(fs::is_empty(dir / "elsewhere"));
+  fs::remove_all(dir);
+}
+
+// output.restart_every_wall: 600 s of wall time when absent, 0 turns it off, below 0 is refused.
+TEST(CaseFile, RestartEveryWallDefaultsTo600SecondsAndZeroIsOff) {
+  EXPECT_EQ(pd::parse_case(kCase, "out/x/case.json").output.restart_every_wall, 600.0);
+  const std::string out = "\"history_every\": 1";
+  std::string off = kCase;
+  off.replace(off.find(out), out.size(), out + R"(, "restart_every_wall": 0)");
+  EXPECT_EQ(pd::parse_case(off, "out/x/case.json").output.restart_every_wall, 0.0);
+  expect_case_error(out, out + R"(, "restart_every_wall": -1)", {"output.restart_every_wall: must be ≥ 0, got -1"});
+  expect_case_error(out, out + R"(, "restart_every_wall": null)", {"output.restart_every_wall: must be a number, got null"});
+}
+
 // A fresh run rewrites frames.pvd (listing no frame) before it deletes the frames of the earlier
 // run, so a run killed in between (kill -9) never leaves a .pvd listing deleted frames (issue 17,
 // item 5). Before, the old .pvd stayed until the new run's first frame.

@@ -405,7 +405,10 @@ TEST(QuasiStatic, ContactSolvesWithCgAndDirectIsRefusedWithTheReason) {
 
 namespace {
 
-void restart_continues_bitwise(const std::string& preconditioner) {
+// keep_from_checkpoint: the restored run is configured with linear_solver and preconditioner auto,
+// which on this bar would factorise, and keeps the saved run's CG as a restart does
+// (Integrator::keep_linear_solver, run/start.cpp).
+void restart_continues_bitwise(const std::string& preconditioner, bool keep_from_checkpoint = false) {
   pdtest::OneThread one;
   // The pulled bar (strain 1e-3 by t = 1) with half of the cross-section at x = 5.5dx cut (its bonds
   // broken before the start): the tangent is shifted as after damage, and the notch makes the
@@ -416,7 +419,7 @@ void restart_continues_bitwise(const std::string& preconditioner) {
     pd::QuasiStatic qs{op};
     pd::State s{m.nodes.size()};
     double t = 0.0, dt = 0.0;
-    explicit Run(const std::string& preconditioner) {
+    explicit Run(const std::string& preconditioner, const std::string& keep = "") {
       for (std::size_t i = 0; i < m.nodes.size(); ++i)
         for (std::int64_t k = m.bonds.offsets[i]; k < m.bonds.offsets[i + 1]; ++k) {
           const auto j = static_cast<std::size_t>(m.bonds.neighbour[static_cast<std::size_t>(k)]);
@@ -428,7 +431,13 @@ void restart_continues_bitwise(const std::string& preconditioner) {
       c.quasi_static.linear_solver = "cg";
       c.quasi_static.preconditioner = preconditioner;
       c.quasi_static.dt_max = 0.1;
+      if (!keep.empty()) c.quasi_static.linear_solver = c.quasi_static.preconditioner = "auto";
       qs.configure(c);
+      if (!keep.empty()) {
+        EXPECT_EQ(qs.linear_solver(), "direct");
+        EXPECT_EQ(qs.keep_linear_solver(keep), "");
+        EXPECT_EQ(qs.linear_solver(), keep);
+      }
       qs.initialize(s, 0.0);
       dt = *qs.initial_dt();
     }
@@ -441,7 +450,7 @@ void restart_continues_bitwise(const std::string& preconditioner) {
   Run a(preconditioner);
   for (int k = 0; k < 4; ++k) a.step();
   const std::vector<char> saved = a.qs.save_state();
-  Run b(preconditioner);
+  Run b(preconditioner, keep_from_checkpoint ? a.qs.linear_solver() : "");
   b.s = a.s;
   b.t = a.t;
   b.dt = a.dt;
@@ -464,6 +473,37 @@ TEST(QuasiStatic, CgRunSavedAndRestoredMidRunContinuesBitwise) { restart_continu
 TEST(QuasiStatic, AmgRunSavedAndRestoredMidRunContinuesBitwise) {
   if (!pd::AmgPreconditioner::available()) GTEST_SKIP() << "built without hypre (PD_HYPRE off)";
   restart_continues_bitwise("amg");
+}
+
+// Issue 36, item 9: auto's choice depends on the rank count (CG on several ranks, CHOLMOD on one
+// for this bar), so a restart keeps the solver and preconditioner its checkpoint recorded; the run
+// then continues bitwise (before, a 2-rank run resumed on 1 rank switched to CHOLMOD unsaid).
+TEST(QuasiStatic, ARestartKeepsTheCheckpointsCgWhereAutoWouldFactorise) { restart_continues_bitwise("block_jacobi", true); }
+
+TEST(QuasiStatic, ARestartKeepsTheCheckpointsAmgWhereAutoWouldFactorise) {
+  if (!pd::AmgPreconditioner::available()) GTEST_SKIP() << "built without hypre (PD_HYPRE off)";
+  restart_continues_bitwise("amg", true);
+}
+
+// What a restart is told when it cannot keep the recorded solver, and what run.log says when it can.
+TEST(QuasiStatic, KeepLinearSolverSaysWhyItCannotAndDescribeSaysWhereItCameFrom) {
+  pd::Model m = bar(1e-3);
+  pd::ForceOperator op(m);
+  pd::QuasiStatic qs(op);
+  qs.configure(bar_case());
+  EXPECT_EQ(qs.linear_solver(), "direct");
+  EXPECT_EQ(qs.keep_linear_solver("direct"), "");  // the same: nothing to do
+  EXPECT_FALSE(qs.uses_cg());
+  EXPECT_EQ(qs.keep_linear_solver("lu"), "the checkpoint names a linear solver this pdsolve does not know ('lu')");
+  EXPECT_FALSE(qs.uses_cg());
+  EXPECT_EQ(qs.keep_linear_solver("cg block_jacobi"), "");
+  EXPECT_TRUE(qs.uses_cg());
+  EXPECT_NE(qs.describe(0.0).front().find("(cg, as the checkpoint was written; this run alone would take direct, auto: "),
+            std::string::npos) << qs.describe(0.0).front();
+  EXPECT_NE(qs.describe(0.0).front().find("; preconditioner block_jacobi: as the checkpoint was written"), std::string::npos)
+      << qs.describe(0.0).front();
+  if (!pd::AmgPreconditioner::available())
+    EXPECT_EQ(qs.keep_linear_solver("cg amg"), "amg needs hypre's BoomerAMG, which this pdsolve was built without");
 }
 
 TEST(QuasiStatic, PredictorFromTheLastLoadStepReachesTheSameEquilibriumInFewerIterations) {

@@ -113,3 +113,37 @@ TEST(Schedule, TheLastStepAbsorbsATinyRemainder) {
   EXPECT_FALSE(next.landing);
   EXPECT_EQ(next.h, 0.1);
 }
+
+// output.restart_every_wall (issue 36, item 8), on a clock the test sets: due every `every` seconds
+// of wall time, never with 0, and after a slow write no sooner than 1/kMaxShare times its length
+// after it began, so that checkpoints take at most 3 % of a run.
+TEST(WallCheckpoints, DueEveryIntervalOfWallTimeAndNeverWithZero) {
+  pd::WallCheckpoints wall(600.0, 0.0);  // the default
+  EXPECT_FALSE(wall.due(0.0));
+  EXPECT_FALSE(wall.due(599.9));
+  EXPECT_TRUE(wall.due(600.0));
+  wall.written(600.5, 601.0);  // written in 0.5 s: the interval counts from its start
+  EXPECT_FALSE(wall.due(1200.0));
+  EXPECT_TRUE(wall.due(1200.5));
+  EXPECT_EQ(pd::OutputSettings().restart_every_wall, 600.0);
+
+  const pd::WallCheckpoints off(0.0, 0.0);
+  for (const double now : {0.0, 600.0, 1e9}) EXPECT_FALSE(off.due(now)) << now;
+}
+
+TEST(WallCheckpoints, ASlowCheckpointPushesTheNextOneToKeepTheirShareAt3Percent) {
+  pd::WallCheckpoints wall(10.0, 100.0);  // a loop that started at 100 s on this clock
+  EXPECT_FALSE(wall.due(109.0));
+  EXPECT_TRUE(wall.due(110.0));
+  wall.written(110.0, 116.0);  // 6 s to write: the next no sooner than 6 / 0.03 = 200 s after it began
+  EXPECT_NEAR(wall.next(), 310.0, 1e-9);  // 6 / 0.03 in floating point
+  EXPECT_FALSE(wall.due(309.9));
+  EXPECT_TRUE(wall.due(310.001));
+  wall.written(310.0, 310.1);  // fast again: back to every 10 s
+  EXPECT_EQ(wall.next(), 320.0);
+  // Any checkpoint (also one of restart_every_steps) restarts the count: the wall-time one follows it.
+  wall.written(315.0, 315.1);
+  EXPECT_FALSE(wall.due(320.0));
+  EXPECT_TRUE(wall.due(325.0));
+  EXPECT_EQ(pd::WallCheckpoints::kMaxShare, 0.03);
+}

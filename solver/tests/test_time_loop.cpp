@@ -4,11 +4,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <string>
+#include <vector>
 
 #include "io/node_file.hpp"
 #include "io/vtu.hpp"
@@ -226,4 +229,37 @@ TEST(TimeLoop, AdaptiveWithTheExactRuleReusesTheExactLimitForItsDefaultDtMax) {
   const double dt_exact = std::stod(exact[1]), eq25 = dt_exact / std::stod(exact[2]);
   EXPECT_NEAR(std::stod(dt_max[1]), std::min(eq25, 0.9 * dt_exact / 2.0), 1e-5 * std::stod(dt_max[1])) << log;
   EXPECT_EQ(log.find("eigenvalue estimate"), std::string::npos) << log;
+}
+
+// A case.json whose output_dir leaves its folder (issue 36, item 3) is refused by pdsolve with exit
+// code 1 before any file is written: before, an absolute path, "../x" or "sub/../../x" received the
+// frames, history.csv and run.log, and a link out of the folder did the same.
+TEST(TimeLoop, AnOutputDirOutsideTheRunFolderIsRefusedBeforeAnyFileIsWritten) {
+  const fs::path dir = temp_dir("output_dir_outside");
+  const fs::path run = dir / "run";
+  fs::create_directories(run);
+  write_case(run, R"({"end": 3e-7, "integrator": "verlet", "dt": "stable", "safety_factor": 0.8})");
+  const std::string text = slurp(run / "case.json"), given = "\"output_dir\": \"out\"";
+  ASSERT_NE(text.find(given), std::string::npos);
+  fs::create_directories(dir / "elsewhere");
+  fs::create_directory_symlink(dir / "elsewhere", run / "away");
+  const fs::path absolute = dir / "absolute";
+  for (const std::string& output_dir : {absolute.string(), std::string("../up"), std::string("sub/../../up"),
+                                        std::string("away/out")}) {
+    std::string changed = text;
+    changed.replace(changed.find(given), given.size(), "\"output_dir\": \"" + output_dir + "\"");
+    std::ofstream(run / "case.json") << changed;
+    EXPECT_EQ(run_solver(run), 1) << output_dir << ": " << slurp(run / "log.txt");
+    EXPECT_NE(slurp(run / "log.txt").find((run / "case.json").string() + ": output_dir: '" + output_dir + "' "),
+              std::string::npos) << slurp(run / "log.txt");
+    EXPECT_FALSE(fs::exists(absolute)) << output_dir;
+    EXPECT_FALSE(fs::exists(dir / "up")) << output_dir;
+    EXPECT_TRUE(fs::is_empty(dir / "elsewhere")) << output_dir;
+  }
+  // The folder holds what it held: the case, the nodes, the link and the solver's log only.
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(run)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"away", "case.json", "log.txt", "nodes.vtu"}));
+  fs::remove_all(dir);
 }

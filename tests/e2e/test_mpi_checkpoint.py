@@ -119,6 +119,31 @@ def test_a_checkpoint_written_on_2_ranks_continues_on_3_and_on_1_bitwise(prepare
         assert_same_run(reference, folder)
 
 
+def test_wall_time_checkpoints_on_2_ranks_change_no_bit_and_continue_bitwise(prepared):
+    """output.restart_every_wall (issue 36, item 8) on 2 ranks: rank 0's clock decides, and the
+    reduction that carries the signal tells rank 1, so both take part in the same checkpoints (a
+    checkpoint is collective: a rank left out would hang the run). At 1 ns every step is due but
+    for the 3 % bound (a checkpoint here takes some 10 ms: one every ~0.3 s of a ~2 s run). The
+    frames and history are the serial run's; the last checkpoint continues the run bitwise."""
+    def wall(case):
+        case["time"]["end"] = 2.0e-3
+        case["output"]["restart_every_wall"] = 1.0e-9
+    reference = copy_case(prepared, "wall_reference", with_checkpoints(2.0e-3, 1.0))
+    assert solve(reference, None).returncode == 0
+    written = copy_case(prepared, "wall_np2", wall)
+    result = solve(written, 2)
+    assert result.returncode == 0, result.stderr
+    assert_same_run(reference, written)
+    log = (written / "run.log").read_text()
+    assert len(re.findall(r"^checkpoint: .*checkpoint\.bin at step \d+, .*restart_every_wall 1e-09 s", log, re.M)) >= 2, log
+    folder = prepared[0] / "wall_np2_to_np2"
+    shutil.copytree(written, folder)
+    result = restart(folder, 2)
+    assert result.returncode == 0, result.stderr
+    assert restarted_at_step(folder) > 0
+    assert_same_run(reference, folder)
+
+
 @pytest.fixture(scope="module")
 def long_reference(prepared):
     """A run long enough to be interrupted (LONG_END), serial and uninterrupted."""

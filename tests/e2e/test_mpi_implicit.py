@@ -206,3 +206,65 @@ def test_direct_is_refused_on_several_ranks_and_auto_takes_cg(prepared, section)
     assert result.returncode == 0, result.stderr
     assert ("(cg, auto: decomposed over 2 MPI ranks (a factorisation stays on one process; a problem that fits one "
             "process is usually solved faster by one rank with it))") in (folder / "run.log").read_text()
+
+
+def quasi_static_auto(case):
+    """quasi_static with linear_solver auto: CG on several ranks, CHOLMOD on one (2D, assembled)."""
+    quasi_static(case)
+    case["quasi_static"]["linear_solver"] = "auto"
+    case["output"]["restart_every_time"] = 6.0e-4  # one checkpoint, the first load step past 0.6 ms
+
+
+def test_a_quasi_static_checkpoint_keeps_its_linear_solver_on_another_rank_count(prepared):
+    """Issue 36, item 9: auto's linear solver depends on the rank count, and the checkpoint records
+    it. A checkpoint of a 2-rank run (CG) resumed on 1 rank goes on with CG, bitwise the
+    uninterrupted 2-rank run (before, it switched to CHOLMOD without a word); a checkpoint of a
+    1-rank run (CHOLMOD) resumed on 2 ranks cannot factorise there, and says so once."""
+    written = copy_case(prepared, "qs_auto_np2", quasi_static_auto)
+    result = solve(written, 2)
+    assert result.returncode == 0, result.stderr
+    assert "(cg, auto: decomposed over 2 MPI ranks" in (written / "run.log").read_text()
+    folder = restarted(prepared, written, "qs_auto_np2_to_serial", None)
+    assert restarted_at_step(folder) > 0  # the first step past 0.6 ms, of some 20 (load steps cut as bonds break)
+    assert_same_run(written, folder)
+    assert ("(cg, as the checkpoint was written; this run alone would take direct, auto: "
+            in (folder / "run.log").read_text())
+
+    serial = copy_case(prepared, "qs_auto_serial", quasi_static_auto)
+    result = solve(serial, None)
+    assert result.returncode == 0, result.stderr
+    assert "(direct, auto: " in (serial / "run.log").read_text()
+    folder = prepared[0] / "qs_auto_serial_to_np2"
+    shutil.copytree(serial, folder)
+    result = restart(folder, 2)
+    assert result.returncode == 0, result.stderr
+    warning = (f"pdsolve: warning: {folder / 'checkpoint.bin'} was written by a run solving with direct, which this "
+               "run cannot take (direct factorises the whole tangent on one process, and this run is decomposed "
+               "over 2 MPI ranks): it goes on with cg block_jacobi, and its results will not be bitwise those of "
+               "the uninterrupted run")
+    assert result.stderr.count(warning) == 1, result.stderr
+    assert warning in (folder / "run.log").read_text()
+
+
+def test_an_implicit_checkpoint_of_one_rank_resumed_on_two_drops_its_factor_and_says_so(prepared):
+    """implicit with linear_solver auto factorises on one rank; its checkpoint holds where the factor
+    was made (the whole model's u). Resumed on 2 ranks, which cannot factorise, the run reads past
+    it, goes on with CG and says once that it is not bitwise the uninterrupted run (before: it
+    factorised the saved tangent for nothing and went on with CG without a word; quasi_static's
+    such restart was refused, 'integrator state of the wrong size')."""
+    def implicit_auto(case):
+        implicit(case)
+        case["implicit"]["linear_solver"] = "auto"
+        case["output"]["restart_every_time"] = 1.0e-5
+    serial = copy_case(prepared, "implicit_auto_serial", implicit_auto)
+    result = solve(serial, None)
+    assert result.returncode == 0, result.stderr
+    assert "(direct, auto: " in (serial / "run.log").read_text()
+    folder = prepared[0] / "implicit_auto_serial_to_np2"
+    shutil.copytree(serial, folder)
+    result = restart(folder, 2)
+    assert result.returncode == 0, result.stderr
+    assert restarted_at_step(folder) > 0
+    assert result.stderr.count("was written by a run solving with direct, which this run cannot take (direct "
+                               "factorises the whole tangent on one process, and this run is decomposed over 2 MPI "
+                               "ranks): it goes on with cg block_jacobi") == 1, result.stderr

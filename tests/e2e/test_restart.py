@@ -5,6 +5,7 @@ A coarse, short copy of cases/membrane goes through mesh and preprocess as the M
 pdsolve runs once uninterrupted, once with SIGTERM after a few frames, then restarts.
 """
 import csv
+import json
 import os
 import shutil
 import signal
@@ -113,6 +114,55 @@ def test_sigkill_then_restart_from_the_periodic_checkpoint(runs, killed):
     rows = read_history(cut / "history.csv")
     assert [int(r["step"]) for r in rows] == list(range(len(rows)))
     assert len(rows) == len(read_history(whole / "history.csv"))
+
+
+@pytest.fixture(scope="module")
+def killed_with_wall_checkpoints_only(prepared):
+    """Checkpoints by wall time alone (output.restart_every_wall, issue 36 item 8: on by default, here
+    every 0.05 s), then SIGKILL after some frames: the run has a checkpoint all the same, and the
+    restart from it continues the run bitwise."""
+    cut = copy_case(prepared, "killed_wall")
+    case = json.loads((cut / "case.json").read_text())
+    case["output"]["restart_every_steps"] = None
+    case["output"]["restart_every_wall"] = 0.05
+    (cut / "case.json").write_text(json.dumps(case))
+    proc = subprocess.Popen([SOLVER, str(cut / "case.json"), "--quiet", "--threads", "1"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and proc.poll() is None:
+        if (cut / "frames" / "frame_000010.vtu").exists() and (cut / "checkpoint.bin").exists():
+            break
+        time.sleep(0.01)
+    assert proc.poll() is None, f"the run ended before it could be killed: {proc.communicate()[1]}"
+    proc.kill()
+    proc.wait(timeout=60)
+    proc.stderr.close()
+    files = sorted(os.listdir(cut))
+    restart = subprocess.run([SOLVER, str(cut / "case.json"), "--quiet", "--threads", "1",
+                              "--restart", str(cut / "checkpoint.bin")],
+                             capture_output=True, text=True, timeout=600)
+    assert restart.returncode == 0, restart.stderr
+    return cut, files
+
+
+def test_sigkill_then_restart_from_a_wall_time_checkpoint(runs, killed_with_wall_checkpoints_only):
+    whole = runs[0]
+    cut, files = killed_with_wall_checkpoints_only
+    assert "checkpoint.bin" in files
+    assert "restart from" in (cut / "run.log").read_text()
+    assert (whole / "frames.pvd").read_text() == (cut / "frames.pvd").read_text()
+    for name in sorted(os.listdir(whole / "frames")):
+        assert (whole / "frames" / name).read_bytes() == (cut / "frames" / name).read_bytes(), name
+    a, b = read_history(whole / "history.csv"), read_history(cut / "history.csv")
+    assert len(a) == len(b)
+    for ra, rb in zip(a, b):
+        ra.pop("wall_time"), rb.pop("wall_time")
+        assert ra == rb
+
+
+def test_the_default_case_json_asks_for_a_checkpoint_every_600_s(prepared):
+    _, out = prepared
+    assert json.loads((out / "case.json").read_text())["output"]["restart_every_wall"] == 600.0
 
 
 def read_history(path):

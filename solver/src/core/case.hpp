@@ -100,6 +100,10 @@ struct OutputSettings {
   // simulated time and/or every restart_every_steps steps; neither: only on SIGINT/SIGTERM.
   std::optional<double> restart_every_time;  // s
   std::optional<std::int64_t> restart_every_steps;
+  // And one every restart_every_wall seconds of wall time (0: none), on by default, so that a run
+  // killed without a signal to catch (SIGKILL, a machine going down) loses at most that much
+  // (run/schedule.hpp WallCheckpoints).
+  double restart_every_wall = 600.0;  // s
   // How frames are stored (pipeline/formats.md §4; checkpoints are always exact): the point fields
   // rounded to float32 or kept float64 (reference points stay Float64 either way), zlib blocks as
   // VTK's vtkZLibDataCompressor writes them or raw, and which point fields a frame carries (the

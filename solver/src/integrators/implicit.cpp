@@ -46,6 +46,15 @@ void Implicit::choose_linear_solver(const Case& c) {
   solver_reason_ = choice.reason;
 }
 
+std::string Implicit::keep_linear_solver(const std::string& recorded) {
+  const std::string here = linear_solver();
+  if (recorded == here) return {};
+  if (std::string why = why_not_linear_solver(op_, recorded); !why.empty()) return why;
+  use_cg_ = recorded != "direct";
+  solver_reason_ = "as the checkpoint was written; this run alone would take " + here + ", " + solver_reason_;
+  return {};
+}
+
 bool Implicit::solve_krylov(const State& s, double t1, double h, double floor) {
   const double c = mass_coefficient(h);
   if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
@@ -401,8 +410,9 @@ void Implicit::load_state(const std::vector<char>& bytes) {
   if (have) {
     State s(n);
     get_vec3(s.u);
-    // Needs the bonds of the checkpoint (restored before load_state, run/start.cpp).
-    if (!factorize_at(s, t, h, definite)) throw std::runtime_error("the saved tangent could not be factorised again");
+    // Needs the bonds of the checkpoint (restored before load_state, run/start.cpp). A factor of a
+    // run on one process is of no use to CG (a decomposed run resuming from it): dropped.
+    if (!use_cg_ && !factorize_at(s, t, h, definite)) throw std::runtime_error("the saved tangent could not be factorised again");
   }
   factorisations_ = factorisations;
 }

@@ -69,6 +69,7 @@
 #include <memory>
 
 #include "integrators/integrator.hpp"
+#include "integrators/newton_krylov.hpp"
 #include "linalg/cholesky.hpp"
 #include "linalg/pcg.hpp"
 #include "linalg/sparse_matrix.hpp"
@@ -106,6 +107,8 @@ class Implicit : public Integrator {
   const GeneralizedAlpha& parameters() const { return ga_; }
   int factorisations() const { return factorisations_; }
   bool uses_cg() const { return use_cg_; }
+  std::string linear_solver() const override { return linear_solver_name(use_cg_); }
+  std::string keep_linear_solver(const std::string& recorded) override;
   std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
   std::string linear_algebra_summary() const override;
   double dt_min() const { return dt_min_; }

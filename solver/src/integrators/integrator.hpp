@@ -83,6 +83,15 @@ class Integrator {
   // On a decomposed run, the whole model every rank holds besides its piece (run/prepare.cpp), for
   // a rule that needs the whole bond graph (mixed's load path). Not called on a serial run.
   virtual void set_whole_model(Model& /*whole*/) {}
+  // The linear solver of the scheme's Newton iterations ("direct", "cg block_jacobi", "cg amg"; ""
+  // for a scheme without one). With linear_solver or preconditioner auto it depends on the rank
+  // count, the build and the machine (integrators/newton_krylov.hpp), and each solves the systems
+  // to other bits: a checkpoint records it (io/checkpoint.hpp) so that a restart can keep it.
+  virtual std::string linear_solver() const { return {}; }
+  // On a restart, after configure() and before initialize(): go on with the linear solver the
+  // checkpoint recorded, so that the run continues bitwise. "" when the run now uses it; otherwise
+  // why it cannot (the run keeps its own choice, and the caller says the results will differ).
+  virtual std::string keep_linear_solver(const std::string& /*recorded*/) { return {}; }
   // ---- end of what the run asks
 
  protected:

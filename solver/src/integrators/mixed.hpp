@@ -110,6 +110,13 @@ class Mixed : public Integrator {
   std::string linear_algebra_summary() const override {
     return home_ == kImplicit ? implicit_.linear_algebra_summary() : static_.linear_algebra_summary();
   }
+  // The start scheme's (the explicit steps solve nothing).
+  std::string linear_solver() const override {
+    return home_ == kImplicit ? implicit_.linear_solver() : static_.linear_solver();
+  }
+  std::string keep_linear_solver(const std::string& recorded) override {
+    return home_ == kImplicit ? implicit_.keep_linear_solver(recorded) : static_.keep_linear_solver(recorded);
+  }
 
   Mode mode() const { return mode_; }  // the mode of the next step
   double explicit_dt() const { return dt_explicit_; }

@@ -47,6 +47,17 @@ LinearSolverChoice choose_linear_solver(const ForceOperator& op, const Case& c, 
                      (dimension == 3 ? ", below " + std::to_string(kCgFromDofs3d) + " in 3D" : std::string(" in 2D"))};
 }
 
+std::string why_not_linear_solver(const ForceOperator& op, const std::string& recorded) {
+  if (recorded == "cg block_jacobi") return {};
+  if (recorded != "direct") return "the checkpoint names a linear solver this pdsolve does not know ('" + recorded + "')";
+  if (const Decomposed* decomposed = op.decomposed())
+    return "direct factorises the whole tangent on one process, and this run is decomposed over " +
+           std::to_string(decomposed->ranks()) + " MPI ranks";
+  if (const std::string missing = op.missing_assembled_stiffness(State(op.size()), 0.0); !missing.empty())
+    return "direct needs an assembled tangent, which " + missing + " does not have";
+  return {};
+}
+
 PcgResult solve_newton_system(const ForceOperator& op, const State& s, double t, const FreeDofs& dofs, const DofSums& sums,
                               const std::vector<double>& diagonal, const Preconditioner& M, const std::vector<double>& rhs,
                               std::vector<double>& correction, PcgSettings settings, Vec3Array& x, Vec3Array& y) {

@@ -32,6 +32,14 @@ struct LinearSolverChoice {
 LinearSolverChoice choose_linear_solver(const ForceOperator& op, const Case& c, const std::string& section,
                                         const std::string& choice, int dof_dimension);
 
+// "direct" or "cg block_jacobi" (Integrator::linear_solver) for a scheme whose CG is preconditioned
+// by block Jacobi.
+inline std::string linear_solver_name(bool use_cg) { return use_cg ? "cg block_jacobi" : "direct"; }
+
+// Why this run cannot solve by `recorded` (a checkpoint's Integrator::linear_solver: "direct" or
+// "cg block_jacobi"), or "": direct needs one process and an assembled tangent, CG runs anywhere.
+std::string why_not_linear_solver(const ForceOperator& op, const std::string& recorded);
+
 // correction = the PCG solution of K Δu = rhs from Δu = 0 (K x = −V ∂f/∂u(s, t)·x + diagonal[q] x[q]
 // over dofs), preconditioned by M; settings.dot is set to sums.dot. A direction of negative
 // curvature at the first iteration gives M⁻¹ rhs (Steihaug's first step, a descent direction for the

@@ -152,6 +152,31 @@ void QuasiStatic::choose_preconditioner(const Case& c, std::size_t free, bool as
   }
 }
 
+// The preconditioner is the checkpoint's too: AMG and block Jacobi give other CG iterates. AMG is
+// kept on one process with hypre and an assembled tangent, even where auto's memory guard would
+// now refuse it: the run that wrote the checkpoint held its hierarchy.
+std::string QuasiStatic::keep_linear_solver(const std::string& recorded) {
+  checkpoint_solver_ = recorded;  // load_state reads the bytes that solver wrote
+  const std::string here = linear_solver();
+  if (recorded == here) return {};
+  const bool amg = recorded == "cg amg";
+  if (amg) {
+    if (const Decomposed* decomposed = op_.decomposed())
+      return "amg is set up on one process, and this run is decomposed over " + std::to_string(decomposed->ranks()) + " MPI ranks";
+    if (!AmgPreconditioner::available()) return "amg needs hypre's BoomerAMG, which this pdsolve was built without";
+    if (const std::string missing = op_.missing_assembled_stiffness(State(op_.size()), 0.0); !missing.empty())
+      return "amg is set up on the assembled tangent, which " + missing + " does not have";
+  } else if (std::string why = why_not_linear_solver(op_, recorded); !why.empty()) {
+    return why;
+  }
+  use_cg_ = recorded != "direct";
+  use_amg_ = amg;
+  solver_reason_ = "as the checkpoint was written; this run alone would take " + here + ", " + solver_reason_ +
+                   (preconditioner_reason_.empty() ? "" : ", preconditioner " + preconditioner_reason_);
+  preconditioner_reason_ = use_cg_ ? (amg ? "amg" : "block_jacobi") + std::string(": as the checkpoint was written") : "";
+  return {};
+}
+
 void QuasiStatic::set_up_amg(const State& s, double t1) {
   const auto start = std::chrono::steady_clock::now();
   if (at_start_.active && !at_start_.amg_u_saved && at_start_.amg_ready) {  // the step's start's, for restore_solver
@@ -376,14 +401,19 @@ std::vector<char> QuasiStatic::save_state() const {
 void QuasiStatic::load_state(const std::vector<char>& bytes) {
   constexpr std::size_t fixed_part = 3 + sizeof(double) + sizeof(int);
   if (bytes.size() < kReportBytes + fixed_part) throw std::runtime_error("integrator state of the wrong size");
-  const std::size_t n = op_.size();
+  // The checkpoint's arrays are the whole model's: a factor and a hierarchy are made on one process,
+  // and a decomposed run that resumes from one (keep_linear_solver could not keep it) drops them.
+  const Decomposed* decomposed = op_.decomposed();
+  const std::size_t n = decomposed ? static_cast<std::size_t>(decomposed->piece().global_nodes) : op_.size();
   const bool have = bytes[kReportBytes] != 0;
   const std::size_t extra = fixed_part + (have ? 3 * n * sizeof(double) : 0);
   load_report(std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes)), 0);
   constexpr std::size_t amg_part = 1 + 2 * sizeof(double);
+  // Whether the bytes hold the hierarchy's part: the writer's solver, if the restart said it.
+  const bool amg_saved = checkpoint_solver_.empty() ? use_cg_ && use_amg_ : checkpoint_solver_ == "cg amg";
   const bool amg = use_cg_ && use_amg_;
-  const bool have_amg = amg && bytes.size() > kReportBytes + extra && bytes[kReportBytes + extra] != 0;
-  const std::size_t amg_extra = amg ? amg_part + (have_amg ? 3 * n * sizeof(double) : 0) : 0;
+  const bool have_amg = amg_saved && bytes.size() > kReportBytes + extra && bytes[kReportBytes + extra] != 0;
+  const std::size_t amg_extra = amg_saved ? amg_part + (have_amg ? 3 * n * sizeof(double) : 0) : 0;
   const std::size_t known = kReportBytes + extra + amg_extra;
   const std::size_t tail = sizeof(double) + 1, counted_out = sizeof(std::int64_t);
   if (bytes.size() != known && bytes.size() != known + tail && bytes.size() != known + tail + counted_out)
@@ -410,7 +440,9 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   broken_since_start_ = op_.any_broken();
   find_hanging();
   MaskedBonds masked(hanging_, op_.model().bonds, !skip_dof_.empty());
-  if (have) {
+  if (have && use_cg_) {
+    at += 3 * n * sizeof(double);  // a factor, of no use to CG
+  } else if (have) {
     State s(n);
     for (auto& component : s.u) std::memcpy(component.data(), at, n * sizeof(double)), at += n * sizeof(double);
     // Needs the bonds of the checkpoint (restored before load_state, run/start.cpp).
@@ -419,12 +451,12 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   }
   factorisations_ = factorisations;
   amg_.clear();
-  if (amg) {
+  if (amg_saved) {
     ++at;  // have_amg, read above
     double amg_t = 0.0, amg_rate = 0.0;
     std::memcpy(&amg_t, at, sizeof amg_t), at += sizeof amg_t;
     std::memcpy(&amg_rate, at, sizeof amg_rate), at += sizeof amg_rate;
-    if (have_amg) {
+    if (have_amg && amg) {
       State s(n);
       for (auto& component : s.u) std::memcpy(component.data(), at, n * sizeof(double)), at += n * sizeof(double);
       set_up_amg(s, amg_t);  // the same K, the same hierarchy (hypre's serial set-up is deterministic)

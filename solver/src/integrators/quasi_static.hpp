@@ -125,6 +125,8 @@ class QuasiStatic : public Integrator {
   std::string linear_algebra_summary() const override;
   bool uses_cg() const { return use_cg_; }
   bool uses_amg() const { return use_cg_ && use_amg_; }
+  std::string linear_solver() const override { return use_cg_ && use_amg_ ? "cg amg" : linear_solver_name(use_cg_); }
+  std::string keep_linear_solver(const std::string& recorded) override;
   int amg_setups() const { return amg_setups_; }  // since configure (not checkpointed)
   // Load steps cut to the first bond failure (see the head of this file), since configure (not checkpointed).
   int cuts() const { return cuts_; }
@@ -293,6 +295,7 @@ class QuasiStatic : public Integrator {
   // forcing term eta; false when CG made no progress.
   bool use_cg_ = false;
   std::string solver_reason_;
+  std::string checkpoint_solver_;  // the solver of the checkpoint a restart reads (keep_linear_solver), or ""
   static constexpr double kEtaMax = 0.1;
   bool solve_krylov(const State& s, double t1, double eta, double floor);
   double build_block_jacobi(const State& s, double t1);

@@ -456,6 +456,34 @@ AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
   return a;
 }
 
+// output_dir, which must stay inside the run folder (the directory of case.json): pdsolve writes
+// frames, history.csv, run.log and checkpoint.bin there and deletes the old frames and checkpoint
+// it finds, so "/abs/path", "../../x" or a symbolic link out of the folder would let a case file
+// write and delete files anywhere its user may (issue 36, item 3). Checked lexically first (an
+// absolute path, or one whose normal form starts with ".."), then the folders of it that exist:
+// their real path, links followed, must still lie in the real path of the run folder.
+std::filesystem::path confined_output_dir(const Checker& ck, const std::filesystem::path& dir, const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path given(text);
+  const std::string advice = "; give a folder inside the directory of case.json, such as \".\" or \"out\"";
+  if (given.has_root_name() || given.has_root_directory())
+    ck.fail("output_dir", "'" + text + "' is an absolute path; pdsolve writes only inside the run folder" + advice);
+  const fs::path normal = given.lexically_normal();
+  if (!normal.empty() && *normal.begin() == "..")
+    ck.fail("output_dir", "'" + text + "' leaves the run folder (the directory of case.json)" + advice);
+  std::error_code folder_error, target_error;
+  const fs::path folder = fs::weakly_canonical(dir.empty() ? fs::path(".") : dir, folder_error);
+  const fs::path target = fs::weakly_canonical(dir / normal, target_error);
+  // Not checkable (a folder that cannot be searched): writing there fails later with its own message.
+  if (!folder_error && !target_error) {
+    const fs::path inside = target.lexically_relative(folder);
+    if (inside.empty() || *inside.begin() == "..")
+      ck.fail("output_dir", "'" + text + "' leads through a symbolic link to " + target.string() +
+                                ", outside the run folder " + folder.string() + advice);
+  }
+  return dir / text;
+}
+
 }  // namespace
 
 const std::map<std::string, std::vector<std::string>>& case_keys() {
@@ -477,7 +505,7 @@ const std::map<std::string, std::vector<std::string>>& case_keys() {
       {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
       {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
       {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
-                  "restart_every_steps", "precision", "compression", "fields", "gmsh", "parallel_frames"}},
+                  "restart_every_steps", "restart_every_wall", "precision", "compression", "fields", "gmsh", "parallel_frames"}},
   };
   return keys;
 }
@@ -508,7 +536,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   c.nodes_file = dir / nodes_file;
   std::string output_dir = kDefaultOutputDir;
   if (const json* j = ck.optional(root, "output_dir")) output_dir = ck.string(*j, "output_dir");
-  c.output_dir = dir / output_dir;
+  c.output_dir = confined_output_dir(ck, dir, output_dir);
 
   c.dimension = static_cast<int>(ck.integer(ck.required(root, "dimension", "dimension"), "dimension", 2, 3));
   c.analysis = ck.string(ck.required(root, "analysis", "analysis"), "analysis");
@@ -620,6 +648,8 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(output, "restart_every_steps"); j && !j->is_null())
     c.output.restart_every_steps =
         ck.integer(*j, "output.restart_every_steps", 1, std::numeric_limits<std::int64_t>::max());
+  if (const json* j = ck.optional(output, "restart_every_wall"))
+    c.output.restart_every_wall = ck.non_negative(*j, "output.restart_every_wall");
   if (const json* j = ck.optional(output, "history_every"))
     c.output.history_every = ck.integer(*j, "output.history_every", 1, std::numeric_limits<std::int64_t>::max());
   if (const json* j = ck.optional(output, "reactions")) {

@@ -89,12 +89,18 @@ class Reader {
 };
 
 // One field list for both directions, so writer and reader cannot drift apart.
+// A text field: an array of chars.
+template <class IO>
+void text(IO& io, std::string& s) {
+  std::vector<char> chars(s.begin(), s.end());
+  io.array(chars);
+  s.assign(chars.begin(), chars.end());
+}
+
 template <class IO>
 void fields(IO& io, Checkpoint& c) {
   io.scalar(c.case_hash), io.scalar(c.nodes_hash), io.scalar(c.nodes), io.scalar(c.directed_bonds);
-  std::vector<char> name(c.integrator.begin(), c.integrator.end());
-  io.array(name);
-  c.integrator.assign(name.begin(), name.end());
+  text(io, c.integrator);
   LoopState& l = c.loop;
   io.scalar(l.step), io.scalar(l.t), io.scalar(l.dt), io.scalar(l.dt_taken);
   io.scalar(l.last_frame_step), io.scalar(l.next_frame_index), io.scalar(l.next_restart_index);
@@ -119,6 +125,7 @@ void fields(IO& io, Checkpoint& c) {
   io.scalar(c.contact_rebuilds), io.scalar(c.contact_seconds), io.vec3(c.contact_u_build);
   io.array(c.frame_times), io.scalar(c.history_bytes);
   io.scalar(s.indenter_energy);  // version 3 (issue 16): before, it was part of contact_energy
+  text(io, c.linear_solver);     // version 4 (issue 36)
 }
 
 }  // namespace

@@ -19,7 +19,8 @@
 namespace pd {
 
 // 2: the per-node critical stretch of LAMMPS's α rule after the broken flags (docs/lammps.md).
-constexpr std::uint32_t kCheckpointVersion = 3;
+// 3: the indenter energy apart from the contact energy. 4: the linear solver in use (issue 36).
+constexpr std::uint32_t kCheckpointVersion = 4;
 
 struct Checkpoint {
   // What it belongs to: a restart refuses a checkpoint of another case or node file.
@@ -45,6 +46,10 @@ struct Checkpoint {
   // of history.csv at the checkpoint (rows after it, from a run killed later, are cut off).
   std::vector<double> frame_times;
   std::uint64_t history_bytes = 0;
+
+  // Integrator::linear_solver() ("direct", "cg block_jacobi", "cg amg"; "" for a scheme without
+  // one): auto's choice depends on the rank count, and a restart keeps it where it can (run/start.cpp).
+  std::string linear_solver;
 };
 
 // FNV-1a-64 of a file's bytes; throws pd::Error if it cannot be read.

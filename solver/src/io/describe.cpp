@@ -61,7 +61,7 @@ json describe_case() {
   keys["title"] = defaulted("string", c.title);
   keys["source"] = defaulted("string", c.source);
   keys["nodes_file"] = required("string", {{"note", "relative to the directory of case.json; not empty"}});
-  keys["output_dir"] = defaulted("string", kDefaultOutputDir, {{"note", "relative to the directory of case.json"}});
+  keys["output_dir"] = defaulted("string", kDefaultOutputDir, {{"note", "relative to the directory of case.json (the run folder), and inside it: an absolute path, .. out of it or a symbolic link out of it is refused"}});
   keys["dimension"] = required("integer", {{"minimum", 2}, {"maximum", 3}});
   keys["analysis"] = required("string", {{"choices", analysis_registry().keys()}, {"note", "must fit dimension"}});
   keys["thickness"] = defaulted("number", c.thickness,
@@ -174,6 +174,8 @@ json describe_case() {
   keys["output.restart_every_time"] = defaulted("number", value_or_null(o.restart_every_time),
                                               {{"above", 0.0}, {"unit", "s"}});
   keys["output.restart_every_steps"] = defaulted("integer", value_or_null(o.restart_every_steps), {{"minimum", 1}});
+  keys["output.restart_every_wall"] = defaulted("number", o.restart_every_wall,
+                                              {{"minimum", 0.0}, {"unit", "s"}, {"note", "wall time; 0: none"}});
   keys["output.precision"] = defaulted("string", o.precision, {{"choices", {"float32", "float64"}}});
   keys["output.compression"] = defaulted("string", o.compression, {{"choices", {"zlib", "none"}}});
   keys["output.fields"] = defaulted("strings", o.fields, {{"choices", frame_fields()}});

@@ -57,6 +57,7 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
   const double wall_before = loop.wall_time;  // time loop of the run(s) before a restart
   const std::int64_t first_step = loop.step;   // steps of this run: loop.step − first_step
   const Schedule schedule(p.c.output, p.c.time.end);
+  WallCheckpoints wall_checkpoints(p.c.output.restart_every_wall, 0.0);  // on the clock seconds_since(loop_start)
   const std::filesystem::path checkpoint_file = checkpoint_path(p.c);
   Energies energies(*p.op, state);
   BlowUpWatch blow_up(loop.growth);
@@ -178,6 +179,17 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     saved.wall_time = wall_before + seconds_since(loop_start);
     write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, std::move(integrator_state), contact_u_build));
     if (!p.whole_bonds) std::vector<std::uint8_t>().swap(p.model.bonds.broken);
+  };
+  // write_restart timed for the wall-time schedule (only rank 0's clock decides it, below).
+  const auto checkpoint = [&](bool for_wall_time) {
+    const double began = seconds_since(loop_start);
+    write_restart();
+    const double ended = seconds_since(loop_start);
+    wall_checkpoints.written(began, ended);
+    if (for_wall_time && out)
+      log.note("checkpoint: " + checkpoint_file.string() + " at step " + std::to_string(loop.step) + ", t = " +
+               format("%.6g", loop.t) + " s (output.restart_every_wall " + format("%g", p.c.output.restart_every_wall) +
+               " s), written in " + format("%.3g", ended - began) + " s wall");
   };
   // A blow-up found after a streak of energy growth: the frames written during the streak show the
   // instability, not the physics (a kept "last valid" frame had max|v| = 1.2·10⁹ m/s, issue 17,
@@ -304,13 +316,20 @@ LoopEnd run_loop(const RunOptions& opt, Prepared& p, Start& s, const HistoryColu
     const bool restart_due = schedule.restart_due(loop);
     if (opt.after_step) opt.after_step(loop.step);
     int signal = pending_signal();
-    if (dec) signal = -static_cast<int>(dec->minimum(-signal));  // stop on every rank after the same step
+    bool wall_due = out && wall_checkpoints.due(seconds_since(loop_start));
+    if (dec) {
+      // Every rank stops, or writes its part of a checkpoint, after the same step: one reduction
+      // carries both, 2·signal + (rank 0's wall-time checkpoint due), the largest over the ranks.
+      const int both = -static_cast<int>(dec->minimum(-(2 * signal + (wall_due ? 1 : 0))));
+      signal = both / 2;
+      wall_due = both % 2 == 1;
+    }
     if (signal != 0) {
       end.interrupted = signal;
       write_restart();
       break;
     }
-    if (restart_due) write_restart();
+    if (restart_due || wall_due) checkpoint(!restart_due);
     progress.after_step(loop.t, loop.step, seconds_since(loop_start));
   }
   progress.clear();

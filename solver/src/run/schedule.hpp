@@ -1,6 +1,8 @@
 // When the time loop writes: frames, history rows and checkpoints, and where a step must land
-// (the end time, every k·every_time) — decided from output.* and time.end, nothing else.
+// (the end time, every k·every_time) — decided from output.* and time.end, nothing else; and the
+// checkpoints of wall time (WallCheckpoints), decided from a clock the caller reads.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 
 #include "core/case.hpp"
@@ -44,6 +46,36 @@ class Schedule {
  private:
   OutputSettings output_;
   double end_;
+};
+
+// A checkpoint every output.restart_every_wall seconds of wall time (0: none; default 600 s), so
+// that a run killed without a signal it can catch (SIGKILL, a machine going down) loses at most that
+// much: a plate_with_hole run killed at step 7,360 of 8,027 lost everything (issue 36, item 8).
+// Times are seconds on the caller's clock (the time loop's since it started; a test's own numbers),
+// so the decision can be tested without waiting. A checkpoint is written between steps and changes
+// no step, history row or frame: only when it comes depends on the clock.
+class WallCheckpoints {
+ public:
+  // Checkpoints may take at most this share of the wall time. A big model on a slow disk can take
+  // a good part of restart_every_wall to write (the state and every bond's broken flag); after one
+  // that took w seconds the next comes no sooner than w / kMaxShare after it began, so a run spends
+  // about 3 % of its time on them at most, whatever the disk (as long as a checkpoint takes about
+  // as long as the one before it).
+  static constexpr double kMaxShare = 0.03;
+
+  // every: restart_every_wall [s]; start: the clock when the time loop began.
+  WallCheckpoints(double every, double start) : every_(every), next_(start + every) {}
+  // True when a checkpoint is due at `now`.
+  bool due(double now) const { return every_ > 0.0 && now >= next_; }
+  // A checkpoint (for any reason: a wall-time one, restart_every_steps/_time) began at `began` and
+  // was written at `ended`: the next is due every seconds, or w / kMaxShare, after it began.
+  void written(double began, double ended) { next_ = began + std::max(every_, (ended - began) / kMaxShare); }
+  // When the next checkpoint is due (for run.log).
+  double next() const { return next_; }
+
+ private:
+  double every_;
+  double next_;
 };
 
 }  // namespace pd

@@ -59,6 +59,19 @@ void restore_piece(Prepared& p, State& whole, Start& s) {
   rows_to_local(piece, p.model.bonds, piece.model.bonds);
 }
 
+// The checkpoint's linear solver, before initialize() sizes the scratch for it. Auto's choice
+// depends on the rank count (a 2-rank quasi_static run solves by CG, one rank would factorise), and
+// either gives other bits: kept where this run can (CG runs on any rank count), else said, since
+// the restarted run will then not be bitwise the uninterrupted one (issue 36, item 9).
+void keep_linear_solver(const RunOptions& opt, Integrator& integrator, const std::string& recorded, Start& s) {
+  const std::string here = integrator.linear_solver();
+  const std::string why = integrator.keep_linear_solver(recorded);
+  if (why.empty()) return;
+  s.solver_changed = "pdsolve: warning: " + opt.restart.string() + " was written by a run solving with " + recorded +
+                     ", which this run cannot take (" + why + "): it goes on with " + here +
+                     ", and its results will not be bitwise those of the uninterrupted run";
+}
+
 // Replaces the fresh state by the checkpoint's, after checking that it belongs to this case.
 void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
@@ -84,6 +97,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   // Checked before any rank takes its piece: every rank holds the same whole state and decides alike
   // (a serial run checks after restore, in start_or_restore).
   if (p.decomposed && first_non_finite(checkpoint.state) >= 0) throw Error(where + "the checkpoint's state is not finite");
+  keep_linear_solver(opt, integrator, checkpoint.linear_solver, s);
   // initialize() sizes the integrator's scratch; then everything it set is replaced by the
   // checkpoint, so the run continues bitwise as if it had never stopped.
   if (p.decomposed) s.state = State(p.decomposed->piece().size());
@@ -183,6 +197,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, 
   k.nodes = model.nodes.size();
   k.directed_bonds = static_cast<std::size_t>(p.directed_bonds());
   k.integrator = p.integrator->name();
+  k.linear_solver = p.integrator->linear_solver();
   k.loop = loop;
   k.integrator_state = std::move(integrator_state);
   k.state = whole;

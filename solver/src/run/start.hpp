@@ -22,6 +22,9 @@ struct Start {
   LoopState loop;
   OutputResume resume;  // a restart: the frames kept and history.csv's length
   std::uint64_t case_hash = 0, nodes_hash = 0;  // what a checkpoint written by this run belongs to
+  // A restart that cannot keep the checkpoint's linear solver: why, and that the results will
+  // differ from the uninterrupted run's (for run.log and stderr); "" otherwise.
+  std::string solver_changed;
 };
 
 // Throws pd::Error for a checkpoint that does not fit (saying how to start over instead) or an
