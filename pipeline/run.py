@@ -23,6 +23,7 @@ from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
 from .cost import check_cost
+from .inputs import check_case_inputs
 from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
 
@@ -235,6 +236,8 @@ def main(argv=None) -> int:
     # Preprocess warnings name their file already; print them as such, not as Python source lines.
     warnings.showwarning = lambda message, *rest, **kw: print(f"warning: {message}", file=sys.stderr)
     try:
+        # Before a stage reads anything: no input may lead out of the case folder (issue 36).
+        check_case_inputs(args.case, getattr(args, "geo", None), getattr(args, "mesh", None))
         args.func(args)
     except CaseError as err:
         print(f"error: {err}", file=sys.stderr)
