@@ -66,11 +66,19 @@ def check_lengths(case: dict, geo: str):
 
 def probe_geometry(case: dict, geo: str) -> dict:
     """preprocess/geo_probe.py's description of the body, in a subprocess with a time limit."""
+    from preprocess import sandbox
+
     parameters = case["geometry"]["parameters"]
-    command = [sys.executable, "-m", "preprocess.geo_probe", geo, str(case["dimension"]), json.dumps(parameters)]
+    real = os.path.realpath(geo)
+    # gmsh.open parses the .geo as gmsh does (a SystemCall there would run): in the sandbox too,
+    # with the case folder and the Python code the probe imports read-only, and nothing writable.
+    # Debian's python3 (in /usr), the one the sandbox holds, with python3-gmsh.
+    python = sys.executable if sys.executable.startswith("/usr/") or not sandbox.enabled() else "/usr/bin/python3"
+    command = [python, "-m", "preprocess.geo_probe", real, str(case["dimension"]), json.dumps(parameters)]
+    code = [os.path.join(ROOT, package) for package in ("preprocess", "pipeline")]
     try:
-        result = subprocess.run(command, cwd=ROOT, stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                timeout=PROBE_TIMEOUT)
+        result = sandbox.run(command, geo, read_only=[os.path.dirname(real), *code], cwd=ROOT,
+                             timeout=PROBE_TIMEOUT)
     except subprocess.TimeoutExpired:
         raise CaseError(f"{case['_path']}:{_line(case)}: gmsh did not build the geometry of {geo} within "
                         f"{PROBE_TIMEOUT:g} s; check the .geo and its parameters") from None
