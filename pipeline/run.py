@@ -18,7 +18,7 @@ import os
 import sys
 import warnings
 
-from .body import check_body, check_lengths, check_mesh_cost, probe_geometry
+from .body import check_body, check_lengths, check_mesh_cost, check_mesh_growth, probe_geometry
 from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
@@ -83,6 +83,7 @@ def cmd_mesh(args):
     probe = check_geometry(case, args.geo)
     # Before gmsh meshes: its size and the lattice's (issue 17, item 11); FORCE=1 runs it anyway.
     plan = check_mesh_cost(case, args.geo, probe, os.path.dirname(os.path.abspath(args.out)))
+    check_mesh_growth(case, args.geo, probe, os.path.dirname(os.path.abspath(args.out)))
     if plan:
         print(f"{args.case}: {plan}")
     try:

@@ -50,19 +50,28 @@ def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[
     limit = gmsh_timeout() if timeout is None else timeout
     with atomic_path(out_msh_path) as tmp:
         result = run_gmsh(geo_path, [f"-{dimension}"], parameters, tmp, limit)
-        output = (result.stdout + "\n" + result.stderr).splitlines()
-        errors = []
-        for line in output:
-            if line.startswith("Error") and line not in errors:
-                errors.append(line)
-        if result.returncode != 0 or errors:
-            shown = errors[:MAX_ERROR_LINES] or output[-MAX_ERROR_LINES:]
-            more = f"\n  ... ({len(errors) - MAX_ERROR_LINES} more)" if len(errors) > MAX_ERROR_LINES else ""
-            raise PreprocessError(f"{geo_path}: gmsh failed (exit code {result.returncode}):\n  "
-                                  + "\n  ".join(shown) + more)
+        check_gmsh_result(geo_path, result)
         if os.path.getsize(tmp) == 0:
             raise PreprocessError(f"{geo_path}: gmsh wrote an empty mesh")
         check_complete_msh(tmp, out_msh_path)
+
+
+def check_gmsh_result(geo_path: str, result: subprocess.CompletedProcess):
+    """PreprocessError with gmsh's error lines when it failed (non-zero exit or any 'Error' line)."""
+    output = (result.stdout + "\n" + result.stderr).splitlines()
+    errors = []
+    for line in output:
+        if line.startswith("Error") and line not in errors:
+            errors.append(line)
+    if result.returncode < 0 or result.returncode >= 128 or any("bad_alloc" in line or "Out of memory" in line for line in output):
+        raise PreprocessError(f"{geo_path}: gmsh ran out of the memory it may use ({sandbox.memory_cap() / 1e6:.0f} "
+                              "MB: half of the memory available, all of it with FORCE=1) or was killed (exit "
+                              f"code {result.returncode}); coarsen the mesh (a larger mesh size)")
+    if result.returncode != 0 or errors:
+        shown = errors[:MAX_ERROR_LINES] or output[-MAX_ERROR_LINES:]
+        more = f"\n  ... ({len(errors) - MAX_ERROR_LINES} more)" if len(errors) > MAX_ERROR_LINES else ""
+        raise PreprocessError(f"{geo_path}: gmsh failed (exit code {result.returncode}):\n  "
+                              + "\n  ".join(shown) + more)
 
 
 def run_gmsh(geo_path: str, steps: list[str], parameters: dict[str, float], out_path: str,
