@@ -57,12 +57,13 @@ def _bwrap_arguments(read_only, writable, cwd) -> list[str]:
     for shell in SHELLS:
         if os.path.exists(shell):
             args += ["--ro-bind", "/dev/null", shell]
-    for path in read_only:
-        real = os.path.realpath(path)
-        args += ["--ro-bind", real, real]
-    for path in writable:
-        real = os.path.realpath(path)
-        args += ["--bind", real, real]
+    for flag, paths in (("--ro-bind", read_only), ("--bind", writable)):
+        for path in paths:
+            real = os.path.realpath(path)
+            if real == "/":   # a .geo at the root of the file system: that would bind everything
+                raise PreprocessError(f"{path}: a case folder must not be the root folder; put the case in a "
+                                      "folder of its own")
+            args += [flag, real, real]
     args += ["--setenv", "PATH", "/usr/bin", "--setenv", "HOME", HOME]
     if os.environ.get("OMP_NUM_THREADS"):
         args += ["--setenv", "OMP_NUM_THREADS", os.environ["OMP_NUM_THREADS"]]
