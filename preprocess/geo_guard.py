@@ -24,7 +24,12 @@ this one (gmsh 4.8.4 Parser/Gmsh.l, each checked by running gmsh 4.8.4 on a .geo
   `If` character by character (skipTest), honouring comments but not strings, and goes on at the
   first Else/EndIf it meets, even one inside a string, so the rest of that string would run;
 - in an identifier, If/Else/EndIf after a digit (`x1EndIf`): skipTest takes a digit for a word
-  boundary and would go on in the middle of the identifier.
+  boundary and would go on in the middle of the identifier;
+- a comment opener or a quote that gmsh's skipping drops: while it skips an If branch, a For loop
+  or a Function body, gmsh reads six characters at each E, I, F or R that starts a word, and when
+  they are not its keyword it pushes back only four, losing the character after the letter; after
+  an `If` or a `For` it pushes back none. ` E/* EndIf … */` then hides nothing from the guard but
+  the comment from gmsh, which goes on at the EndIf inside it (tried: the command ran).
 Every gmsh that reads a case's .geo also runs in a sandbox (preprocess/sandbox.py), so that a
 construct this guard does not know of still cannot run a program or write outside its output.
 """
@@ -117,6 +122,33 @@ def tokens(text: str, path: str):
         at = m.end()
 
 
+def _skip_hazard(text: str) -> int | None:
+    """The offset of a character gmsh's skip()/skipTest() would drop unseen that opens a comment or a
+    string (see the module's docstring), or None. Over-approximates where gmsh would start a
+    candidate word: after a non-letter, and where skipping resumes after a dropped character."""
+    def word_start(k: int) -> bool:
+        return k == 0 or not (text[k - 1].isalpha() or text[k - 1] == "_")
+
+    candidates = [k for k, c in enumerate(text) if c in "EIFR" and word_start(k)]
+    seen = set(candidates)
+    while candidates:
+        k = candidates.pop()
+        swallowed = [k + 1]                          # a word that is not the keyword: one lost
+        resume = [k + 2]
+        if text.startswith("If", k) and not text[k + 2:k + 3].isalpha():
+            swallowed, resume = range(k + 2, k + 6), [k + 6]   # nested If: four lost
+        elif text.startswith("For", k) and not text[k + 3:k + 4].isalpha():
+            swallowed, resume = range(k + 3, k + 6), [k + 6]   # nested For: three lost
+        for j in swallowed:
+            if j < len(text) and (text[j] in "\"'" or text.startswith(("//", "/*"), j)):
+                return j
+        for j in resume:   # gmsh goes on there with the old previous character: a word start
+            if j < len(text) and text[j] in "EIFR" and j not in seen:
+                seen.add(j)
+                candidates.append(j)
+    return None
+
+
 def _check_string(value: str, path: str, line: int):
     """A string literal that gmsh would not read as one string (see the module's docstring)."""
     if len(value) >= GMSH_STRING_CUT:
@@ -163,6 +195,13 @@ def _scan(path: str, case_dir: str, scanned: list, depth: int):
     except UnicodeDecodeError as err:
         line = raw[:err.start].count(b"\n") + 1
         raise PreprocessError(f"{path}:{line}: not UTF-8 text; a .geo is a text file") from None
+    hazard = _skip_hazard(text)
+    if hazard is not None:
+        line = text.count("\n", 0, hazard) + 1
+        shown = text[max(0, hazard - 5):hazard + 1].split("\n")[-1].strip()
+        raise PreprocessError(f"{path}:{line}: '{shown}': gmsh, skipping an If branch, a "
+                              f"For loop or a Function body, would not see the {text[hazard]!r} after the E, I, F or "
+                              "R before it and would read what follows differently: put a space between them")
     found = list(tokens(text, path))
     for k, (kind, value, line) in enumerate(found):
         if kind != "ident":

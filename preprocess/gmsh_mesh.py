@@ -49,7 +49,7 @@ def mesh_geo(geo_path: str, out_msh_path: str, dimension: int, parameters: dict[
     check_geo(geo_path)
     limit = gmsh_timeout() if timeout is None else timeout
     with atomic_path(out_msh_path) as tmp:
-        result = run_gmsh(geo_path, [f"-{dimension}"], parameters, tmp, limit)
+        result = run_gmsh(geo_path, dimension, parameters, tmp, limit)
         check_gmsh_result(geo_path, result)
         if os.path.getsize(tmp) == 0:
             raise PreprocessError(f"{geo_path}: gmsh wrote an empty mesh")
@@ -63,7 +63,9 @@ def check_gmsh_result(geo_path: str, result: subprocess.CompletedProcess):
     for line in output:
         if line.startswith("Error") and line not in errors:
             errors.append(line)
-    if result.returncode < 0 or result.returncode >= 128 or any("bad_alloc" in line or "Out of memory" in line for line in output):
+    # At the memory cap gmsh's allocation throws std::bad_alloc and it aborts (bwrap: exit 134).
+    killed = result.returncode < 0 or result.returncode >= 128
+    if killed or any("bad_alloc" in line or "Out of memory" in line for line in output):
         raise PreprocessError(f"{geo_path}: gmsh ran out of the memory it may use ({sandbox.memory_cap() / 1e6:.0f} "
                               "MB: half of the memory available, all of it with FORCE=1) or was killed (exit "
                               f"code {result.returncode}); coarsen the mesh (a larger mesh size)")
@@ -74,9 +76,9 @@ def check_gmsh_result(geo_path: str, result: subprocess.CompletedProcess):
                               + "\n  ".join(shown) + more)
 
 
-def run_gmsh(geo_path: str, steps: list[str], parameters: dict[str, float], out_path: str,
+def run_gmsh(geo_path: str, dimension: int, parameters: dict[str, float], out_path: str,
              timeout: float) -> subprocess.CompletedProcess:
-    """`gmsh <steps> geo -o out -format msh4 -setnumber NAME VALUE ...` in the sandbox
+    """`gmsh -<dimension> geo -o out -format msh4 -setnumber NAME VALUE ...` in the sandbox
     (preprocess/sandbox.py): the case folder read-only, and writable only a fresh folder next to
     `out_path`, from which the mesh is moved to `out_path` once gmsh has ended. A .geo that gets
     past geo_guard still cannot run a program or write elsewhere. TimeoutExpired and
@@ -88,7 +90,7 @@ def run_gmsh(geo_path: str, steps: list[str], parameters: dict[str, float], out_
     workdir = tempfile.mkdtemp(prefix=".gmsh-", dir=os.path.dirname(os.path.abspath(out_path)))
     try:
         written = os.path.join(workdir, "mesh.msh")
-        cmd = [exe, *steps, geo, "-o", written, "-format", "msh4", "-nopopup"]
+        cmd = [exe, f"-{dimension}", geo, "-o", written, "-format", "msh4", "-nopopup"]
         for name, value in parameters.items():
             cmd += ["-setnumber", str(name), repr(float(value))]
         try:

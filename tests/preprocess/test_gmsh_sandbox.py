@@ -54,13 +54,22 @@ def test_the_report_string_split_at_1023_characters_is_refused_by_check(tmp_path
     ("If (0)\ns = \"Else SystemCall 'touch M'; t = '\";\n'; EndIf\n// '\n", 2, "holds 'Else'"),
     # … and it honours comments there, but not strings: a // in a string hides the next line
     ('If (0)\ns = "//"; t = "\nEndIf\nSystemCall "touch M";\nu = "\nEndIf\n', 2, "the string \"//\" holds '//'"),
-    ('s = "/* a comment for gmsh in an If";\n', 1, "holds '/*'"),
+    ('s = "/* a comment for gmsh";\n', 1, "holds '/*'"),
     # a digit is a word boundary for that search: it would stop in the middle of the name
     ("If (0)\nx1EndIf = 1;\nEndIf\n", 2, "the name 'x1EndIf' holds If/Else/EndIf after a digit"),
+    # skipping, gmsh drops the character after an E, I, F or R that is not its keyword (tried: each ran)
+    ("If (0)\n E/* EndIf SystemCall 'touch M'; /* */\nEndIf\n", 2,
+     "'E/': gmsh, skipping an If branch, a For loop or a Function body, would not see the '/' after the E, I, F "
+     "or R before it and would read what follows differently: put a space between them"),
+    ("Function f\n R\"Return SystemCall 'touch M'; a = '\";\n'; Return\nx = 1; // '\n", 2, "'R\"': gmsh, skipping"),
+    ("For i In {1:0}\n E\"EndFor SystemCall 'touch M'; a = '\";\n'; EndFor\nx = 1; // '\n", 2, "'E\"': gmsh, skipping"),
+    # … and after a nested If it drops four characters
+    ("If (0)\nIf(1/* EndIf EndIf SystemCall 'touch M'; */\nEndIf\n", 2, "'If(1/': gmsh, skipping"),
     # a NUL byte ends a string or a comment for gmsh
     ('s = "abc\0"; t = "";\n', 1, "a NUL byte, which ends a string or a comment early for gmsh"),
 ], ids=["1022-chars", "1023-chars", "EndIf-in-string", "Else-in-string", "line-comment-in-string",
-        "block-comment-in-string", "digit-EndIf-name", "NUL"])
+        "block-comment-in-string", "digit-EndIf-name", "If-drops-comment", "Function-drops-quote", "For-drops-quote",
+        "nested-If-drops-four", "NUL"])
 def test_what_gmsh_lexes_differently_is_refused(tmp_path, text, line, message):
     geo = tmp_path / "case.geo"
     geo.write_text(SQUARE + text)
