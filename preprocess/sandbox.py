@@ -63,7 +63,10 @@ def _bwrap_arguments(read_only, writable, cwd) -> list[str]:
             if real == "/":   # a .geo at the root of the file system: that would bind everything
                 raise PreprocessError(f"{path}: a case folder must not be the root folder; put the case in a "
                                       "folder of its own")
-            args += [flag, real, real]
+            # At its real path, and at the path given when that goes through a symbolic link (a
+            # tree whose preprocess/ links to the repository's): the program may use either.
+            for where in dict.fromkeys((real, os.path.abspath(path))):
+                args += [flag, real, where]
     args += ["--setenv", "PATH", "/usr/bin", "--setenv", "HOME", HOME]
     if os.environ.get("OMP_NUM_THREADS"):
         args += ["--setenv", "OMP_NUM_THREADS", os.environ["OMP_NUM_THREADS"]]
