@@ -81,7 +81,8 @@ MAX_GEO_BYTES = 10 * 1024 * 1024
 # gmsh 4.8.4 parsestring() cuts a string at 1023 characters (`char tmp[1024]`): refused from there.
 GMSH_STRING_CUT = 1023
 # What gmsh's skipTest (the untaken branch of an If) reacts to while it ignores strings.
-SKIP_TEST_IN_STRING = re.compile(r"//|/\*|(?<![A-Za-z_])(?:EndIf|Else|If)")
+# Anywhere in the string, whatever precedes: gmsh's "previous character" is stale after a dropped one.
+SKIP_TEST_IN_STRING = re.compile(r"//|/\*|EndIf|Else|If")
 SKIP_TEST_IN_IDENT = re.compile(r"[0-9](?:EndIf|Else|If)")
 
 TOKEN = re.compile(r"""
@@ -210,6 +211,12 @@ def _scan(path: str, case_dir: str, scanned: list, depth: int):
         if SKIP_TEST_IN_IDENT.search(value):
             raise PreprocessError(f"{where}: the name '{value}' holds If/Else/EndIf after a digit, where gmsh "
                                   "would end a skipped If branch in the middle of the name: rename it")
+        # Where gmsh goes on in the middle of a name, it reads the digits as a number and the rest
+        # as a name of its own: a command after digits could hide in a longer name.
+        hidden = [word for word in FORBIDDEN if re.search(rf"[0-9]{word}", value)]
+        if hidden:
+            raise PreprocessError(f"{where}: the name '{value}' holds '{hidden[0]}' after a digit, which gmsh could "
+                                  f"read as a command of its own; {FIX}")
         if value in FORBIDDEN:
             raise PreprocessError(f"{where}: '{value}' {FORBIDDEN[value]}; {FIX}")
         if value == "Printf" and _printf_redirects(found, k):

@@ -65,11 +65,14 @@ def test_the_report_string_split_at_1023_characters_is_refused_by_check(tmp_path
     ("For i In {1:0}\n E\"EndFor SystemCall 'touch M'; a = '\";\n'; EndFor\nx = 1; // '\n", 2, "'E\"': gmsh, skipping"),
     # … and after a nested If it drops four characters
     ("If (0)\nIf(1/* EndIf EndIf SystemCall 'touch M'; */\nEndIf\n", 2, "'If(1/': gmsh, skipping"),
+    # after a dropped character gmsh's "previous character" is stale: an EndIf after a letter matches
+    ("If (0)\ns = \" EaEndIf SystemCall 'touch M'; t = '\";\n'; EndIf\n// '\n", 2, "holds 'EndIf'"),
+    ("If (0)\n EaEndIf2SystemCall = 1;\nEndIf\n", 2, "the name 'EaEndIf2SystemCall' holds 'SystemCall' after a digit"),
     # a NUL byte ends a string or a comment for gmsh
     ('s = "abc\0"; t = "";\n', 1, "a NUL byte, which ends a string or a comment early for gmsh"),
 ], ids=["1022-chars", "1023-chars", "EndIf-in-string", "Else-in-string", "line-comment-in-string",
         "block-comment-in-string", "digit-EndIf-name", "If-drops-comment", "Function-drops-quote", "For-drops-quote",
-        "nested-If-drops-four", "NUL"])
+        "nested-If-drops-four", "stale-previous-in-string", "command-after-digits-in-name", "NUL"])
 def test_what_gmsh_lexes_differently_is_refused(tmp_path, text, line, message):
     geo = tmp_path / "case.geo"
     geo.write_text(SQUARE + text)
