@@ -66,11 +66,19 @@ def check_lengths(case: dict, geo: str):
 
 def probe_geometry(case: dict, geo: str) -> dict:
     """preprocess/geo_probe.py's description of the body, in a subprocess with a time limit."""
+    from preprocess import sandbox
+
     parameters = case["geometry"]["parameters"]
-    command = [sys.executable, "-m", "preprocess.geo_probe", geo, str(case["dimension"]), json.dumps(parameters)]
+    real = os.path.realpath(geo)
+    # gmsh.open parses the .geo as gmsh does (a SystemCall there would run): in the sandbox too,
+    # with the case folder and the Python code the probe imports read-only, and nothing writable.
+    # Debian's python3 (in /usr), the one the sandbox holds, with python3-gmsh.
+    python = sys.executable if sys.executable.startswith("/usr/") or not sandbox.enabled() else "/usr/bin/python3"
+    command = [python, "-m", "preprocess.geo_probe", real, str(case["dimension"]), json.dumps(parameters)]
+    code = [os.path.join(ROOT, package) for package in ("preprocess", "pipeline")]
     try:
-        result = subprocess.run(command, cwd=ROOT, stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                timeout=PROBE_TIMEOUT)
+        result = sandbox.run(command, geo, read_only=[os.path.dirname(real), *code], cwd=ROOT,
+                             timeout=PROBE_TIMEOUT)
     except subprocess.TimeoutExpired:
         raise CaseError(f"{case['_path']}:{_line(case)}: gmsh did not build the geometry of {geo} within "
                         f"{PROBE_TIMEOUT:g} s; check the .geo and its parameters") from None
@@ -203,6 +211,49 @@ def estimate_mesh(case: dict, geo: str, probe: dict) -> dict:
             "measure": measure}
 
 
+def _gmsh_over_limits(n: float, memory: float, disk: float) -> list[str]:
+    """What a gmsh mesh of n nodes would go beyond: MAX_HOURS, half of the memory or of the disk."""
+    seconds, need, size = n / GMSH_NODE_RATE, n * GMSH_BYTES_PER_NODE, n * MSH_BYTES_PER_NODE
+    found = []
+    if seconds > MAX_HOURS * 3600:
+        found.append(f"meshing would take about {_duration(seconds)} (more than {MAX_HOURS:g} h)")
+    if need > 0.5 * memory:
+        found.append(f"gmsh would need about {need / 1e6:.0f} MB, more than half of the {memory / 1e6:.0f} MB "
+                     "available")
+    if size > 0.5 * disk:
+        found.append(f"the mesh file would be about {size / 1e6:.3g} MB, more than half of the {disk / 1e6:.3g} MB free")
+    return found
+
+
+def check_mesh_growth(case: dict, geo: str, probe: dict, out_dir: str, force: bool | None = None):
+    """The estimate above trusts the .geo's labelled mesh size; a mesh size field (`Field[1] =
+    MathEval; Field[1].F = "2e-6"; Background Field = 1;`) or a point's size bypassed it (722 nodes
+    estimated, then gmsh meshed until the time limit). The probe meshed the boundary (its curves in
+    2D, its surfaces in 3D) with everything the .geo sets: at that mean element size h, the body
+    (its bounding box, an upper bound) would have measure / (area or volume per node at h) nodes;
+    above check_mesh_cost's limits this is a CaseError naming the .geo, the boundary's mesh and the
+    estimate, unless FORCE=1."""
+    force = os.environ.get("FORCE") == "1" if force is None else force
+    boundary = probe.get("boundary")
+    if force or not boundary or not boundary["size"]:
+        return
+    dim = case["dimension"]
+    est = estimate_mesh(case, geo, probe)
+    h = boundary["size"]
+    n = est["measure"] / ((AREA_PER_NODE if dim == 2 else VOLUME_PER_NODE) * h ** dim)
+    found = _gmsh_over_limits(n, _available_memory(), _free_disk(out_dir))
+    if not found:
+        return
+    what = "curves" if dim == 2 else "surfaces"
+    said = (f"the estimate from the case's mesh size {est['mesh_size']:g} m was about {est['mesh_nodes']:.3g} nodes"
+            if est["mesh_nodes"] is not None else "the .geo labels no mesh size")
+    raise CaseError(f"{case['_path']}:{_line(case)}: {geo}: gmsh meshed the body's {what} with {boundary['nodes']} "
+                    f"nodes, {h:.3g} m apart on average ({said}); at that size the {dim}D mesh would have about "
+                    f"{n:.3g} nodes: " + "; ".join(found) + ": a mesh size field (Field, Background Field) or the "
+                    "size of a point makes the mesh finer than the mesh size says; coarsen it, or run it anyway "
+                    "with FORCE=1 (make FORCE=1 case=...)")
+
+
 def check_mesh_cost(case: dict, geo: str, probe: dict, out_dir: str, force: bool | None = None) -> str | None:
     """CaseError (naming the mesh size's or dx's line, the estimate and FORCE=1) above a limit."""
     force = os.environ.get("FORCE") == "1" if force is None else force
@@ -219,15 +270,7 @@ def check_mesh_cost(case: dict, geo: str, probe: dict, out_dir: str, force: bool
                      f"{need / 1e6:.0f} MB of memory, {n * MSH_BYTES_PER_NODE / 1e6:.0f} MB of .msh")
         size_names = [k for k in case["geometry"]["parameters"] if "mesh" in k.lower() or k == "lc"]
         line = _line(case, size_names[0] if size_names else None)
-        found = []
-        if seconds > MAX_HOURS * 3600:
-            found.append(f"meshing would take about {_duration(seconds)} (more than {MAX_HOURS:g} h)")
-        if need > 0.5 * memory:
-            found.append(f"gmsh would need about {need / 1e6:.0f} MB, more than half of the {memory / 1e6:.0f} MB "
-                         "available")
-        if n * MSH_BYTES_PER_NODE > 0.5 * disk:
-            found.append(f"the mesh file would be about {n * MSH_BYTES_PER_NODE / 1e6:.3g} MB, more than half of "
-                         f"the {disk / 1e6:.3g} MB free")
+        found = _gmsh_over_limits(n, memory, disk)
         if found:
             reasons += found
             where = (line, "make the mesh size larger (for a lattice case the mesh only outlines the body: "

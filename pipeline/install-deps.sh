@@ -12,10 +12,12 @@
 # tangent (solver/src/linalg/woodbury.cpp; libarmadillo-dev pulls it in too).
 # libhypre-dev: BoomerAMG, the algebraic multigrid preconditioner of quasi_static's CG on large 3D
 # models (solver/src/linalg/amg.hpp).
+# bubblewrap: the sandbox every gmsh that reads a case's .geo runs in (preprocess/sandbox.py);
+# as root it needs nothing more, otherwise unprivileged user namespaces (docs/reliability.md).
 set -eu
 PACKAGES="$* g++ make cmake libgtest-dev libbenchmark-dev libarmadillo-dev libsuitesparse-dev liblapack-dev libhypre-dev libopenblas0-serial nlohmann-json3-dev zlib1g-dev \
 libopenmpi-dev openmpi-bin \
-gmsh python3-gmsh python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
+gmsh python3-gmsh bubblewrap python3-meshio python3-numpy python3-scipy python3-yaml python3-matplotlib \
 python3-pytest xvfb clang libclang-rt-14-dev libomp-14-dev lammps"
 missing=""
 for p in $PACKAGES; do

@@ -18,11 +18,12 @@ import os
 import sys
 import warnings
 
-from .body import check_body, check_lengths, check_mesh_cost, probe_geometry
+from .body import check_body, check_lengths, check_mesh_cost, check_mesh_growth, probe_geometry
 from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
 from .cost import check_cost
+from .inputs import check_case_inputs
 from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
 
@@ -82,6 +83,7 @@ def cmd_mesh(args):
     probe = check_geometry(case, args.geo)
     # Before gmsh meshes: its size and the lattice's (issue 17, item 11); FORCE=1 runs it anyway.
     plan = check_mesh_cost(case, args.geo, probe, os.path.dirname(os.path.abspath(args.out)))
+    check_mesh_growth(case, args.geo, probe, os.path.dirname(os.path.abspath(args.out)))
     if plan:
         print(f"{args.case}: {plan}")
     try:
@@ -235,6 +237,8 @@ def main(argv=None) -> int:
     # Preprocess warnings name their file already; print them as such, not as Python source lines.
     warnings.showwarning = lambda message, *rest, **kw: print(f"warning: {message}", file=sys.stderr)
     try:
+        # Before a stage reads anything: no input may lead out of the case folder (issue 36).
+        check_case_inputs(args.case, getattr(args, "geo", None), getattr(args, "mesh", None))
         args.func(args)
     except CaseError as err:
         print(f"error: {err}", file=sys.stderr)

@@ -14,6 +14,24 @@ identifier from strings is StringToName[…] / S2N[…], which is refused; `name
 `_<i>`. Macro/Call with a computed name are allowed: they can only run a function whose body is in
 a file scanned here. Include/Merge take a string literal only, so the path that gmsh opens is the
 path checked.
+
+The guard must see the tokens gmsh sees, so it also refuses what would make gmsh's lexer part from
+this one (gmsh 4.8.4 Parser/Gmsh.l, each checked by running gmsh 4.8.4 on a .geo that shows it):
+- a string of 1023 characters or more: gmsh keeps at most 1023 in a char[1024]; past them it says
+  "String too long", drops one character and reads the rest of the string as commands;
+- a NUL byte: gmsh ends a string, a comment or the file there;
+- in a string, `//`, `/*` or the words If, Else, ElseIf, EndIf: gmsh skips the untaken branch of an
+  `If` character by character (skipTest), honouring comments but not strings, and goes on at the
+  first Else/EndIf it meets, even one inside a string, so the rest of that string would run;
+- in an identifier, If/Else/EndIf after a digit (`x1EndIf`): skipTest takes a digit for a word
+  boundary and would go on in the middle of the identifier;
+- a comment opener or a quote that gmsh's skipping drops: while it skips an If branch, a For loop
+  or a Function body, gmsh reads six characters at each E, I, F or R that starts a word, and when
+  they are not its keyword it pushes back only four, losing the character after the letter; after
+  an `If` or a `For` it pushes back none. ` E/* EndIf … */` then hides nothing from the guard but
+  the comment from gmsh, which goes on at the EndIf inside it (tried: the command ran).
+Every gmsh that reads a case's .geo also runs in a sandbox (preprocess/sandbox.py), so that a
+construct this guard does not know of still cannot run a program or write outside its output.
 """
 from __future__ import annotations
 
@@ -60,6 +78,12 @@ DATA_EXTENSIONS = {".msh", ".step", ".stp", ".brep", ".iges", ".igs", ".stl", ".
 
 MAX_INCLUDE_DEPTH = 20
 MAX_GEO_BYTES = 10 * 1024 * 1024
+# gmsh 4.8.4 parsestring() cuts a string at 1023 characters (`char tmp[1024]`): refused from there.
+GMSH_STRING_CUT = 1023
+# What gmsh's skipTest (the untaken branch of an If) reacts to while it ignores strings.
+# Anywhere in the string, whatever precedes: gmsh's "previous character" is stale after a dropped one.
+SKIP_TEST_IN_STRING = re.compile(r"//|/\*|EndIf|Else|If")
+SKIP_TEST_IN_IDENT = re.compile(r"[0-9](?:EndIf|Else|If)")
 
 TOKEN = re.compile(r"""
     (?P<space>[ \t\r\f]+) | (?P<newline>\n)
@@ -91,11 +115,51 @@ def tokens(text: str, path: str):
         if kind == "newline":
             line += 1
         elif kind == "string":
+            _check_string(m.group()[1:-1], path, line)
             yield kind, m.group()[1:-1], line
             line += m.group().count("\n")
         elif kind in ("ident", "number", "punct"):
             yield kind, m.group(), line
         at = m.end()
+
+
+def _skip_hazard(text: str) -> int | None:
+    """The offset of a character gmsh's skip()/skipTest() would drop unseen that opens a comment or a
+    string (see the module's docstring), or None. Over-approximates where gmsh would start a
+    candidate word: after a non-letter, and where skipping resumes after a dropped character."""
+    def word_start(k: int) -> bool:
+        return k == 0 or not (text[k - 1].isalpha() or text[k - 1] == "_")
+
+    candidates = [k for k, c in enumerate(text) if c in "EIFR" and word_start(k)]
+    seen = set(candidates)
+    while candidates:
+        k = candidates.pop()
+        swallowed = [k + 1]                          # a word that is not the keyword: one lost
+        resume = [k + 2]
+        if text.startswith("If", k) and not text[k + 2:k + 3].isalpha():
+            swallowed, resume = range(k + 2, k + 6), [k + 6]   # nested If: four lost
+        elif text.startswith("For", k) and not text[k + 3:k + 4].isalpha():
+            swallowed, resume = range(k + 3, k + 6), [k + 6]   # nested For: three lost
+        for j in swallowed:
+            if j < len(text) and (text[j] in "\"'" or text.startswith(("//", "/*"), j)):
+                return j
+        for j in resume:   # gmsh goes on there with the old previous character: a word start
+            if j < len(text) and text[j] in "EIFR" and j not in seen:
+                seen.add(j)
+                candidates.append(j)
+    return None
+
+
+def _check_string(value: str, path: str, line: int):
+    """A string literal that gmsh would not read as one string (see the module's docstring)."""
+    if len(value) >= GMSH_STRING_CUT:
+        raise PreprocessError(f"{path}:{line}: a string of {len(value)} characters; gmsh cuts strings at "
+                              f"{GMSH_STRING_CUT} characters and reads the rest as commands: keep it shorter")
+    found = SKIP_TEST_IN_STRING.search(value)
+    if found:
+        raise PreprocessError(f"{path}:{line}: the string \"{value[:40]}\" holds '{found.group()}', which gmsh "
+                              "takes for a comment or for the end of an If branch even inside a string, so "
+                              "the rest of it could run as commands: reword the string")
 
 
 def check_geo(geo_path: str, case_dir: str | None = None) -> list[str]:
@@ -112,6 +176,9 @@ def _scan(path: str, case_dir: str, scanned: list, depth: int):
     real = os.path.realpath(path)
     if real in scanned:
         return  # an Include cycle: gmsh would loop, the .geo is wrong, but nothing new to check
+    # The .geo itself and the .opt gmsh merges by itself: a symbolic link out of the case folder
+    # (to /etc/shadow) had gmsh print the file's first line in its syntax error.
+    check_inside(path, case_dir)
     scanned.append(real)
     try:
         if os.path.getsize(path) > MAX_GEO_BYTES:
@@ -120,16 +187,36 @@ def _scan(path: str, case_dir: str, scanned: list, depth: int):
             raw = stream.read()
     except OSError as err:
         raise PreprocessError(f"{path}: cannot read: {err.strerror}") from None
+    if b"\0" in raw:
+        line = raw[:raw.index(b"\0")].count(b"\n") + 1
+        raise PreprocessError(f"{path}:{line}: a NUL byte, which ends a string or a comment early for gmsh; "
+                              "a .geo is a text file: remove it")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as err:
         line = raw[:err.start].count(b"\n") + 1
         raise PreprocessError(f"{path}:{line}: not UTF-8 text; a .geo is a text file") from None
+    hazard = _skip_hazard(text)
+    if hazard is not None:
+        line = text.count("\n", 0, hazard) + 1
+        shown = text[max(0, hazard - 5):hazard + 1].split("\n")[-1].strip()
+        raise PreprocessError(f"{path}:{line}: '{shown}': gmsh, skipping an If branch, a "
+                              f"For loop or a Function body, would not see the {text[hazard]!r} after the E, I, F or "
+                              "R before it and would read what follows differently: put a space between them")
     found = list(tokens(text, path))
     for k, (kind, value, line) in enumerate(found):
         if kind != "ident":
             continue
         where = f"{path}:{line}"
+        if SKIP_TEST_IN_IDENT.search(value):
+            raise PreprocessError(f"{where}: the name '{value}' holds If/Else/EndIf after a digit, where gmsh "
+                                  "would end a skipped If branch in the middle of the name: rename it")
+        # Where gmsh goes on in the middle of a name, it reads the digits as a number and the rest
+        # as a name of its own: a command after digits could hide in a longer name.
+        hidden = [word for word in FORBIDDEN if re.search(rf"[0-9]{word}", value)]
+        if hidden:
+            raise PreprocessError(f"{where}: the name '{value}' holds '{hidden[0]}' after a digit, which gmsh could "
+                                  f"read as a command of its own; {FIX}")
         if value in FORBIDDEN:
             raise PreprocessError(f"{where}: '{value}' {FORBIDDEN[value]}; {FIX}")
         if value == "Printf" and _printf_redirects(found, k):
@@ -149,6 +236,18 @@ def _scan(path: str, case_dir: str, scanned: list, depth: int):
     opt = path + ".opt"
     if os.path.exists(opt):  # gmsh merges <file>.opt after <file>, as .geo commands
         _scan(opt, case_dir, scanned, depth + 1)
+
+
+def check_inside(path: str, case_dir: str):
+    """PreprocessError unless `path`, its symbolic links followed, is a regular file inside `case_dir`."""
+    real = os.path.realpath(path)
+    case_dir = os.path.realpath(case_dir)
+    if os.path.commonpath([real, case_dir]) != case_dir:
+        raise PreprocessError(f"{path}: leads outside the case folder {case_dir} (a symbolic link to {real}); "
+                              "a case reads only its own files: copy the file into the case folder")
+    if not os.path.isfile(real):
+        what = "does not exist" if not os.path.exists(real) else "is not a regular file"
+        raise PreprocessError(f"{path}: {what}; a case input must be a regular file in {case_dir}")
 
 
 def _printf_redirects(found, k) -> bool:

@@ -15,7 +15,12 @@ The JSON holds, for the top-dimension entities (surfaces of a 2D case, volumes o
   errors: gmsh's error and warning lines while it read the geometry;
   numbers: the .geo's parameters as gmsh holds them (DefineConstant Name → value; a parameter given
     with -setnumber is not among them: its value is the case file's);
-  size_options: Mesh.MeshSizeFactor, Mesh.MeshSizeMin and Mesh.MeshSizeMax as the .geo left them.
+  size_options: Mesh.MeshSizeFactor, Mesh.MeshSizeMin and Mesh.MeshSizeMax as the .geo left them;
+  boundary: {nodes, elements, size} of gmsh's mesh of the body's boundary (its curves in 2D, its
+    surfaces in 3D; size the mean element size in m), made last, after everything above: a mesh size
+    field (`Background Field`) or a point's size can make gmsh's mesh far finer than the case's mesh
+    size says, and the boundary shows it in a small fraction of the whole mesh's time
+    (pipeline/body.py check_mesh_growth extrapolates it to the body).
 """
 from __future__ import annotations
 
@@ -75,6 +80,30 @@ def _loop_points(gmsh, loop: list[int], per_curve: int = 32) -> list[list[float]
     return points
 
 
+def _boundary_mesh(gmsh, dimension: int) -> dict:
+    """Mesh the entities of dimension - 1 and measure their elements (corner nodes only)."""
+    import numpy as np
+
+    gmsh.model.mesh.generate(dimension - 1)
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    if not len(tags):
+        return {"nodes": 0, "elements": 0, "size": None}
+    where = np.zeros(int(np.max(tags)) + 1, dtype=np.int64)
+    where[np.asarray(tags, dtype=np.int64)] = np.arange(len(tags))
+    xyz = np.asarray(coords, dtype=float).reshape(-1, 3)
+    measures = []
+    for etype, _, nodes in zip(*gmsh.model.mesh.getElements(dimension - 1)):
+        count = gmsh.model.mesh.getElementProperties(etype)[3]
+        corners = xyz[where[np.asarray(nodes, dtype=np.int64).reshape(-1, count)[:, :dimension]]]
+        if dimension == 2:
+            measures.append(np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1))
+        else:   # an equilateral triangle of side h has area √3/4 h²: the side of the mean area
+            areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+            measures.append(np.sqrt(areas / (np.sqrt(3.0) / 4.0)))
+    sizes = np.concatenate(measures) if measures else np.zeros(0)
+    return {"nodes": len(tags), "elements": len(sizes), "size": float(sizes.mean()) if len(sizes) else None}
+
+
 def probe(geo: str, dimension: int, parameters: dict[str, float]) -> dict:
     import gmsh
 
@@ -113,8 +142,9 @@ def probe(geo: str, dimension: int, parameters: dict[str, float]) -> dict:
         numbers = {p["name"]: p["values"][0] for p in json.loads(gmsh.onelab.get())["onelab"]["parameters"]
                    if p.get("type") == "number" and len(p.get("values", [])) == 1}
         size_options = {o: gmsh.option.getNumber(f"Mesh.{o}") for o in ("MeshSizeFactor", "MeshSizeMin", "MeshSizeMax")}
+        boundary = _boundary_mesh(gmsh, dimension) if entities else None
         return {"entities": entities, "bbox": box, "groups": groups, "errors": errors, "numbers": numbers,
-                "size_options": size_options}
+                "size_options": size_options, "boundary": boundary}
     finally:
         gmsh.finalize()
 

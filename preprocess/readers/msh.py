@@ -16,15 +16,76 @@ from ..errors import PreprocessError
 from ..mesh import ELEMENT_TYPES, Group, Mesh, element_dimension
 
 
-def read(path: str) -> Mesh:
-    import meshio  # imported here so that a missing meshio only matters for .msh files
+def _element_nodes_exist(path: str):
+    """PreprocessError naming the element and its line if an element of an ASCII .msh (format 2 or
+    4) names a node that $Nodes does not define. meshio maps node tags through an array: a tag
+    missing between others became -1 and a tag 0 wrapped round to the last node, both silently
+    (a binary file is checked after meshio, on the indices it returns)."""
+    tags: set[int] = set()
+    version, section, expect = None, None, 0
+    with open(path, "rb") as stream:
+        for number, raw in enumerate(stream, 1):
+            line = raw.strip()
+            if line.startswith(b"$"):
+                section, expect = (None if line.startswith(b"$End") else line[1:].decode("ascii", "replace")), -1
+                continue
+            if section == "MeshFormat":
+                fields = line.split()
+                if len(fields) >= 2 and fields[1] != b"0":
+                    return   # binary
+                version = fields[0] if fields else None
+            elif section not in ("Nodes", "Elements") or not line:
+                continue
+            fields = line.split()
+            if expect == -1:       # the section's header line
+                expect = 0
+                continue
+            if version and version.startswith(b"2"):
+                if section == "Nodes":
+                    tags.add(int(fields[0]))
+                else:
+                    nodes = fields[3 + int(fields[2]):]
+                    _refuse_missing(path, number, fields[0], nodes, tags)
+                continue
+            # format 4: a block header, then (Nodes) its tags and coordinates, (Elements) its elements
+            if expect == 0:
+                expect = int(fields[3])
+                # 4.1 lists a block's node tags, then their coordinates; 4.0 one "tag x y z" line a node
+                block_lines = expect * (2 if section == "Nodes" and version != b"4" and not version.startswith(b"4.0")
+                                        else 1)
+                position = 0
+                continue
+            if section == "Nodes":
+                if position < expect:
+                    tags.add(int(fields[0]))
+            else:
+                _refuse_missing(path, number, fields[0], fields[1:], tags)
+            position += 1
+            if position == block_lines:
+                expect = 0
 
+
+def _refuse_missing(path, number, element, nodes, tags):
+    for node in nodes:
+        if int(node) not in tags:
+            raise PreprocessError(f"{path}:{number}: element {element.decode()} names node {node.decode()}, which "
+                                  "$Nodes does not define; fix the mesh (export it again)")
+
+
+def read(path: str) -> Mesh:
+    import meshio.gmsh  # imported here so that a missing meshio only matters for .msh files
+
+    try:
+        _element_nodes_exist(path)
+    except (ValueError, IndexError):
+        pass   # a malformed file: meshio says what is wrong with it below
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            m = meshio.read(path, file_format="gmsh")
+            m = meshio.gmsh.read(path)  # meshio.read prints a ReadError and calls sys.exit(1)
     except Exception as err:  # meshio raises many types (ReadError, ValueError, IndexError...)
-        raise PreprocessError(f"{path}: cannot read as a gmsh .msh file: {err}") from err
+        reason = str(err) or f"{type(err).__name__} (meshio gives no reason)"
+        raise PreprocessError(f"{path}: cannot read as a gmsh .msh file: {reason}") from err
 
     blocks = []  # (type, connectivity, physical tags or None)
     physical = m.cell_data.get("gmsh:physical")
@@ -33,7 +94,12 @@ def read(path: str) -> Mesh:
             raise PreprocessError(f"{path}: element type '{block.type}' is not supported; supported: "
                                   f"{', '.join(ELEMENT_TYPES)}")
         tags = None if physical is None else np.asarray(physical[i])
-        blocks.append((block.type, np.asarray(block.data, dtype=np.int64), tags))
+        conn = np.asarray(block.data, dtype=np.int64)
+        bad = np.nonzero((conn < 0) | (conn >= len(m.points)))[0]
+        if len(bad):
+            raise PreprocessError(f"{path}: {block.type} element {bad[0] + 1} of element block {i + 1} names a node "
+                                  "that $Nodes does not define; fix the mesh (export it again)")
+        blocks.append((block.type, conn, tags))
 
     names = {str(name): (int(v[0]), int(v[1])) for name, v in m.field_data.items()
              if np.asarray(v).size >= 2}

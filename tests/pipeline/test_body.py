@@ -144,3 +144,27 @@ def test_a_hole_in_the_missing_corner_of_an_l_shaped_plate(tmp_path, c, outside)
     assert "ell.yaml:4: in " in result.stderr and "surface 1 has a hole (its boundary [-8, -7]) partly or wholly " \
         "outside its outer boundary [1, 2, 3, 4, 5, 6] (" in result.stderr
     assert f"{outside} points of the hole's outline lie outside the body): move the hole into the body" in result.stderr
+
+
+def test_a_mesh_size_field_finer_than_the_mesh_size_stops_before_meshing(tmp_path):
+    """A `Background Field` bypassed the estimate (722 nodes estimated, then gmsh meshed until its
+    time limit): the probe meshes the boundary with everything the .geo sets and extrapolates."""
+    folder = tmp_path / "field"
+    folder.mkdir()
+    shutil.copy(os.path.join(ROOT, "cases", "plate_with_hole", "plate_with_hole.yaml"), folder / "field.yaml")
+    geo = folder / "field.geo"
+    geo.write_text(open(os.path.join(ROOT, "cases", "plate_with_hole", "plate_with_hole.geo")).read()
+                   + 'Field[1] = MathEval; Field[1].F = "2e-6"; Background Field = 1;\n')
+    env = dict(os.environ, PD_GMSH_TIMEOUT="20")   # today's code meshes until this limit
+    env.pop("FORCE", None)
+    start = time.monotonic()
+    result = run("mesh", folder / "field.yaml", geo, tmp_path / "out" / "mesh.msh", env=env, timeout=120)
+    assert time.monotonic() - start < 15
+    assert result.returncode == 2, result.stdout + result.stderr
+    # 165,708 curve elements of 2e-6 m; the bounding box 0.1 m × 0.05 m / (√3/2 · 4e-12) = 1.44e9 nodes
+    assert (f"field.yaml:10: {geo}: gmsh meshed the body's curves with 165709 nodes, 2e-06 m apart on average "
+            "(the estimate from the case's mesh size 0.002 m was about 1.44e+03 nodes); at that size the 2D mesh "
+            "would have about 1.44e+09 nodes: meshing would take about") in result.stderr, result.stderr
+    assert "a mesh size field (Field, Background Field) or the size of a point makes the mesh finer" in result.stderr
+    assert result.stderr.endswith("coarsen it, or run it anyway with FORCE=1 (make FORCE=1 case=...)\n")
+    assert not (tmp_path / "out").exists() or os.listdir(tmp_path / "out") == []
