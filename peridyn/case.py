@@ -11,6 +11,7 @@ import subprocess
 import yaml
 
 from pipeline.case import CaseError, load_case
+from pipeline.yaml_lines import load_with_lines
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3"
@@ -23,8 +24,11 @@ class RunError(RuntimeError):
 def load(path: str) -> "Case":
     """The case file at `path` (checked against the schema now, so a bad file fails here)."""
     load_case(path)  # CaseError with the file, the line and the key
-    with open(path, encoding="utf-8") as stream:
-        return Case(yaml.safe_load(stream) or {}, source=path)
+    # The data as the checker read it (YAML 1.2, pipeline/yaml_lines.py), not yaml.safe_load's
+    # YAML 1.1 reading of the same text; and the file is read once more only through the bounded
+    # loader (a regular file of at most 1 MiB).
+    data, _lines = load_with_lines(path)
+    return Case(data or {}, source=path)
 
 
 def _parts(key: str) -> list:

@@ -12,7 +12,7 @@ import math
 import re
 
 from .schema import CASE, MODEL_KEYS, MODEL_NOTE, MODEL_REQUIRED, REQUIRED, Key
-from .yaml_lines import CaseError
+from .yaml_lines import MAX_NUMBER, CaseError, dotted
 
 MAX_INTEGER = 2 ** 53
 MAX_TEXT = 200  # characters in a text value (title, set name)
@@ -43,13 +43,17 @@ class _Checker:
         return self.lines.get(keypath, 1)
 
     def error(self, keypath: tuple, message: str):
-        dotted = ".".join(f"[{p}]" if isinstance(p, int) else str(p) for p in keypath).replace(".[", "[")
-        self.errors.append(f"{self.path}:{self.line_of(keypath)}: {dotted or '<top>'}: {message}")
+        self.errors.append(f"{self.path}:{self.line_of(keypath)}: {dotted(keypath) or '<top>'}: {message}")
 
     # -- scalar kinds -------------------------------------------------------
     def number(self, value, keypath: tuple, key: Key):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}{yaml11_hint(value)}")
+            return None
+        if isinstance(value, int) and abs(value) > MAX_NUMBER:  # float() would raise OverflowError
+            # (its size from bit_length: str() of a 5000-digit int raises ValueError in Python ≥ 3.11)
+            self.error(keypath, f"a whole number of about 10^{int(value.bit_length() * 0.30103)} is too large: "
+                       f"a number is at most {MAX_NUMBER:.4g}")
             return None
         value = float(value)
         if not math.isfinite(value):
