@@ -122,6 +122,8 @@ class _Checker:
             return self.number(value, keypath, key)
         if kind == "integer":
             return self.integer(value, keypath, key)
+        if kind == "string" and key.choices:  # a text of a closed set is a choice (issue 36, item 14)
+            return self.choice(value, keypath, key)
         if kind == "string":
             if not isinstance(value, str) or not value:
                 self.error(keypath, f"expected a non-empty text, got {value!r}")
@@ -335,11 +337,7 @@ def _check_context(case: dict, checker: _Checker):
         _check_indenter(ind, i, dim, names, checker)
     for i, crack in enumerate(case["cracks"]):
         _check_crack(crack, i, dim, checker)
-    adaptive = case["adaptive"]
-    for low, high in (("dt_min", "dt_max"), ("dt_min", "dt_initial"), ("dt_initial", "dt_max")):
-        if adaptive[low] is not None and adaptive[high] is not None and adaptive[low] > adaptive[high]:
-            checker.error(("adaptive", low), f"{low} {adaptive[low]:g} s is larger than {high} "
-                          f"{adaptive[high]:g} s")
+    _check_integrator_settings(case, checker)
     out = case["output"]
     if out["every_time"] is not None and out["every_time"] > case["time"]["end"]:
         checker.error(("output", "every_time"), f"{out['every_time']:g} s is longer than the run (time.end = "
@@ -349,6 +347,61 @@ def _check_context(case: dict, checker: _Checker):
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
         out["every_time"] = case["time"]["end"] / 50.0
+    for i, name in enumerate(out["fields"]):
+        if name in out["fields"][:i]:  # the solver refuses a field listed twice (case_reader.cpp)
+            checker.error(("output", "fields", i), f"'{name}' is listed twice; list each field once")
+
+
+def _check_integrator_settings(case: dict, checker: _Checker):
+    """The step limits and solver choices of the integrators' sections, as pdsolve judges them
+    (solver/src/io/case_reader.cpp read_adaptive, read_quasi_static, read_implicit and the
+    integrators' configure()): before, a case that broke one passed check and was refused by the
+    solver, naming case.json instead of the .yaml line (issue 36, item 14)."""
+    end = case["time"]["end"]
+    integrator = case["time"]["integrator"]
+    for name, default_max in (("adaptive", None), ("quasi_static", end / 10.0), ("implicit", end / 10.0)):
+        section = case[name]
+        dt_min, dt_initial, dt_max = section["dt_min"], section["dt_initial"], section["dt_max"]
+        # quasi_static and implicit default dt_max to end/10: a given dt_min above that is refused too
+        # (QuasiStatic/Implicit::configure); adaptive's default dt_max comes from eq. 2.5, the mesh's.
+        limit = dt_max if dt_max is not None else default_max
+        if dt_min is not None and limit is not None and dt_min > limit:
+            if dt_max is not None:
+                checker.error((name, "dt_min"), f"dt_min {dt_min:g} s is larger than dt_max {dt_max:g} s")
+            else:
+                checker.error((name, "dt_min"), f"dt_min {dt_min:g} s is larger than the default dt_max "
+                              f"{limit:g} s (time.end/10); lower dt_min or give {name}.dt_max")
+        if name == "quasi_static":
+            continue  # its dt_initial is cut to dt_max by the solver
+        if dt_initial is not None and dt_max is not None and dt_initial > dt_max:
+            checker.error((name, "dt_initial"), f"dt_initial {dt_initial:g} s is larger than dt_max {dt_max:g} s")
+        if dt_initial is not None and dt_min is not None and dt_initial < dt_min:
+            checker.error((name, "dt_initial"), f"dt_initial {dt_initial:g} s is smaller than dt_min {dt_min:g} s")
+    mixed_start = case["mixed"]["start"] if integrator == "mixed" else None
+    # The sections whose settings the run uses: mixed runs quasi_static or implicit steps between its
+    # explicit ones, as mixed.start says.
+    uses_static = integrator == "quasi_static" or mixed_start == "quasi_static"
+    uses_implicit = integrator == "implicit" or mixed_start == "implicit"
+    if uses_static and case["damping"] != 0.0:
+        # QuasiStatic::configure: equilibrium has no velocity for damping to act on.
+        how = "mixed.start: implicit (its steps integrate damping)" if integrator == "mixed" else \
+            "time.integrator: verlet or implicit"
+        checker.error(("damping",), f"{case['damping']:g} 1/s, but the {integrator} integrator solves load steps "
+                      f"for equilibrium, where damping does nothing: set damping: 0, or use {how}")
+    # Contact has no assembled tangent (solver/src/operator/force_operator.cpp
+    # missing_assembled_stiffness): linear_solver direct is refused when contact is on
+    # (integrators/newton_krylov.cpp), as for lps (_check_materials).
+    contact = case["contact"]
+    contact_on = contact["enabled"] == "on" or (contact["enabled"] == "auto" and
+                                                (len(case["materials"]) > 1 or contact["self_contact"]))
+    if contact_on:
+        why = ("contact.enabled is on" if contact["enabled"] == "on" else
+               "contact is on (contact.enabled auto, with " +
+               ("self_contact" if contact["self_contact"] else f"{len(case['materials'])} blocks") + ")")
+        for name, used in (("quasi_static", uses_static), ("implicit", uses_implicit)):
+            if used and case[name]["linear_solver"] == "direct":
+                checker.error((name, "linear_solver"), f"direct factorises the assembled tangent stiffness, and {why}, "
+                              "which has none; use linear_solver: cg (or auto), or contact.enabled: off")
 
 
 def _check_pmb_pairs(name: str, m: dict, checker: _Checker):
@@ -478,8 +531,15 @@ def _check_indenter(ind: dict, i: int, dim: int, names: set, checker: _Checker):
             checker.error(where + (key,), f"expected {'2 or 3' if dim == 2 else '3'} components, got {len(vector)}")
             continue
         ind[key] = [float(c) for c in vector] + [0.0] * (3 - len(vector))
-        if key in ("normal", "axis") and not any(ind[key]):
-            checker.error(where + (key,), "must be a non-zero direction")
+        if key in ("normal", "axis"):
+            # The solver divides by the length √(x² + y² + z²) in doubles (case_reader.cpp
+            # read_direction): components like 1e200 overflow it and 1e-200 underflow it to 0.
+            length = math.sqrt(sum(c * c for c in ind[key]))
+            if not any(ind[key]):
+                checker.error(where + (key,), "must be a non-zero direction")
+            elif not (0.0 < length < math.inf):
+                checker.error(where + (key,), f"its length {'overflows' if length else 'underflows'} a double; "
+                              "give the direction with components of about 1, e.g. [0, 1, 0]")
     shape = ind["shape"]
     if shape in ("sphere", "cylinder") and ind["radius"] is None:
         checker.error(where + ("radius",), f"a {shape} indenter needs radius [m]")
