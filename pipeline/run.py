@@ -164,13 +164,17 @@ def run_cost(case: dict, resolved: dict, cloud) -> dict:
     points = np.asarray(cloud.points)
     tree = cKDTree(points)
     time = case["time"]
+    implicit = time["integrator"] == "implicit" or (time["integrator"] == "mixed" and
+                                                     case["mixed"]["start"] == "implicit")
+    # eq. 2.5's step: Verlet's with its safety factor, and the scale of an implicit step's accuracy
+    dt_stable = case_stable_time_step(case, resolved, cloud, tree)[0] if isinstance(time["dt"], str) or implicit \
+        else None
     if isinstance(time["dt"], str):
-        dt_stable, _ = case_stable_time_step(case, resolved, cloud, tree)
         dt = dt_stable * float(time["safety_factor"])   # "exact" is larger: this is an upper bound
     else:
         dt = float(time["dt"])
     bonds = mean_bonds(points, tree, float(resolved["horizon"]), BOND_SLACK) * len(points)
-    return estimate(case, cloud, bonds, dt if dt > 0 and math.isfinite(dt) else float(time["end"]))
+    return estimate(case, cloud, bonds, dt if dt > 0 and math.isfinite(dt) else float(time["end"]), dt_stable)
 
 
 def cmd_preprocess(args):

@@ -16,6 +16,11 @@ from .yaml_lines import MAX_NUMBER, CaseError, dotted
 
 MAX_INTEGER = 2 ** 53
 MAX_TEXT = 200  # characters in a text value (title, set name)
+# Lists that multiply postprocess's work (issue 36, item 12: 90 000 figures.times passed check and
+# drew PNGs for minutes): each figures.times entry is a damage and a displacement map; each frame is
+# read by postprocess (history plots, crack tip, output.gmsh: all) and written by the solver.
+MAX_FIGURE_TIMES = 24
+MAX_FRAMES = 10_000
 NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 COMPONENTS = ("x", "y", "z")
 
@@ -347,6 +352,19 @@ def _check_context(case: dict, checker: _Checker):
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
         out["every_time"] = case["time"]["end"] / 50.0
+    frames = case["time"]["end"] / out["every_time"] if out["every_time"] is not None else 0.0
+    if frames > MAX_FRAMES:
+        checker.error(("output", "every_time"), f"{out['every_time']:g} s makes {frames:.3g} frames over time.end = "
+                      f"{case['time']['end']:g} s; at most {MAX_FRAMES} (each is written, read and drawn from): "
+                      f"use every_time ≥ {case['time']['end'] / MAX_FRAMES:.3g} s")
+    times = case["figures"]["times"]
+    if times is not None and not times:
+        checker.error(("figures", "times"), "an empty list; give the times of the maps [s], or leave the key out "
+                      "for four frames spread over the run")
+    if times is not None and len(times) > MAX_FIGURE_TIMES:
+        checker.error(("figures", "times"), f"{len(times)} times; at most {MAX_FIGURE_TIMES}: each draws a damage "
+                      "and a displacement map (PNG). Pick the times to show; frames.pvd holds every frame "
+                      "(ParaView)")
     for i, name in enumerate(out["fields"]):
         if name in out["fields"][:i]:  # the solver refuses a field listed twice (case_reader.cpp)
             checker.error(("output", "fields", i), f"'{name}' is listed twice; list each field once")
