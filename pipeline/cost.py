@@ -24,8 +24,8 @@ before anyone was told. The figures are estimates from rates measured on this pr
   implicit step is also held by its error estimate: on cases/membrane (make bench-implicit,
   docs/accuracy.md) its mean was IMPLICIT_STEP_PER_EQ25 = 2 × eq. 2.5 at tol 10⁻³, growing as
   tol^0.55 (7.25× at 10⁻², 0.6× at 10⁻⁴); measured again here on cases/membrane with
-  integrator: implicit: 992 steps to 1.41 ms, mean 2.0 × eq. 2.5, 0.17 s per step at load 6
-  (2.6·10⁻⁶ s per step and bond, near the 2D figure). A smooth load allows longer implicit steps.
+  integrator: implicit: 3 286 steps to 4.53 ms, mean 1.9 × eq. 2.5, 0.15 s per step at load 6
+  (2.2·10⁻⁶ s per step and bond, near the 2D figure). A smooth load allows longer implicit steps.
   The quasi-static count is the fewest steps (cuts and re-solves add more: traction took 120 for 70),
   and mixed's explicit phases (while a crack runs) are not counted: both are lower bounds ("at least").
   These rates were measured on the shared machine under load; a quiet one runs several times faster.

@@ -358,7 +358,8 @@ CASE = {
     ),
     "output": section(
         "what the solver writes and how often",
-        every_time=Key("number", "a frame every this much simulated time (default: end/50)",
+        every_time=Key("number", "a frame every this much simulated time (default: end/50); at most "
+                       "10 000 frames (every_steps: the work plan stops more unless FORCE=1)",
                        default=None, unit="s", above=0.0),
         every_steps=Key("integer", "a frame every this many steps (instead of every_time)",
                         default=None, minimum=1),
@@ -393,7 +394,8 @@ CASE = {
     "figures": section(
         "what postprocess draws",
         times=Key("numbers", "simulated times of the damage and displacement maps (default: four "
-                  "frames spread over the run)", default=None, unit="s"),
+                  "frames spread over the run); at most 24, each a damage and a displacement map",
+                  default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
         probe=Key("point_or_name", "where probe.png follows the displacement component: a point "
