@@ -23,6 +23,7 @@ from .atomic import DISK_FULL_EXIT, WriteError, write_atomically
 from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
 from .cost import check_cost
+from .regular_file import open_regular
 from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
 
@@ -67,8 +68,10 @@ def cmd_mesh_parameters(args):
     case = load_case(args.case)
     text = json.dumps(case["geometry"]["parameters"], sort_keys=True, indent=1) + "\n"
     try:
-        with open(args.out, encoding="utf-8") as stream:
-            if stream.read() == text:
+        # open_regular: a FIFO in its place would block a plain open(); it is replaced like any
+        # stale file (NotRegularFile is an OSError)
+        with open_regular(args.out) as stream:
+            if stream.read(len(text.encode("utf-8")) + 1).decode("utf-8", "replace") == text:
                 return
     except OSError:
         pass

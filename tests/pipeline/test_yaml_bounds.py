@@ -134,6 +134,17 @@ def test_a_fifo_as_the_given_mesh_is_refused(tmp_path):
     assert f"error: {mesh}: a FIFO (named pipe), not a regular file" in result.stderr
 
 
+def test_a_fifo_in_place_of_the_mesh_parameters_is_replaced_not_read(tmp_path):
+    """The mesh-parameters stage reads its old output to leave it unchanged: a FIFO there blocked."""
+    case, out = tmp_path / "plate.yaml", tmp_path / "mesh-parameters.json"
+    case.write_text(MINIMAL + "geometry:\n  parameters: {L: 0.05}\n")
+    os.mkfifo(out)
+    result = subprocess.run([sys.executable, "-m", "pipeline.run", "mesh-parameters", str(case), str(out)], cwd=ROOT,
+                            capture_output=True, text=True, timeout=20)
+    assert result.returncode == 0, result.stderr
+    assert out.read_text() == '{\n "L": 0.05\n}\n'
+
+
 def test_huge_whole_numbers_are_refused_by_the_api_loader_too(tmp_path):
     """peridyn.load read the file with yaml.safe_load after the check: the same 5000-digit value
     is one CaseError at its line there too, and validate() given such an int by a program says so."""
