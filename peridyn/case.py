@@ -10,8 +10,10 @@ import subprocess
 
 import yaml
 
+from pipeline.atomic import write_atomically
 from pipeline.case import CaseError, load_case
 from pipeline.output_lock import FolderInUse, output_lock
+from pipeline.yaml_lines import load_with_lines
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3"
@@ -24,14 +26,67 @@ class RunError(RuntimeError):
 def load(path: str) -> "Case":
     """The case file at `path` (checked against the schema now, so a bad file fails here)."""
     load_case(path)  # CaseError with the file, the line and the key
-    with open(path, encoding="utf-8") as stream:
-        return Case(yaml.safe_load(stream) or {}, source=path)
+    # The data as the checker read it (YAML 1.2, pipeline/yaml_lines.py), not yaml.safe_load's
+    # YAML 1.1 reading of the same text; and the file is read once more only through the bounded
+    # loader (a regular file of at most 1 MiB).
+    data, _lines = load_with_lines(path)
+    return Case(data or {}, source=path)
 
 
 def _parts(key: str) -> list:
     """"materials.glass.density" → ["materials", "glass", "density"]; "boundary_conditions.0.set"
     → [..., 0, ...] (a list index)."""
     return [int(p) if p.isdigit() else p for p in key.split(".")]
+
+
+def _what(value) -> str:
+    """How a value that is not a section reads in an error: 'a number (0.001)', 'a list of 2 entries'."""
+    if isinstance(value, list):
+        return f"a list of {len(value)} entries"
+    if isinstance(value, bool) or value is None:
+        return repr(value)
+    kind = "a number" if isinstance(value, (int, float)) else "a text" if isinstance(value, str) else type(value).__name__
+    return f"{kind} ({value!r})"
+
+
+def _step(node, part, walked: str, key: str):
+    """node[part] for Case.__getitem__/__setitem__, or a KeyError naming the path walked so far:
+    an index past the end of a list, a name given to a list, a key under a number (before, an
+    IndexError or a TypeError from deep inside, issue 36 item 13)."""
+    where = walked or "the case file"
+    if isinstance(node, list):
+        if not isinstance(part, int):
+            raise KeyError(f"{key}: {where} is a list of {len(node)} entries: give an index, e.g. {walked}.0")
+        if part >= len(node):
+            has = f"has {len(node)} entries (indices 0 to {len(node) - 1})" if node else "is an empty list"
+            raise KeyError(f"{key}: {where} {has}, no index {part}; set the whole list to add entries")
+        return node[part]
+    if isinstance(node, dict):
+        return node[str(part)]  # KeyError: the caller says what is missing
+    raise KeyError(f"{key}: {where} is {_what(node)}, not a section: it has no key '{part}'")
+
+
+def _plain(value, key: str):
+    """The value as YAML can write it: numpy scalars and arrays become Python numbers and lists
+    (PyYAML's safe dumper raised RepresenterError on them, leaving a half-written case file), tuples
+    lists; anything else that is no number, text, list or mapping is refused, naming the key."""
+    if value is None or type(value) in (bool, int, float, str):
+        return value
+    try:
+        import numpy as np
+    except ImportError:  # peridyn runs without numpy too
+        np = None
+    if np is not None and isinstance(value, (np.generic, np.ndarray)):
+        return _plain(value.tolist(), key)  # tolist(): Python scalars, nested lists for arrays
+    for plain in (bool, int, float, str):  # a subclass (an IntEnum, a str subclass): its plain value
+        if isinstance(value, plain):
+            return plain(value)
+    if isinstance(value, (list, tuple)):
+        return [_plain(item, f"{key}.{i}") for i, item in enumerate(value)]
+    if isinstance(value, dict):
+        return {str(name): _plain(item, f"{key}.{name}") for name, item in value.items()}
+    raise TypeError(f"{key}: a {type(value).__module__}.{type(value).__qualname__} cannot be written to a case "
+                    "file; give a number, a text, true/false, a list or a mapping of them")
 
 
 class Case:
@@ -52,33 +107,53 @@ class Case:
         return os.path.basename(self.folder)
 
     def __getitem__(self, key: str):
-        node = self.data
+        node, walked = self.data, ""
         for part in _parts(key):
             try:
-                node = node[part]
-            except (KeyError, IndexError, TypeError):
-                raise KeyError(f"{key}: not in the case file {self.source} (defaults are in docs/case-file.md)") from None
+                node = _step(node, part, walked, key)
+            except KeyError as err:
+                if isinstance(node, dict):  # a name missing from a section
+                    raise KeyError(f"{key}: not in the case file {self.source} (defaults are in "
+                                   "docs/case-file.md)") from None
+                raise KeyError(err.args[0]) from None
+            walked = f"{walked}.{part}" if walked else str(part)
         return node
 
     def __setitem__(self, key: str, value):
-        """Set a dotted key, making the sections on the way; checked against the schema at run()."""
+        """Set a dotted key, making the sections on the way; checked against the schema at run().
+
+        numpy scalars and arrays are stored as Python numbers and lists; an index past the end of
+        a list, or a key under a value that is not a section, is a KeyError naming the path."""
+        value = _plain(value, key)
         parts = _parts(key)
-        node = self.data
+        node, walked = self.data, ""
         for part in parts[:-1]:
-            if isinstance(node, list):
-                node = node[part]
-            else:
-                node = node.setdefault(part, {})
-        node[parts[-1]] = value
+            if isinstance(node, dict) and str(part) not in node:
+                node[str(part)] = {}
+            node = _step(node, part, walked, key)
+            walked = f"{walked}.{part}" if walked else str(part)
+        last = parts[-1]
+        if isinstance(node, list):
+            _step(node, last, walked, key)  # the index must exist
+            node[last] = value
+        elif isinstance(node, dict):
+            node[str(last)] = value
+        else:
+            _step(node, last, walked, key)  # raises: a key under a number
 
     def copy(self) -> "Case":
         return Case(self.data, self.source)
 
     def write(self, path: str) -> str:
-        """Write the case file (YAML) and check it; returns the path."""
+        """Write the case file (YAML) and check it; returns the path.
+
+        The YAML is made in memory first (values put into self.data directly, not through
+        case[key] = value, are made plain here too) and written under a temporary name and renamed
+        (pipeline/atomic.py): a value YAML cannot hold leaves no file, half-written or not."""
+        plain = {str(name): _plain(value, str(name)) for name, value in self.data.items()}
+        text = yaml.safe_dump(plain, sort_keys=False, allow_unicode=True)
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        with open(path, "w", encoding="utf-8") as stream:
-            yaml.safe_dump(self.data, stream, sort_keys=False, allow_unicode=True)
+        write_atomically(path, text)
         load_case(path)
         return path
 

@@ -24,9 +24,13 @@ import time
 import traceback
 
 from .case import CaseError, load_case
+from .memory_limit import limit_address_space
+from .regular_file import read_regular
+from .yaml_lines import MAX_BYTES
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PER_INPUT_SECONDS = 5
+MEMORY_LIMIT_MB = 2048  # as the libFuzzer runs' -rss_limit_mb (Makefile): set by main() on itself
 
 # Tokens that reach the corners of the loader and the schema.
 TOKENS = [
@@ -37,6 +41,8 @@ TOKENS = [
     ".nan", "~", "null", "yes", "on", "true", "2001-12-14", "-0", "0", "1", "-1", "2", "3", "2.0",
     "9223372036854775808", "1e30", "x" * 300, "[[0, 1], [1, 2]]", "[[1, 0], [0, 1]]", "{x: 1, y: 2}",
     "[1, 2, 3]", "[]", "{}", "''",
+    # whole numbers past a double, past Python's 4300-digit int-string limit, and in hex (issue 36)
+    "1" + "0" * 400, "-1" + "0" * 5000, "0x" + "f" * 300,
 ]
 
 
@@ -48,13 +54,29 @@ def _alarm(signum, frame):
     raise _Timeout()
 
 
-def seeds() -> list[bytes]:
-    paths = sorted(glob.glob(os.path.join(ROOT, "cases", "*", "*.yaml")) +
-                   glob.glob(os.path.join(ROOT, "validation", "models", "*.yaml")))
+def seeds(root: str | None = None, skipped: list | None = None) -> list[bytes]:
+    """The shipped case files under `root` (default: the repository), as bytes. A seed must be a regular file of at most
+    MAX_BYTES inside its own folder (cases/ or validation/models/): a link out of it, a FIFO, a
+    device or a huge file is skipped (its reason appended to `skipped`). Before, every
+    cases/*/*.yaml was read whole: a link to /dev/zero took 23.7 GB (issue 36, item 15)."""
+    root = ROOT if root is None else root
     out = []
-    for path in paths:
-        with open(path, "rb") as stream:
-            out.append(stream.read())
+    for folder, pattern in ((os.path.join(root, "cases"), os.path.join("*", "*.yaml")),
+                            (os.path.join(root, "validation", "models"), "*.yaml")):
+        inside = os.path.realpath(folder)
+        for path in sorted(glob.glob(os.path.join(folder, pattern))):
+            real = os.path.realpath(path)
+            try:
+                if os.path.commonpath([real, inside]) != inside:
+                    raise OSError(f"{path}: a link out of {folder} (to {real})")
+                data = read_regular(path, MAX_BYTES)
+                if len(data) > MAX_BYTES:
+                    raise OSError(f"{path}: larger than {MAX_BYTES >> 10} kB")
+            except OSError as err:  # NotRegularFile included
+                if skipped is not None:
+                    skipped.append(str(err))
+                continue
+            out.append(data)
     return out
 
 
@@ -117,10 +139,13 @@ def run_one(data: bytes, path: str) -> tuple[str, str | None]:
         signal.setitimer(signal.ITIMER_REAL, 0)
 
 
-def fuzz(seconds: float, seed: int, max_runs: int | None = None, artifacts: str | None = None) -> dict:
+def fuzz(seconds: float, seed: int, max_runs: int | None = None, artifacts: str | None = None,
+         skipped: list | None = None) -> dict:
     """Mutate and load until `seconds` pass (or `max_runs` inputs); return the counts and findings."""
     rng = random.Random(seed)
-    corpus = seeds()
+    corpus = seeds(skipped=skipped)
+    if not corpus:
+        raise SystemExit(f"pd_fuzz_case_yaml: no seed case files under {ROOT}/cases")
     previous = signal.signal(signal.SIGALRM, _alarm)
     findings = []
     runs = loaded = 0
@@ -153,7 +178,11 @@ def main(argv=None) -> int:
     parser.add_argument("--artifacts", default=None, help="folder for the inputs of findings")
     args = parser.parse_args(argv)
     seed = args.seed if args.seed is not None else int(time.time())
-    result = fuzz(args.seconds, seed, artifacts=args.artifacts)
+    limit_address_space(MEMORY_LIMIT_MB)  # a runaway input is a MemoryError (a finding), not the OOM killer
+    skipped: list[str] = []
+    result = fuzz(args.seconds, seed, artifacts=args.artifacts, skipped=skipped)
+    for reason in skipped:
+        print(f"pd_fuzz_case_yaml: seed skipped: {reason}", file=sys.stderr)
     print(f"pd_fuzz_case_yaml: seed {seed}: {result['runs']} inputs in {result['seconds']:.0f} s, "
           f"{result['loaded']} loaded, the rest refused with a CaseError; "
           f"{len(result['findings'])} finding(s)")

@@ -21,8 +21,13 @@ import time
 
 import numpy as np
 
+from .memory_limit import limit_address_space
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PER_RUN_SECONDS = 20
+# Set by main() on itself and inherited by every pdsolve it starts: the 64-node runs need some
+# 100 MB; OpenMP threads and glibc's per-thread arenas reserve address space beyond that.
+MEMORY_LIMIT_MB = 4096
 DOCUMENTED = {0, 1, 2, 3}
 
 
@@ -110,6 +115,7 @@ def main(argv=None) -> int:
     parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"))
     args = parser.parse_args(argv)
     seed = args.seed if args.seed is not None else int(time.time())
+    limit_address_space(MEMORY_LIMIT_MB)  # bounds make fuzz's memory, pdsolve's runs included
     result = fuzz(args.solver, args.seconds, seed)
     codes = ", ".join(f"{k}: {v}" for k, v in sorted(result["codes"].items()))
     print(f"pdsolve command line: seed {seed}: {result['runs']} runs in {result['seconds']:.0f} s (exit codes "

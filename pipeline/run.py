@@ -24,6 +24,7 @@ from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
 from .cost import check_cost
 from .inputs import check_case_inputs
+from .regular_file import open_regular
 from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
 
@@ -68,8 +69,10 @@ def cmd_mesh_parameters(args):
     case = load_case(args.case)
     text = json.dumps(case["geometry"]["parameters"], sort_keys=True, indent=1) + "\n"
     try:
-        with open(args.out, encoding="utf-8") as stream:
-            if stream.read() == text:
+        # open_regular: a FIFO in its place would block a plain open(); it is replaced like any
+        # stale file (NotRegularFile is an OSError)
+        with open_regular(args.out) as stream:
+            if stream.read(len(text.encode("utf-8")) + 1).decode("utf-8", "replace") == text:
                 return
     except OSError:
         pass
@@ -166,13 +169,17 @@ def run_cost(case: dict, resolved: dict, cloud) -> dict:
     points = np.asarray(cloud.points)
     tree = cKDTree(points)
     time = case["time"]
+    implicit = time["integrator"] == "implicit" or (time["integrator"] == "mixed" and
+                                                     case["mixed"]["start"] == "implicit")
+    # eq. 2.5's step: Verlet's with its safety factor, and the scale of an implicit step's accuracy
+    dt_stable = case_stable_time_step(case, resolved, cloud, tree)[0] if isinstance(time["dt"], str) or implicit \
+        else None
     if isinstance(time["dt"], str):
-        dt_stable, _ = case_stable_time_step(case, resolved, cloud, tree)
         dt = dt_stable * float(time["safety_factor"])   # "exact" is larger: this is an upper bound
     else:
         dt = float(time["dt"])
     bonds = mean_bonds(points, tree, float(resolved["horizon"]), BOND_SLACK) * len(points)
-    return estimate(case, cloud, bonds, dt if dt > 0 and math.isfinite(dt) else float(time["end"]))
+    return estimate(case, cloud, bonds, dt if dt > 0 and math.isfinite(dt) else float(time["end"]), dt_stable)
 
 
 def cmd_preprocess(args):

@@ -263,14 +263,14 @@ CASE = {
                                  "largest stretch ratio reaches 1 (linear between the two), so that "
                                  "the first bonds break at their load and not all at once past it",
                                  default=True),
-        linear_solver=Key("string", "the linear solve of each Newton iteration: direct (CHOLMOD "
+        linear_solver=Key("choice", "the linear solve of each Newton iteration: direct (CHOLMOD "
                           "factorisation of the assembled tangent), cg (matrix-free conjugate "
                           "gradients with a block-Jacobi preconditioner, solved only as far as "
                           "Newton needs: Eisenstat–Walker), or auto (cg when a term or the "
                           "material has no assembled tangent, i.e. contact or model lps, or the "
                           "model is large, or the run is on several MPI ranks: run.log says which and "
                           "why); lps cannot use direct, nor a run on several MPI ranks", default="auto", choices=("auto", "direct", "cg")),
-        preconditioner=Key("string", "the preconditioner of CG (linear_solver cg): block_jacobi "
+        preconditioner=Key("choice", "the preconditioner of CG (linear_solver cg): block_jacobi "
                            "(the 3×3 node blocks of the tangent, matrix-free), amg (algebraic "
                            "multigrid: one V-cycle of hypre's BoomerAMG on the assembled tangent, "
                            "set up again after bonds break or when CG's iterations grow), or auto "
@@ -316,7 +316,7 @@ CASE = {
         dt_min=Key("number", "smallest step; a step not accepted there stops the run (default: 1e-6 × "
                    "eq. 2.5)", default=None, unit="s", above=0.0),
         dt_max=Key("number", "largest step (default: end/10)", default=None, unit="s", above=0.0),
-        linear_solver=Key("string", "the linear solve of each Newton iteration, on the tangent plus "
+        linear_solver=Key("choice", "the linear solve of each Newton iteration, on the tangent plus "
                           "the mass term: direct (CHOLMOD factorisation of the assembled matrix), cg "
                           "(matrix-free conjugate gradients with a block-Jacobi preconditioner), or "
                           "auto (cg for the lps model, for contact, for 3D models with at least 20 000 "
@@ -334,7 +334,7 @@ CASE = {
         "time is physical, so the boundary conditions are loading rates; history.csv's mode column is "
         "1 for a quasi-static step, 2 for an implicit one, 0 for an explicit one, and run.log says "
         "every switch",
-        start=Key("string", "the scheme the run starts with and returns to once a crack has arrested: "
+        start=Key("choice", "the scheme the run starts with and returns to once a crack has arrested: "
                   "quasi_static (equilibrium load steps, the kinetic energy given up on return) or "
                   "implicit (generalized-α dynamics, the motion kept; no damping needed); implicit "
                   "leaves for explicit when a step fails down to implicit.dt_min or when bonds break "
@@ -358,7 +358,8 @@ CASE = {
     ),
     "output": section(
         "what the solver writes and how often",
-        every_time=Key("number", "a frame every this much simulated time (default: end/50)",
+        every_time=Key("number", "a frame every this much simulated time (default: end/50); at most "
+                       "10 000 frames (every_steps: the work plan stops more unless FORCE=1)",
                        default=None, unit="s", above=0.0),
         every_steps=Key("integer", "a frame every this many steps (instead of every_time)",
                         default=None, minimum=1),
@@ -399,7 +400,8 @@ CASE = {
     "figures": section(
         "what postprocess draws",
         times=Key("numbers", "simulated times of the damage and displacement maps (default: four "
-                  "frames spread over the run)", default=None, unit="s"),
+                  "frames spread over the run); at most 24, each a damage and a displacement map",
+                  default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
         probe=Key("point_or_name", "where probe.png follows the displacement component: a point "

@@ -12,10 +12,15 @@ import math
 import re
 
 from .schema import CASE, MODEL_KEYS, MODEL_NOTE, MODEL_REQUIRED, REQUIRED, Key
-from .yaml_lines import CaseError
+from .yaml_lines import MAX_NUMBER, CaseError, dotted
 
 MAX_INTEGER = 2 ** 53
 MAX_TEXT = 200  # characters in a text value (title, set name)
+# Lists that multiply postprocess's work (issue 36, item 12: 90 000 figures.times passed check and
+# drew PNGs for minutes): each figures.times entry is a damage and a displacement map; each frame is
+# read by postprocess (history plots, crack tip, output.gmsh: all) and written by the solver.
+MAX_FIGURE_TIMES = 24
+MAX_FRAMES = 10_000
 NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 COMPONENTS = ("x", "y", "z")
 
@@ -43,13 +48,17 @@ class _Checker:
         return self.lines.get(keypath, 1)
 
     def error(self, keypath: tuple, message: str):
-        dotted = ".".join(f"[{p}]" if isinstance(p, int) else str(p) for p in keypath).replace(".[", "[")
-        self.errors.append(f"{self.path}:{self.line_of(keypath)}: {dotted or '<top>'}: {message}")
+        self.errors.append(f"{self.path}:{self.line_of(keypath)}: {dotted(keypath) or '<top>'}: {message}")
 
     # -- scalar kinds -------------------------------------------------------
     def number(self, value, keypath: tuple, key: Key):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.error(keypath, f"expected a number{self.unit(key)}, got {value!r}{yaml11_hint(value)}")
+            return None
+        if isinstance(value, int) and abs(value) > MAX_NUMBER:  # float() would raise OverflowError
+            # (its size from bit_length: str() of a 5000-digit int raises ValueError in Python ≥ 3.11)
+            self.error(keypath, f"a whole number of about 10^{int(value.bit_length() * 0.30103)} is too large: "
+                       f"a number is at most {MAX_NUMBER:.4g}")
             return None
         value = float(value)
         if not math.isfinite(value):
@@ -118,6 +127,8 @@ class _Checker:
             return self.number(value, keypath, key)
         if kind == "integer":
             return self.integer(value, keypath, key)
+        if kind == "string" and key.choices:  # a text of a closed set is a choice (issue 36, item 14)
+            return self.choice(value, keypath, key)
         if kind == "string":
             if not isinstance(value, str) or not value:
                 self.error(keypath, f"expected a non-empty text, got {value!r}")
@@ -331,11 +342,7 @@ def _check_context(case: dict, checker: _Checker):
         _check_indenter(ind, i, dim, names, checker)
     for i, crack in enumerate(case["cracks"]):
         _check_crack(crack, i, dim, checker)
-    adaptive = case["adaptive"]
-    for low, high in (("dt_min", "dt_max"), ("dt_min", "dt_initial"), ("dt_initial", "dt_max")):
-        if adaptive[low] is not None and adaptive[high] is not None and adaptive[low] > adaptive[high]:
-            checker.error(("adaptive", low), f"{low} {adaptive[low]:g} s is larger than {high} "
-                          f"{adaptive[high]:g} s")
+    _check_integrator_settings(case, checker)
     out = case["output"]
     if out["every_time"] is not None and out["every_time"] > case["time"]["end"]:
         checker.error(("output", "every_time"), f"{out['every_time']:g} s is longer than the run (time.end = "
@@ -345,6 +352,74 @@ def _check_context(case: dict, checker: _Checker):
         checker.error(("output", "every_steps"), "give every_time or every_steps, not both")
     if out["every_time"] is None and out["every_steps"] is None:
         out["every_time"] = case["time"]["end"] / 50.0
+    frames = case["time"]["end"] / out["every_time"] if out["every_time"] is not None else 0.0
+    if frames > MAX_FRAMES:
+        checker.error(("output", "every_time"), f"{out['every_time']:g} s makes {frames:.3g} frames over time.end = "
+                      f"{case['time']['end']:g} s; at most {MAX_FRAMES} (each is written, read and drawn from): "
+                      f"use every_time ≥ {case['time']['end'] / MAX_FRAMES:.3g} s")
+    times = case["figures"]["times"]
+    if times is not None and not times:
+        checker.error(("figures", "times"), "an empty list; give the times of the maps [s], or leave the key out "
+                      "for four frames spread over the run")
+    if times is not None and len(times) > MAX_FIGURE_TIMES:
+        checker.error(("figures", "times"), f"{len(times)} times; at most {MAX_FIGURE_TIMES}: each draws a damage "
+                      "and a displacement map (PNG). Pick the times to show; frames.pvd holds every frame "
+                      "(ParaView)")
+    for i, name in enumerate(out["fields"]):
+        if name in out["fields"][:i]:  # the solver refuses a field listed twice (case_reader.cpp)
+            checker.error(("output", "fields", i), f"'{name}' is listed twice; list each field once")
+
+
+def _check_integrator_settings(case: dict, checker: _Checker):
+    """The step limits and solver choices of the integrators' sections, as pdsolve judges them
+    (solver/src/io/case_reader.cpp read_adaptive, read_quasi_static, read_implicit and the
+    integrators' configure()): before, a case that broke one passed check and was refused by the
+    solver, naming case.json instead of the .yaml line (issue 36, item 14)."""
+    end = case["time"]["end"]
+    integrator = case["time"]["integrator"]
+    for name, default_max in (("adaptive", None), ("quasi_static", end / 10.0), ("implicit", end / 10.0)):
+        section = case[name]
+        dt_min, dt_initial, dt_max = section["dt_min"], section["dt_initial"], section["dt_max"]
+        # quasi_static and implicit default dt_max to end/10: a given dt_min above that is refused too
+        # (QuasiStatic/Implicit::configure); adaptive's default dt_max comes from eq. 2.5, the mesh's.
+        limit = dt_max if dt_max is not None else default_max
+        if dt_min is not None and limit is not None and dt_min > limit:
+            if dt_max is not None:
+                checker.error((name, "dt_min"), f"dt_min {dt_min:g} s is larger than dt_max {dt_max:g} s")
+            else:
+                checker.error((name, "dt_min"), f"dt_min {dt_min:g} s is larger than the default dt_max "
+                              f"{limit:g} s (time.end/10); lower dt_min or give {name}.dt_max")
+        if name == "quasi_static":
+            continue  # its dt_initial is cut to dt_max by the solver
+        if dt_initial is not None and dt_max is not None and dt_initial > dt_max:
+            checker.error((name, "dt_initial"), f"dt_initial {dt_initial:g} s is larger than dt_max {dt_max:g} s")
+        if dt_initial is not None and dt_min is not None and dt_initial < dt_min:
+            checker.error((name, "dt_initial"), f"dt_initial {dt_initial:g} s is smaller than dt_min {dt_min:g} s")
+    mixed_start = case["mixed"]["start"] if integrator == "mixed" else None
+    # The sections whose settings the run uses: mixed runs quasi_static or implicit steps between its
+    # explicit ones, as mixed.start says.
+    uses_static = integrator == "quasi_static" or mixed_start == "quasi_static"
+    uses_implicit = integrator == "implicit" or mixed_start == "implicit"
+    if uses_static and case["damping"] != 0.0:
+        # QuasiStatic::configure: equilibrium has no velocity for damping to act on.
+        how = "mixed.start: implicit (its steps integrate damping)" if integrator == "mixed" else \
+            "time.integrator: verlet or implicit"
+        checker.error(("damping",), f"{case['damping']:g} 1/s, but the {integrator} integrator solves load steps "
+                      f"for equilibrium, where damping does nothing: set damping: 0, or use {how}")
+    # Contact has no assembled tangent (solver/src/operator/force_operator.cpp
+    # missing_assembled_stiffness): linear_solver direct is refused when contact is on
+    # (integrators/newton_krylov.cpp), as for lps (_check_materials).
+    contact = case["contact"]
+    contact_on = contact["enabled"] == "on" or (contact["enabled"] == "auto" and
+                                                (len(case["materials"]) > 1 or contact["self_contact"]))
+    if contact_on:
+        why = ("contact.enabled is on" if contact["enabled"] == "on" else
+               "contact is on (contact.enabled auto, with " +
+               ("self_contact" if contact["self_contact"] else f"{len(case['materials'])} blocks") + ")")
+        for name, used in (("quasi_static", uses_static), ("implicit", uses_implicit)):
+            if used and case[name]["linear_solver"] == "direct":
+                checker.error((name, "linear_solver"), f"direct factorises the assembled tangent stiffness, and {why}, "
+                              "which has none; use linear_solver: cg (or auto), or contact.enabled: off")
 
 
 def _check_pmb_pairs(name: str, m: dict, checker: _Checker):
@@ -474,8 +549,15 @@ def _check_indenter(ind: dict, i: int, dim: int, names: set, checker: _Checker):
             checker.error(where + (key,), f"expected {'2 or 3' if dim == 2 else '3'} components, got {len(vector)}")
             continue
         ind[key] = [float(c) for c in vector] + [0.0] * (3 - len(vector))
-        if key in ("normal", "axis") and not any(ind[key]):
-            checker.error(where + (key,), "must be a non-zero direction")
+        if key in ("normal", "axis"):
+            # The solver divides by the length √(x² + y² + z²) in doubles (case_reader.cpp
+            # read_direction): components like 1e200 overflow it and 1e-200 underflow it to 0.
+            length = math.sqrt(sum(c * c for c in ind[key]))
+            if not any(ind[key]):
+                checker.error(where + (key,), "must be a non-zero direction")
+            elif not (0.0 < length < math.inf):
+                checker.error(where + (key,), f"its length {'overflows' if length else 'underflows'} a double; "
+                              "give the direction with components of about 1, e.g. [0, 1, 0]")
     shape = ind["shape"]
     if shape in ("sphere", "cylinder") and ind["radius"] is None:
         checker.error(where + ("radius",), f"a {shape} indenter needs radius [m]")

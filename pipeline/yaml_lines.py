@@ -1,12 +1,16 @@
 """Load a case file (YAML) into plain Python objects while remembering the line of every key.
 
 The loader is safe and bounded, because a case file comes from other people (issue 17, item 3):
-- the file is a regular UTF-8 text file of at most MAX_BYTES (a binary file, /dev/zero or a
-  directory is refused before it is parsed);
+- the file is a regular UTF-8 text file of at most MAX_BYTES (a binary file, /dev/zero, a FIFO or a
+  directory is refused before it is parsed, and a FIFO without blocking: pipeline/regular_file.py);
 - nesting is at most MAX_DEPTH deep, and the tree, with every alias expanded, has at most
   MAX_NODES values (a "billion laughs" file of nested aliases fails at once instead of expanding
   10¹⁰ items), no alias may contain itself;
 - a text value has at most MAX_SCALAR characters;
+- a whole number is at most MAX_NUMBER in size, the largest double: every number of a case file
+  becomes one (Python's float(), the solver's JSON reader), and a 400-digit integer ended in an
+  OverflowError, a 5000-digit one in Python's int-string limit (4300 digits), both as tracebacks
+  (issue 36, item 11);
 - explicit tags (`!foo`, `!!python/object:…`) and merge keys (`<<`) are refused: a case file is
   plain data, and nothing in it may name a Python type;
 - plain scalars are read with the YAML 1.2 core schema (https://yaml.org/spec/1.2.2/#1032-tag-resolution):
@@ -17,17 +21,20 @@ error about `time.safety_factor` can say "plate.yaml:14".
 """
 from __future__ import annotations
 
-import os
 import re
-import stat
+import sys
 
 import yaml
 from yaml.events import AliasEvent, CollectionStartEvent, ScalarEvent
+
+from .regular_file import NotRegularFile, read_regular
 
 MAX_BYTES = 1 << 20      # 1 MiB: the shipped cases are below 3 kB
 MAX_DEPTH = 64           # the schema nests 4 deep; a table of rows is 2 more
 MAX_NODES = 100_000      # values after alias expansion (a time table of 10⁴ rows is 3·10⁴)
 MAX_SCALAR = 10_000      # characters in one value
+MAX_NUMBER = sys.float_info.max   # 1.8e308: the largest double
+MAX_DIGITS = len(str(int(MAX_NUMBER)))   # 309: a longer decimal integer is larger still
 
 # YAML 1.2 core schema, plain scalars only (quoted scalars are always text).
 _NULL = re.compile(r"^(?:~|null|Null|NULL|)$")
@@ -51,6 +58,24 @@ class CaseError(Exception):
     """A problem in a case file, with the file, the line and what to do in the message."""
 
 
+def dotted(keypath: tuple) -> str:
+    """("materials", "glass", "density") → "materials.glass.density"; list indices as [i]."""
+    return ".".join(f"[{p}]" if isinstance(p, int) else str(p) for p in keypath).replace(".[", "[")
+
+
+def _integer(text: str, digits: str, base: int, where: str):
+    """A whole number no larger than MAX_NUMBER; the digit count is checked before int() so that
+    Python's int-string limit (4300 decimal digits) is never reached."""
+    too_long = base == 10 and len(digits.lstrip("0")) > MAX_DIGITS
+    value = None if too_long else int(digits, base)
+    if value is None or value > MAX_NUMBER:
+        shown = text if len(text) <= 24 else f"{text[:12]}…{text[-6:]} ({len(text)} characters)"
+        raise CaseError(f"{where}: the whole number {shown} is too large: a number in a case file is at "
+                        f"most {MAX_NUMBER:.4g} (a double) and a count at most 2^53; write it in "
+                        "exponent form (e.g. 1.0e+9) and check it for a typo")
+    return -value if text.startswith("-") else value
+
+
 def _core_scalar(text: str, where: str):
     """The value of a plain scalar under the YAML 1.2 core schema."""
     if _NULL.match(text):
@@ -66,11 +91,11 @@ def _core_scalar(text: str, where: str):
         raise CaseError(f"{where}: '{text}' starts with 0: YAML 1.1 reads it as octal, YAML 1.2 as "
                         f"decimal; write it without the leading 0 (or 0o… for octal)")
     if _INT10.match(text):
-        return int(text)
+        return _integer(text, text.lstrip("+-"), 10, where)
     if _INT8.match(text):
-        return int(text[2:], 8)
+        return _integer(text, text[2:], 8, where)
     if _INT16.match(text):
-        return int(text[2:], 16)
+        return _integer(text, text[2:], 16, where)
     if _FLOAT.match(text):
         return float(text)
     if _INF.match(text):
@@ -115,10 +140,9 @@ class _BoundedLoader(yaml.SafeLoader):
 def _read_text(path: str) -> str:
     """The file's text, or a CaseError if it is not a small regular UTF-8 text file."""
     try:
-        with open(path, "rb") as stream:
-            if not stat.S_ISREG(os.fstat(stream.fileno()).st_mode):
-                raise CaseError(f"{path}: not a regular file; give the case's .yaml file")
-            data = stream.read(MAX_BYTES + 1)
+        data = read_regular(path, MAX_BYTES)
+    except NotRegularFile as err:
+        raise CaseError(f"{err}; give the case's .yaml file") from None
     except OSError as err:
         raise CaseError(f"{path}: cannot read the case file: {err.strerror}") from None
     if len(data) > MAX_BYTES:
@@ -178,7 +202,8 @@ def load_with_lines(path: str):
                             "expanded: remove the nested aliases")
         lines.setdefault(keypath, node.start_mark.line + 1)
         if isinstance(node, yaml.ScalarNode):
-            return _core_scalar(node.value, where) if node.style is None else node.value
+            named = f"{where}: {dotted(keypath)}" if keypath else where
+            return _core_scalar(node.value, named) if node.style is None else node.value
         if id(node) in on_path:
             raise CaseError(f"{where}: an alias refers to a value that contains it (a cycle); "
                             "remove the alias")
@@ -193,7 +218,8 @@ def load_with_lines(path: str):
                     if key_node.style is None and key_node.value == "<<":
                         raise CaseError(f"{key_where}: merge keys ('<<') are not supported; "
                                         + _MERGE_HINT)
-                    key = _core_scalar(key_node.value, key_where) if key_node.style is None else key_node.value
+                    named = f"{key_where}: {dotted(keypath)}" if keypath else key_where
+                    key = _core_scalar(key_node.value, named) if key_node.style is None else key_node.value
                     key = str(key) if not isinstance(key, str) else key
                     if key in out:
                         raise CaseError(f"{key_where}: key '{key}' appears twice; keep one")

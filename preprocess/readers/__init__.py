@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import os
+import stat
+
+from pipeline.regular_file import kind_of
 
 from ..errors import PreprocessError
 from ..mesh import Mesh
@@ -29,8 +32,14 @@ def read_mesh(path: str) -> Mesh:
     if reader is None:
         raise PreprocessError(f"{path}: unknown mesh format '{ext or '(no extension)'}'; "
                               f"known extensions: {', '.join(sorted(READERS))}")
-    if not os.path.isfile(path):
-        raise PreprocessError(f"{path}: no such mesh file")
+    # Only a regular file is read: a FIFO would block the reader's open() (issue 36, item 11).
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as err:
+        raise PreprocessError(f"{path}: cannot read the mesh file: {err.strerror}") from None
+    if not stat.S_ISREG(mode):
+        raise PreprocessError(f"{path}: {kind_of(mode)}, not a regular file; give the case's "
+                              f"mesh file ({', '.join(sorted(READERS))})")
     check_mesh_size(path)
     try:
         return reader(path)

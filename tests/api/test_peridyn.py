@@ -79,3 +79,53 @@ def test_a_bad_key_fails_before_any_work_naming_the_file_and_key(small, tmp_path
 def test_open_reads_a_finished_run(run):
     again = peridyn.open(run.out_dir)
     assert len(again) == 5 and np.array_equal(again.history["dt"], run.history["dt"])
+
+
+# -- values and keys from a program (issue 36, item 13): no solver needed -----------------------
+
+@pytest.fixture
+def membrane():
+    return peridyn.load(os.path.join(ROOT, "cases", "membrane", "membrane.yaml"))
+
+
+def test_numpy_scalars_and_arrays_are_written_as_plain_numbers(membrane, tmp_path):
+    """PyYAML's safe dumper raised RepresenterError on numpy values, after writing part of the file."""
+    membrane["time.end"] = np.float64(2.0e-3)
+    membrane["output.history_every"] = np.int64(2)
+    membrane["contact.self_contact"] = np.bool_(False)
+    membrane["figures.times"] = np.linspace(0.0, 2.0e-3, 3)
+    membrane.data["damping"] = np.float32(250.0)      # put into the data directly: made plain at write()
+    path = membrane.write(str(tmp_path / "study.yaml"))
+    text = open(path, encoding="utf-8").read()
+    assert "!!python" not in text and "numpy" not in text
+    again = peridyn.load(path)
+    assert again["time.end"] == 2.0e-3 and type(again["time.end"]) is float
+    assert again["output.history_every"] == 2 and again["contact.self_contact"] is False
+    assert again["figures.times"] == [0.0, 1.0e-3, 2.0e-3] and again["damping"] == 250.0
+
+
+def test_a_value_yaml_cannot_hold_leaves_no_file(membrane, tmp_path):
+    membrane.data["time"]["end"] = object()
+    with pytest.raises(TypeError, match=r"^time\.end: a builtins\.object cannot be written to a case file"):
+        membrane.write(str(tmp_path / "study.yaml"))
+    assert os.listdir(tmp_path) == []  # neither the case file nor a temporary one
+    with pytest.raises(TypeError, match=r"^figures\.times\.1: a builtins\.complex cannot be written"):
+        membrane["figures.times"] = [0.0, 1j]
+
+
+@pytest.mark.parametrize("key, message", [
+    ("boundary_conditions.3.set", "boundary_conditions.3.set: boundary_conditions has 1 entries (indices 0 to 0), "
+                                  "no index 3; set the whole list to add entries"),
+    ("time.end.x", "time.end.x: time.end is a number (0.01), not a section: it has no key 'x'"),
+    ("boundary_conditions.set", "boundary_conditions.set: boundary_conditions is a list of 1 entries: give an "
+                                "index, e.g. boundary_conditions.0"),
+])
+def test_a_bad_index_or_a_key_under_a_value_names_the_path(membrane, key, message):
+    """Before: IndexError (index past the end) and TypeError/AttributeError (a key under a number)."""
+    with pytest.raises(KeyError) as got:
+        membrane[key] = 1.0
+    assert got.value.args[0] == message
+    with pytest.raises(KeyError) as got:
+        membrane[key]
+    assert got.value.args[0] == message
+    assert membrane["time.end"] == 0.01 and len(membrane["boundary_conditions"]) == 1  # nothing changed

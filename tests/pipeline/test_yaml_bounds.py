@@ -53,6 +53,15 @@ HOSTILE = {
                         "title: expected one line of at most 200 characters, got 300 characters", 11),
     "long_value": (MINIMAL + "title: " + "x" * 20_000 + "\n", "a value of 20000 characters", 11),
     "two_documents": (MINIMAL + "---\n" + MINIMAL, "not valid YAML: expected a single document in the stream, but found another document", 11),
+    # Whole numbers past a double (issue 36, item 11): an OverflowError from float() (400 digits)
+    # and Python's int-string limit (5000 digits > 4300) were tracebacks before.
+    "int_400_digits": (MINIMAL + "damping: 1" + "0" * 400 + "\n",
+                       "damping: the whole number 100000000000…000000 (401 characters) is too large", 11),
+    "int_5000_digits": (MINIMAL.replace("  end: 1.0e-3\n", "  end: 1.0e-3\n  max_steps: 1" + "0" * 5000 + "\n"),
+                        "time.max_steps: the whole number 100000000000…000000 (5001 characters) is too large", 11),
+    "hex_past_a_double": (MINIMAL + "damping: 0x" + "f" * 300 + "\n", "damping: the whole number 0xffffffffff", 11),
+    "int_key_400_digits": (MINIMAL + "geometry:\n  parameters:\n    1" + "0" * 400 + ": 1\n",
+                           "geometry.parameters: the whole number", 13),
 }
 
 
@@ -99,6 +108,54 @@ def test_a_directory_or_device_is_not_a_case_file(tmp_path, target):
         load_case(path)
     assert str(info.value).startswith(f"{path}: ")
     assert ("not a regular file" in str(info.value)) or ("cannot read" in str(info.value))
+
+
+def test_a_fifo_is_refused_at_once_not_waited_on(tmp_path):
+    """A FIFO as the case file hung `make check` in open() (issue 36, item 11): now refused without
+    blocking, by check and by peridyn.load (a writer never comes, so a hang would hit the timeout)."""
+    path = tmp_path / "plate.yaml"
+    os.mkfifo(path)
+    code, err, seconds = check(path, timeout=20)
+    assert code == 2 and "Traceback" not in err, err
+    assert err == f"error: {path}: a FIFO (named pipe), not a regular file; give the case's .yaml file\n"
+    import peridyn
+    with pytest.raises(CaseError, match="plate.yaml: a FIFO"):
+        peridyn.load(str(path))
+
+
+def test_a_fifo_as_the_given_mesh_is_refused(tmp_path):
+    """`check CASE MESH` with a FIFO as the given mesh: refused, not read (it would block too)."""
+    case, mesh = tmp_path / "plate.yaml", tmp_path / "plate.msh"
+    case.write_text(MINIMAL)
+    os.mkfifo(mesh)
+    result = subprocess.run([sys.executable, "-m", "pipeline.run", "check", str(case), str(mesh)], cwd=ROOT,
+                            capture_output=True, text=True, timeout=20)
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert f"error: {mesh}: a FIFO (named pipe), not a regular file" in result.stderr
+
+
+def test_a_fifo_in_place_of_the_mesh_parameters_is_replaced_not_read(tmp_path):
+    """The mesh-parameters stage reads its old output to leave it unchanged: a FIFO there blocked."""
+    case, out = tmp_path / "plate.yaml", tmp_path / "mesh-parameters.json"
+    case.write_text(MINIMAL + "geometry:\n  parameters: {L: 0.05}\n")
+    os.mkfifo(out)
+    result = subprocess.run([sys.executable, "-m", "pipeline.run", "mesh-parameters", str(case), str(out)], cwd=ROOT,
+                            capture_output=True, text=True, timeout=20)
+    assert result.returncode == 0, result.stderr
+    assert out.read_text() == '{\n "L": 0.05\n}\n'
+
+
+def test_huge_whole_numbers_are_refused_by_the_api_loader_too(tmp_path):
+    """peridyn.load read the file with yaml.safe_load after the check: the same 5000-digit value
+    is one CaseError at its line there too, and validate() given such an int by a program says so."""
+    import peridyn
+    from pipeline.validate import validate
+    path = tmp_path / "plate.yaml"
+    path.write_text(MINIMAL + "damping: 1" + "0" * 5000 + "\n")
+    with pytest.raises(CaseError, match=r"plate\.yaml:11: damping: the whole number .* is too large"):
+        peridyn.load(str(path))
+    with pytest.raises(CaseError, match=r"x\.yaml:1: damping: a whole number of about 10\^5000 is too large"):
+        validate({"damping": 10 ** 5000}, "x.yaml", {})
 
 
 def test_yaml_12_core_schema(tmp_path):
