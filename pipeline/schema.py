@@ -399,8 +399,10 @@ CASE = {
     ),
     "figures": section(
         "what postprocess draws",
-        times=Key("numbers", "simulated times of the damage and displacement maps (default: four "
-                  "frames spread over the run); at most 24, each a damage and a displacement map",
+        times=Key("numbers", "simulated times of the damage and displacement maps (default: where bonds "
+                  "break, the frames at 10, 50 and 90 % of the final broken-bond count, the last and the one "
+                  "before the first break; otherwise four frames spread over the run); at most 24, each a "
+                  "damage and a displacement map",
                   default=None, unit="s"),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
