@@ -21,7 +21,8 @@ void throw_write_error(const std::filesystem::path& file, const std::string& wha
   throw Error(file.string() + ": " + what + ": " + std::strerror(error_number));
 }
 
-void write_file_atomically(const std::filesystem::path& path, const std::vector<std::string_view>& pieces) {
+void write_file_atomically(const std::filesystem::path& path, const std::vector<std::string_view>& pieces,
+                           Durability durability) {
   const std::filesystem::path tmp = path.string() + ".part";
   std::size_t total = 0;
   for (const std::string_view piece : pieces) total += piece.size();
@@ -48,6 +49,7 @@ void write_file_atomically(const std::filesystem::path& path, const std::vector<
       done += static_cast<std::size_t>(w);
     }
   }
+  if (durability == Durability::synced && ::fsync(fd) != 0) fail("fsync failed");
   if (::close(fd) != 0) {
     const int error_number = errno;
     std::error_code ignored;
@@ -61,10 +63,20 @@ void write_file_atomically(const std::filesystem::path& path, const std::vector<
     std::filesystem::remove(tmp, ignored);
     throw Error(path.string() + ": cannot rename " + tmp.string() + " into place: " + ec.message());
   }
+  if (durability == Durability::synced) {
+    // The rename is an entry of the folder: flushed with it. A folder that cannot be opened or
+    // flushed (some network file systems) leaves the file as durable as the file system makes it.
+    const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    const int dir = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dir >= 0) {
+      ::fsync(dir);
+      ::close(dir);
+    }
+  }
 }
 
-void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
-  write_file_atomically(path, std::vector<std::string_view>{text});
+void write_file_atomically(const std::filesystem::path& path, const std::string& text, Durability durability) {
+  write_file_atomically(path, std::vector<std::string_view>{text}, durability);
 }
 
 }  // namespace pd

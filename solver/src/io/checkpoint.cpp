@@ -148,7 +148,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
   Writer sum;
   sum.scalar(fnv1a(payload.bytes().data(), payload.bytes().size()));
   text += sum.bytes();
-  write_file_atomically(path, text);
+  write_file_atomically(path, text, Durability::synced);
 }
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
