@@ -349,10 +349,10 @@ def main(argv=None) -> int:
         parser.error(f"{args.solver} is missing: build it with `make solver`")
     # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
     with output_lock(args.out, "make bench-accuracy (bench.accuracy)"):
-        return measure(args)
+        return measure(args, chosen)
 
 
-def measure(args):
+def measure(args, chosen):
     """The runs of main(), with the output folder locked."""
     repeat = 1 if args.quick else max(1, args.repeat)
     os.makedirs(args.out, exist_ok=True)

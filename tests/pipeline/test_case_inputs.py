@@ -65,7 +65,8 @@ def test_a_folder_or_a_fifo_named_as_an_input_is_refused(tmp_path):
     os.mkfifo(case / "leak.geo")   # gmsh would wait on it for ever
     result = run("check", case / "leak.yaml")
     assert result.returncode == 2
-    assert f"error: {case / 'leak.geo'}: is not a regular file; a case input must be a regular file in {case}" \
+    assert f"error: {case / 'leak.geo'}: a FIFO (named pipe), not a regular file; a case input must be a regular " \
+        f"file in {case}" \
         in result.stderr
 
 

@@ -117,7 +117,7 @@ def test_a_fifo_is_refused_at_once_not_waited_on(tmp_path):
     os.mkfifo(path)
     code, err, seconds = check(path, timeout=20)
     assert code == 2 and "Traceback" not in err, err
-    assert err == f"error: {path}: a FIFO (named pipe), not a regular file; give the case's .yaml file\n"
+    assert err == f"error: {path}: a FIFO (named pipe), not a regular file; a case input must be a regular file in {tmp_path}\n"
     import peridyn
     with pytest.raises(CaseError, match="plate.yaml: a FIFO"):
         peridyn.load(str(path))
