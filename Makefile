@@ -42,7 +42,7 @@ not_count = $(strip $(call unsafe_chars,$(1),$(DIGITS))$(if $(filter-out 1,$(wor
 # refused from the command line (`make clean-case OUT=/tmp/x` ran `rm -rf -- '/tmp/x'`), or a
 # setting checked like case= below (`LOCK_WAIT="0' …; touch /tmp/pwn; echo '"` ran the touch).
 # `override` keeps them ours under `make -e` too. SOLVER_SOURCES (tests set it empty) reaches no shell.
-INTERNAL_VARIABLES := ALL_SOLVER_TARGETS OUT CASEDIR YAML MESH GIVEN_MESH CHECKPOINT MPIRUN RANK_THREADS PY PYTEST DEPS \
+INTERNAL_VARIABLES := ALL_SOLVER_TARGETS PD_LOCK_FD OUT CASEDIR YAML MESH GIVEN_MESH CHECKPOINT MPIRUN RANK_THREADS PY PYTEST DEPS \
     ASAN_DIR FUZZ_DIR FUZZ_TARGETS BENCH_DEPS PD_CASE_LOCK LOCKED_GOALS DRY_RUN MAKE SHELL .SHELLFLAGS
 $(foreach v,$(INTERNAL_VARIABLES),$(if $(filter command line,$(origin $(v))),$(error $(v) is set by \
     this Makefile, not on the command line: $(if $(filter OUT CASEDIR YAML MESH CHECKPOINT,$(v)),the output \
@@ -155,8 +155,16 @@ pd-case-lock:
 	  echo "error: $(OUT)/ is in use by another run ($$(cat '$(OUT)/.lock' 2>/dev/null || echo unknown)); wait \
 	for it to finish (or stop it: its Ctrl-C writes a checkpoint), or give LOCK_WAIT=<seconds> to wait" >&2; exit 75; }; \
 	echo "pid $$$$, make $(MAKECMDGOALS) case=$(case) config=$(config), since $$(date +%T)" > '$(OUT)/.lock'; \
-	PD_CASE_LOCK=1 exec $(MAKE) --no-print-directory $(MAKECMDGOALS)
+	PD_CASE_LOCK=1 PD_LOCK_FD=9 exec $(MAKE) --no-print-directory $(MAKECMDGOALS)
 else
+# The make this rule starts holds the lock as fd 9 (PD_LOCK_FD tells pdsolve so: it locks its output
+# folder itself, io/output_lock.hpp). PD_CASE_LOCK=1 in the environment of a make run by hand would
+# skip the lock: that make is refused unless fd 9 is the folder's lock and holds it.
+ifneq ($(and $(PD_CASE_LOCK),$(LOCKED_GOALS),$(if $(DRY_RUN),,check)),)
+  ifneq ($(shell [ /proc/self/fd/9 -ef '$(OUT)/.lock' ] && flock -n 9 true && echo held),held)
+    $(error PD_CASE_LOCK is this Makefile's own (the make it starts under the lock of $(OUT)/); unset it)
+  endif
+endif
 
 .PHONY: all run figures help test test-asan fuzz solver deps check clean clean-case bench bench-accuracy bench-implicit validate
 .DELETE_ON_ERROR:

@@ -77,7 +77,12 @@ def _plain(value, key: str):
     except ImportError:  # peridyn runs without numpy too
         np = None
     if np is not None and isinstance(value, (np.generic, np.ndarray)):
-        return _plain(value.tolist(), key)  # tolist(): Python scalars, nested lists for arrays
+        plain = value.tolist()  # Python scalars, nested lists for arrays
+        if isinstance(plain, np.generic):  # longdouble and its kin stay numpy: a double is what YAML holds
+            if isinstance(plain, (np.floating, np.integer)):
+                return float(plain) if isinstance(plain, np.floating) else int(plain)
+            raise TypeError(f"{key}: a numpy {type(plain).__name__} cannot be written to a case file; give a number")
+        return _plain(plain, key)
     for plain in (bool, int, float, str):  # a subclass (an IntEnum, a str subclass): its plain value
         if isinstance(value, plain):
             return plain(value)
@@ -158,7 +163,20 @@ class Case:
         return path
 
     def mesh_source(self) -> tuple[str, str]:
-        """("given", path) of cases/<case>/<case>.unv|.msh, else ("geo", path of the .geo)."""
+        """("given", path) of cases/<case>/<case>.unv|.msh, else ("geo", path of the .geo). Each of the
+        folder's inputs must be a regular file inside it, as make's stages require (pipeline/inputs.py):
+        a .unv linked to /etc/shadow had its first line printed through Case.run (issue 36 probe)."""
+        from pipeline.inputs import CASE_FILE_EXTENSIONS
+        from preprocess.errors import PreprocessError
+        from preprocess.geo_guard import check_inside
+
+        for ext in CASE_FILE_EXTENSIONS:
+            path = os.path.join(self.folder, self.base_name + ext)
+            if os.path.lexists(path):
+                try:
+                    check_inside(path, self.folder)
+                except PreprocessError as error:
+                    raise RunError(str(error)) from None
         for ext in (".unv", ".msh"):
             path = os.path.join(self.folder, self.base_name + ext)
             if os.path.isfile(path):
@@ -216,7 +234,10 @@ class Case:
         command = [solver, os.path.join(out_dir, "case.json")] + (["--threads", str(threads)] if threads else [])
         say("solve: " + " ".join(command))
         with open(os.path.join(out_dir, "solver.log"), "w", encoding="utf-8") as stream:
-            status = subprocess.run(command, stdout=stream, stderr=subprocess.STDOUT, pass_fds=(lock_fd,)).returncode
+            # The lock's descriptor, and its number for pdsolve, which locks its folder itself
+            # (io/output_lock.hpp) and finds it held for it here.
+            status = subprocess.run(command, stdout=stream, stderr=subprocess.STDOUT, pass_fds=(lock_fd,),
+                                    env=dict(os.environ, PD_LOCK_FD=str(lock_fd))).returncode
         if status != 0:
             raise RunError(f"{' '.join(command)} failed (exit {status}); see {out_dir}/solver.log and run.log")
         if figures:

@@ -29,6 +29,29 @@ def _holder(fd: int) -> str:
         return "unknown"
 
 
+def _handed_down(path: str) -> int | None:
+    """The descriptor of `path` that the process which started this one holds the lock through
+    (PD_LOCK_FD, set by make and peridyn, as pdsolve reads it: io/output_lock.hpp; -1 if that
+    descriptor was closed or reused on the way: the parent's word), or None (no PD_LOCK_FD) to take
+    our own. A descriptor of the lock that does not hold it (another run does): FolderInUse."""
+    text = os.environ.get("PD_LOCK_FD", "")
+    if not text.isdigit():
+        return None
+    fd = int(text)
+    try:
+        handed, own = os.fstat(fd), os.stat(path)
+    except OSError:
+        handed = own = None
+    if handed is None or (handed.st_dev, handed.st_ino) != (own.st_dev, own.st_ino):
+        return -1   # closed on the way, its number reused: the parent's word, as pdsolve takes it
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # succeeds on the open file that holds it
+    except BlockingIOError:
+        raise FolderInUse(f"error: {os.path.dirname(path)}/ is in use by another run ({_holder(fd)}); wait for "
+                          "it to finish, or write into another folder") from None
+    return fd
+
+
 @contextlib.contextmanager
 def output_lock(folder: str, who: str, wait: float = 0.0):
     """Hold <folder>/.lock for the `with` block; yields the lock's file descriptor (hand it to a
@@ -39,6 +62,10 @@ def output_lock(folder: str, who: str, wait: float = 0.0):
     """
     os.makedirs(folder, exist_ok=True)
     path = os.path.join(folder, ".lock")
+    handed = _handed_down(path)
+    if handed is not None:
+        yield handed
+        return
     # O_NOFOLLOW: a .lock planted as a symbolic link must not make us write into its target.
     fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_APPEND | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
     try:
@@ -53,8 +80,11 @@ def output_lock(folder: str, who: str, wait: float = 0.0):
                         f"error: {folder}/ is in use by another run ({_holder(fd)}); wait for it to finish "
                         f"(or stop it: its Ctrl-C writes a checkpoint), or write into another folder") from None
                 time.sleep(0.2)
-        os.ftruncate(fd, 0)
-        os.write(fd, f"pid {os.getpid()}, {who}, since {time.strftime('%H:%M:%S')}\n".encode())
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"pid {os.getpid()}, {who}, since {time.strftime('%H:%M:%S')}\n".encode())
+        except OSError:
+            pass  # a full disk: the lock is held, only the note for a refused writer is missing
         yield fd
     finally:
         os.close(fd)  # closing the last descriptor of the open file releases the lock

@@ -11,6 +11,7 @@ name and renamed, so an interrupted stage leaves nothing half-written.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import difflib
 import json
 import math
@@ -24,6 +25,7 @@ from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
 from .cost import check_cost
 from .inputs import check_case_inputs
+from .output_lock import FolderInUse, output_lock
 from .regular_file import open_regular
 from .resolve import check_set_names, resolve
 from .stability import check_discretized_case
@@ -246,7 +248,15 @@ def main(argv=None) -> int:
     try:
         # Before a stage reads anything: no input may lead out of the case folder (issue 36).
         check_case_inputs(args.case, getattr(args, "geo", None), getattr(args, "mesh", None))
-        args.func(args)
+        # A stage that writes takes its output folder's lock, or finds make's (PD_LOCK_FD): run by
+        # hand beside a make of the same case it wrote into that run's files (issue 36 probe).
+        folder = args.out_dir if args.command == "preprocess" else (
+            os.path.dirname(os.path.abspath(args.out)) if args.command in ("mesh", "mesh-parameters") else None)
+        with output_lock(folder, f"python3 -m pipeline.run {args.command}") if folder else contextlib.nullcontext():
+            args.func(args)
+    except FolderInUse as err:
+        print(err, file=sys.stderr)
+        return 75
     except CaseError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

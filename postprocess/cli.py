@@ -11,6 +11,7 @@ Exit status 0 on success, 1 with a message naming the file on an error, 2 on a u
 from __future__ import annotations
 
 import argparse
+import contextlib
 import glob
 import os
 import re
@@ -247,8 +248,17 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
+    from pipeline.output_lock import FolderInUse, output_lock
+
     try:
-        run(args.out_dir, args.case_json, args.only)
+        # The run folder's lock (make's, handed down as PD_LOCK_FD, or our own): figures drawn by
+        # hand while a run writes the frames read frames half the run had written (issue 36 probe).
+        with output_lock(args.out_dir, "python3 -m postprocess") if os.path.isdir(args.out_dir) \
+                else contextlib.nullcontext():
+            run(args.out_dir, args.case_json, args.only)
+    except FolderInUse as error:
+        print(f"postprocess: {error}", file=sys.stderr)
+        return 75
     except PostprocessError as error:
         print(f"postprocess: error: {error}", file=sys.stderr)
         return 1

@@ -13,6 +13,7 @@
 #include "io/case_reader.hpp"
 #include "io/describe.hpp"
 #include "io/node_file.hpp"
+#include "io/output_lock.hpp"
 #include "parallel/session.hpp"
 #include "run.hpp"
 
@@ -64,6 +65,7 @@ const char* const kUsage =
     "Exit codes: 0 done; 1 bad input (reported before any output file is written); 2 bad command\n"
     "line; 3 the run failed (e.g. the state became non-finite, or the disk is full: \"disk full\n"
     "writing FILE: free N MB and run make again\"; the frames and rows written before are whole);\n"
+    "75 the output folder is in use by another run (make, peridyn or pdsolve: output_dir/.lock);\n"
     "130 / 143 interrupted by SIGINT / SIGTERM after writing the checkpoint.\n";
 
 #ifdef _OPENMP
@@ -270,6 +272,10 @@ int main(int argc, char** argv) {
       return print_stable_dt(options.case_file, exact);
     }
     return pd::run(options);
+  } catch (const pd::FolderInUse& e) {
+    // Another run writes into the output folder (io/output_lock.hpp): EX_TEMPFAIL, as make's lock.
+    std::cerr << "pdsolve: error: " << e.what() << "\n";
+    return pd::kFolderInUse;
   } catch (const pd::Error& e) {
     // Bad input is found by every rank of a decomposed run alike (each reads the same files): one says it.
     if (pd::world_ranks().rank == 0) std::cerr << "pdsolve: error: " << e.what() << "\n";

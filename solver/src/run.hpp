@@ -21,7 +21,7 @@ struct RunOptions {
 
 // Exit codes of pdsolve. Interrupted by SIGINT or SIGTERM after writing a checkpoint: 128 + the
 // signal number (130, 143), as a shell reports a process killed by it.
-enum ExitCode : int { kOk = 0, kInputError = 1, kUsageError = 2, kRunFailed = 3 };
+enum ExitCode : int { kOk = 0, kInputError = 1, kUsageError = 2, kRunFailed = 3, kFolderInUse = 75 };
 constexpr int kInterruptedBase = 128;
 
 // Throws pd::Error for bad input, always before any output file is written; returns kRunFailed

@@ -105,6 +105,14 @@ def test_numpy_scalars_and_arrays_are_written_as_plain_numbers(membrane, tmp_pat
     assert again["figures.times"] == [0.0, 1.0e-3, 2.0e-3] and again["damping"] == 250.0
 
 
+def test_numpy_long_double_becomes_a_double_and_its_complex_is_refused(membrane):
+    """longdouble.tolist() is a longdouble again: the conversion recursed until RecursionError."""
+    membrane["time.end"] = np.longdouble(2.0e-3)
+    assert membrane["time.end"] == 2.0e-3 and type(membrane["time.end"]) is float
+    with pytest.raises(TypeError, match=r"^time\.end: a numpy complex\d+ cannot be written to a case file"):
+        membrane["time.end"] = np.clongdouble(1.0)
+
+
 def test_a_value_yaml_cannot_hold_leaves_no_file(membrane, tmp_path):
     membrane.data["time"]["end"] = object()
     with pytest.raises(TypeError, match=r"^time\.end: a builtins\.object cannot be written to a case file"):

@@ -33,7 +33,7 @@ def test_a_run_into_a_folder_make_holds_is_refused_before_any_work(tmp_path):
     out.mkdir()
     (out / ".lock").write_text("pid 1, make all case=held config=held, since 12:00:00\n")
     # flock(1) on the file, as the Makefile's pd-case-lock rule holds it while make runs.
-    holder = subprocess.Popen(["flock", str(out / ".lock"), "sleep", "60"])
+    holder = subprocess.Popen(["flock", str(out / ".lock"), "sleep", "60"], start_new_session=True)
     try:
         deadline = time.monotonic() + 10
         while subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode == 0:
@@ -43,7 +43,7 @@ def test_a_run_into_a_folder_make_holds_is_refused_before_any_work(tmp_path):
             small_case().run(str(out), threads=1)
         assert sorted(os.listdir(out)) == [".lock"]      # nothing written: not even the .yaml
     finally:
-        holder.kill()
+        os.killpg(holder.pid, signal.SIGKILL)   # flock(1) and its sleep, which holds the lock too
         holder.wait()
 
 
@@ -77,3 +77,55 @@ def test_the_folder_stays_locked_while_case_run_solves(tmp_path):
     while subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode != 0:
         assert time.monotonic() < deadline, "the lock outlived the run's processes"
         time.sleep(0.1)
+
+
+def test_a_mesh_linked_out_of_the_case_folder_is_refused_by_case_run(tmp_path):
+    """make's stages refused it, Case.run read it: a .unv linked to a file outside had its first line
+    printed in the reader's error (issue 36 probe)."""
+    secret = tmp_path / "secret.txt"
+    secret.write_text("root:*:20228:0:99999:7:::\n")
+    case_dir = tmp_path / "leak"
+    case_dir.mkdir()
+    (case_dir / "leak.yaml").write_text((open(os.path.join(ROOT, "cases", "membrane", "membrane.yaml")).read()))
+    os.symlink(secret, case_dir / "leak.unv")
+    case = peridyn.load(str(case_dir / "leak.yaml"))
+    with pytest.raises(peridyn.RunError, match=r"leak.unv: leads outside the case folder") as error:
+        case.run(str(tmp_path / "out"), figures=False)
+    assert "root:" not in str(error.value)
+    assert not (tmp_path / "out" / "nodes.vtu").exists()
+
+
+def test_pdsolve_started_by_hand_into_a_folder_a_run_holds_is_refused(tmp_path):
+    """pdsolve locks its output folder itself (io/output_lock.hpp): started by hand beside a make
+    solving into the same folder, as its own interrupt message suggests, it wrote NUL bytes into
+    history.csv and deleted the other run's frames (issue 36 probe). Here the folder is a finished
+    Case.run's, held by flock(1) as make holds it."""
+    out = tmp_path / "held"
+    small_case().run(str(out), threads=1, figures=False)
+    history = (out / "history.csv").read_bytes()
+    holder = subprocess.Popen(["flock", str(out / ".lock"), "sleep", "60"], start_new_session=True)
+    try:
+        deadline = time.monotonic() + 10
+        while subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode == 0:
+            assert time.monotonic() < deadline, "flock(1) did not take the lock"
+            time.sleep(0.05)
+        env = {k: v for k, v in os.environ.items() if k != "PD_LOCK_FD"}
+        result = subprocess.run([SOLVER, str(out / "case.json"), "--quiet"], capture_output=True, text=True,
+                                env=env, timeout=60)
+        assert result.returncode == 75, result.stderr
+        assert f"{out}/ is in use by another run (" in result.stderr
+        assert (out / "history.csv").read_bytes() == history           # nothing touched
+        # PD_LOCK_FD naming a descriptor of the lock that does not hold it: refused too.
+        with open(out / ".lock") as stream:
+            handed = subprocess.run([SOLVER, str(out / "case.json"), "--quiet"], capture_output=True, text=True,
+                                    env=dict(env, PD_LOCK_FD=str(stream.fileno())), pass_fds=(stream.fileno(),),
+                                    timeout=60)
+        assert handed.returncode == 75, handed.stderr
+    finally:
+        os.killpg(holder.pid, signal.SIGKILL)   # flock(1) and its sleep, which holds the lock too
+        holder.wait()
+    # The lock free: pdsolve by hand takes it, runs, and leaves it free again.
+    result = subprocess.run([SOLVER, str(out / "case.json"), "--quiet"], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "pdsolve " in (out / ".lock").read_text()
+    assert subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode == 0

@@ -50,3 +50,21 @@ def test_the_lock_is_free_again_when_make_ends(tree):
     result = make(tree, NAME, f"out/{NAME}/mesh-parameters.json")
     assert result.returncode == 0, result.stderr
     assert (out / ".lock").exists()
+
+
+def test_pd_case_lock_in_the_environment_does_not_skip_the_lock(tree):
+    """PD_CASE_LOCK=1 is the Makefile's own mark of the make it starts under the lock; set in the
+    environment of a make run by hand it skipped the lock, and two solvers ran on one folder
+    (issue 36 probe). Now that make checks it holds the lock, and stops."""
+    out = tree / "out" / NAME
+    first = start_make(tree, NAME, f"out/{NAME}/.solved")
+    try:
+        wait_for_steps(out, first)
+        second = start_make(tree, NAME, f"out/{NAME}/.solved", env={"PD_CASE_LOCK": "1"})
+        _, err = second.communicate(timeout=60)
+        assert second.returncode != 0
+        assert "PD_CASE_LOCK is this Makefile's own" in err, err
+        assert first.poll() is None
+    finally:
+        os.killpg(first.pid, signal.SIGTERM)
+        first.communicate(timeout=120)

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "core/case.hpp"
 #include "core/model.hpp"
 #include "core/state.hpp"
+#include "io/output_lock.hpp"
 #include "io/vtu.hpp"
 
 namespace pd {
@@ -95,6 +97,8 @@ class OutputWriter {
   explicit OutputWriter(std::filesystem::path output_dir, const std::vector<std::string>& extra_columns = {},
                         const OutputResume* resume = nullptr, FrameFormat format = FrameFormat{});
   ~OutputWriter();
+  // Keeps the output folder's lock for as long as this writer lives (io/output_lock.hpp).
+  void hold(std::unique_ptr<OutputLock> lock) { lock_ = std::move(lock); }
   OutputWriter(const OutputWriter&) = delete;
   OutputWriter& operator=(const OutputWriter&) = delete;
 
@@ -123,6 +127,7 @@ class OutputWriter {
   FrameFormat format_;
   std::vector<std::pair<double, std::string>> frames_;  // (time, relative file)
   int history_fd_ = -1;
+  std::unique_ptr<OutputLock> lock_;  // released once ~OutputWriter has closed the files
   std::string history_buffer_;
   std::uint64_t history_bytes_ = 0;
   double last_flush_ = 0.0;  // steady-clock seconds

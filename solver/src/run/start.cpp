@@ -2,6 +2,7 @@
 #include "run/start.hpp"
 
 #include "core/conditions.hpp"
+#include "io/output_lock.hpp"
 #include "io/read_file.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
@@ -171,15 +172,24 @@ std::filesystem::path checkpoint_path(const Case& c) { return (c.output_dir / "c
 std::unique_ptr<OutputWriter> open_output(const RunOptions& opt, const Prepared& p, const Start& s,
                                           const HistoryColumns& columns) {
   if (!p.writes_output()) return nullptr;
+  // The folder's lock before any file in it changes: make, peridyn and a pdsolve started by hand
+  // never write into one folder at once (io/output_lock.hpp).
+  auto lock = std::make_unique<OutputLock>(p.c.output_dir, "pdsolve " + opt.case_file.string());
   // The frames' format (output.precision, compression, fields) reaches the writer here.
   FrameFormat format = frame_format_of(p.c.output);
   format.pieces = p.frames_in_pieces();
-  if (!s.restarting) return std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), nullptr, format);
-  try {
-    return std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), &s.resume, format);
-  } catch (const Error& e) {  // history.csv shorter than recorded, a frame missing
-    throw start_over(opt, e);
+  std::unique_ptr<OutputWriter> out;
+  if (!s.restarting) {
+    out = std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), nullptr, format);
+  } else {
+    try {
+      out = std::make_unique<OutputWriter>(p.c.output_dir, columns.names(), &s.resume, format);
+    } catch (const Error& e) {  // history.csv shorter than recorded, a frame missing
+      throw start_over(opt, e);
+    }
   }
+  out->hold(std::move(lock));
+  return out;
 }
 
 std::string restart_line(const RunOptions& opt, const Start& s) {
