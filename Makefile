@@ -52,6 +52,10 @@ $(foreach v,$(INTERNAL_VARIABLES),$(if $(filter command line,$(origin $(v))),$(e
 ifneq ($(call unsafe_chars,LOCK_WAIT,$(DIGITS) .)$(filter-out 0 1,$(words $(value LOCK_WAIT))),)
   $(error LOCK_WAIT='$(value LOCK_WAIT)' is not a number of seconds: digits and '.' only, e.g. LOCK_WAIT=600)
 endif
+# Its characters known safe, its form: a number as flock -w reads it (`..` passed, then flock failed).
+ifneq ($(if $(value LOCK_WAIT),$(shell printf '%s\n' '$(value LOCK_WAIT)' | grep -Eqx '[0-9]+(\.[0-9]*)?|\.[0-9]+' || echo bad)),)
+  $(error LOCK_WAIT='$(value LOCK_WAIT)' is not a number of seconds, e.g. LOCK_WAIT=600 or LOCK_WAIT=2.5)
+endif
 $(foreach v,JOBS FUZZ_SECONDS,$(if $(and $(value $(v)),$(call not_count,$(v))),$(error \
     $(v)='$(value $(v))' is not a whole number: digits only, e.g. $(v)=2)))
 $(foreach v,BENCH_SIDES BENCH_MPI_SIDES,$(if $(call unsafe_chars,$(v),$(DIGITS)),$(error \
@@ -88,7 +92,8 @@ endif
 # RANKS=1000 started a thousand processes on 2 cores without a word (issue 36, item 10): at most 4
 # ranks per core, as pdsolve's --threads allows at most 4 threads per core.
 ifneq ($(shell [ '$(RANKS)' -le $$(( 4 * $$(nproc) )) ] 2>/dev/null || echo over),)
-  $(error RANKS=$(RANKS) is more than 4 ranks per core on this machine ($(shell nproc) cores): give RANKS=$(shell nproc) or fewer \
+  $(error RANKS=$(RANKS) is more than 4 ranks per core on this machine ($(shell nproc) cores): give at most \
+      RANKS=$(shell echo $$(( 4 * $$(nproc) ))), best RANKS=$(shell nproc) or fewer \
       (each rank runs OMP_NUM_THREADS threads); on a cluster, start pdsolve with the cluster's own launcher)
 endif
 # One rank: pdsolve alone (the serial path). More: under mpiexec; --oversubscribe lets a small machine
@@ -188,10 +193,18 @@ $(DEPS): pipeline/install-deps.sh
 # A case needs pdsolve alone: building every test and benchmark too was ~8 of the first
 # `make case=membrane`'s 10 minutes (issue 39, item 4). test, bench and validate build the rest.
 solver: $(SOLVER)
+ifeq ($(SOLVER),build/solver/pdsolve)
 $(SOLVER): $(SOLVER_SOURCES) | $(DEPS)
 	cmake -S solver -B build/solver -DCMAKE_BUILD_TYPE=Release
 	cmake --build build/solver -j$(JOBS) --target pdsolve
 	@touch $@
+else
+# Another solver (SOLVER=…, validation's PDSOLVE) is used as it is: never built or touched here. Before,
+# its rule was build/solver's, and the locked re-run of make does not get make's -o: `make
+# SOLVER=/usr/bin/touch -o /usr/bin/touch …` started cmake, whose recipe ends touching $(SOLVER).
+$(SOLVER):
+	@echo "error: SOLVER=$(SOLVER): no such file; build that solver, or leave SOLVER unset for build/solver/pdsolve" >&2; exit 2
+endif
 override ALL_SOLVER_TARGETS := cmake --build build/solver -j$(JOBS)
 
 # With the mesh at hand (given, or made by an earlier run), material and node-set names are checked

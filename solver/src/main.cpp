@@ -66,7 +66,7 @@ const char* const kUsage =
     "line; 3 the run failed (e.g. the state became non-finite, or the disk is full: \"disk full\n"
     "writing FILE: free N MB and run make again\"; the frames and rows written before are whole);\n"
     "75 the output folder is in use by another run (make, peridyn or pdsolve: output_dir/.lock);\n"
-    "130 / 143 interrupted by SIGINT / SIGTERM after writing the checkpoint.\n";
+    "129 / 130 / 143 interrupted by SIGHUP / SIGINT / SIGTERM after writing the checkpoint.\n";
 
 #ifdef _OPENMP
 // The specification version of an _OPENMP date (OpenMP's own table).

@@ -298,3 +298,16 @@ def test_sigterm_to_one_rank_or_to_mpiexec_stops_the_run_with_a_checkpoint(tree,
     assert code != 0
     assert solver_pids(out) == [] and mpiexec_pids(out) == [], "processes of the run outlived make"
     assert_whole_checkpoint(out, "SIGTERM")
+
+
+def test_sighup_to_the_group_writes_a_checkpoint(tree):
+    """The terminal closed (an ssh session dropped) under `make case=X`: SIGHUP to the whole group
+    killed the solver with no checkpoint (issue 36 probe); now it stops the run as SIGTERM does."""
+    out = fresh(tree)
+    process = start_make(tree, NAME, f"out/{NAME}/.solved")
+    wait_for_steps(out, process)
+    os.killpg(process.pid, signal.SIGHUP)
+    code, err = finish(process)
+    assert code != 0
+    assert solver_pids(out) == []
+    assert_whole_checkpoint(out, "SIGHUP")

@@ -187,6 +187,14 @@ def test_a_goal_with_shell_characters_never_runs(tmp_path):
     assert not marker.exists()
 
 
+@pytest.mark.parametrize("value", ["..", ".", "1.2.3"])
+def test_a_lock_wait_that_is_no_number_is_refused(value):
+    """`LOCK_WAIT=..` passed the character check; flock then failed and make blamed a stale holder."""
+    result = make("-n", "clean-case", "case=membrane", f"LOCK_WAIT={value}")
+    assert result.returncode != 0
+    assert f"LOCK_WAIT='{value}' is not a number of seconds" in result.stderr, result.stderr
+
+
 def test_good_settings_pass():
     result = make("-n", "clean-case", "case=membrane", "LOCK_WAIT=1.5", "JOBS=3", "BENCH_SIDES=40 100",
                   "ACCURACY_ARGS=--quick --coarsen 4", "SOLVER=build/solver/pdsolve")
@@ -198,5 +206,6 @@ def test_ranks_beyond_the_machine_are_refused():
     result = make("-n", "case=membrane", "RANKS=1000")
     assert result.returncode != 0
     assert "RANKS=1000 is more than 4 ranks per core on this machine" in result.stderr, result.stderr
+    assert f"give at most RANKS={4 * len(os.sched_getaffinity(0))}," in result.stderr   # nproc
     huge = make("-n", "case=membrane", "RANKS=" + "9" * 40)
     assert huge.returncode != 0 and "more than 4 ranks per core" in huge.stderr

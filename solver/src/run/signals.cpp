@@ -1,4 +1,4 @@
-// The SIGINT / SIGTERM handler of a run and its guard (run/signals.hpp).
+// The SIGINT / SIGTERM / SIGHUP handler of a run and its guard (run/signals.hpp).
 #include "run/signals.hpp"
 
 #include <csignal>
@@ -53,20 +53,29 @@ SignalGuard::SignalGuard(double same_request_seconds) {
   sigemptyset(&action.sa_mask);
   sigaddset(&action.sa_mask, SIGINT);   // one handler at a time: the first signal is recorded
   sigaddset(&action.sa_mask, SIGTERM);  // with its time before a second one is looked at
+  sigaddset(&action.sa_mask, SIGHUP);
   action.sa_flags = SA_RESTART;
   sigaction(SIGINT, &action, &old_int_);
   sigaction(SIGTERM, &action, &old_term_);
+  // SIGHUP: the terminal closed (an ssh session dropped) under a run in it. It killed the solver
+  // with no checkpoint (issue 36 probe); now it stops the run as SIGTERM does. Under nohup it is
+  // ignored, and stays so, as SIGINT and SIGTERM ignored by the parent do.
+  sigaction(SIGHUP, &action, &old_hup_);
   if (old_int_.sa_handler == SIG_IGN) sigaction(SIGINT, &old_int_, nullptr);
   if (old_term_.sa_handler == SIG_IGN) sigaction(SIGTERM, &old_term_, nullptr);
+  if (old_hup_.sa_handler == SIG_IGN) sigaction(SIGHUP, &old_hup_, nullptr);
 }
 
 SignalGuard::~SignalGuard() {
   sigaction(SIGINT, &old_int_, nullptr);
   sigaction(SIGTERM, &old_term_, nullptr);
+  sigaction(SIGHUP, &old_hup_, nullptr);
 }
 
 int pending_signal() { return g_signal.load(); }
 
-const char* signal_name(int signal) { return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : "a signal"; }
+const char* signal_name(int signal) {
+  return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : signal == SIGHUP ? "SIGHUP" : "a signal";
+}
 
 }  // namespace pd

@@ -1,4 +1,4 @@
-// SIGINT / SIGTERM during a run: the handler only records the signal; the time loop asks after
+// SIGINT / SIGTERM / SIGHUP during a run: the handler only records the signal; the time loop asks after
 // each step, writes a checkpoint and stops (solver/README.md, "Checkpoint and restart").
 #pragma once
 #include <signal.h>  // struct sigaction (POSIX)
@@ -21,13 +21,13 @@ class SignalGuard {
   SignalGuard& operator=(const SignalGuard&) = delete;
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {}, old_term_ {}, old_hup_ {};
 };
 
 // The signal received since the guard was installed, or 0.
 int pending_signal();
 
-// "SIGINT", "SIGTERM", else "a signal": for messages.
+// "SIGINT", "SIGTERM", "SIGHUP", else "a signal": for messages.
 const char* signal_name(int signal);
 
 }  // namespace pd
