@@ -38,8 +38,9 @@ run: for each prepared run (in manifest order; --only / --skip to choose), empty
     other byte of every line, line ends included, exactly as written: no number is re-parsed);
   - "frames.pvd" and every "frames/frame_NNNNNN.vtu", byte for byte;
   - any other file the solver leaves in output/, byte for byte (today there is none; a new one
-    shows up as a difference), except run.log (timings, paths) and checkpoint.bin (written
-    on a signal, with output.restart_every_*, and every 600 s of wall time; it holds the wall time);
+    shows up as a difference), except run.log (timings, paths), checkpoint.bin (written
+    on a signal, with output.restart_every_*, and every 600 s of wall time; it holds the wall time)
+    and .lock (the folder's lock: the solver's pid and start time);
   - "input/case.json" and "input/nodes.vtu" (<run>/case.json and nodes.vtu), so that hashes of
     different input sets are not
     compared by mistake;
@@ -66,7 +67,7 @@ import sys
 import tempfile
 import time
 
-EXCLUDED = {"run.log", "checkpoint.bin"}  # output files not hashed (see the module docstring)
+EXCLUDED = {"run.log", "checkpoint.bin", ".lock"}  # output files not hashed (see the module docstring)
 HISTORY = "history.csv"
 DROPPED_COLUMN = b"wall_time"
 
