@@ -1,6 +1,7 @@
 """peridyn's Case.run takes the output folder's lock, the one make takes (issue 36, item 5): before,
 two runs into one folder both returned OK reporting the second run's results, and a Case.run beside
 `make case=membrane` wrote NUL bytes into history.csv."""
+import contextlib
 import os
 import signal
 import subprocess
@@ -28,23 +29,30 @@ def small_case(end=1.0e-4):
     return case
 
 
+@contextlib.contextmanager
+def held_as_make_holds_it(lock):
+    """flock(1) on `lock` for the `with` block, as the Makefile's pd-case-lock rule holds it while
+    make runs; its sleep holds the lock too, so the whole group is killed at the end."""
+    holder = subprocess.Popen(["flock", str(lock), "sleep", "60"], start_new_session=True)
+    try:
+        deadline = time.monotonic() + 10
+        while subprocess.run(["flock", "-n", str(lock), "true"]).returncode == 0:
+            assert time.monotonic() < deadline, "flock(1) did not take the lock"
+            time.sleep(0.05)
+        yield
+    finally:
+        os.killpg(holder.pid, signal.SIGKILL)
+        holder.wait()
+
+
 def test_a_run_into_a_folder_make_holds_is_refused_before_any_work(tmp_path):
     out = tmp_path / "held"
     out.mkdir()
     (out / ".lock").write_text("pid 1, make all case=held config=held, since 12:00:00\n")
-    # flock(1) on the file, as the Makefile's pd-case-lock rule holds it while make runs.
-    holder = subprocess.Popen(["flock", str(out / ".lock"), "sleep", "60"], start_new_session=True)
-    try:
-        deadline = time.monotonic() + 10
-        while subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode == 0:
-            assert time.monotonic() < deadline, "flock(1) did not take the lock"
-            time.sleep(0.05)
+    with held_as_make_holds_it(out / ".lock"):
         with pytest.raises(peridyn.RunError, match=r"held/ is in use by another run \(pid 1, make all case=held"):
             small_case().run(str(out), threads=1)
         assert sorted(os.listdir(out)) == [".lock"]      # nothing written: not even the .yaml
-    finally:
-        os.killpg(holder.pid, signal.SIGKILL)   # flock(1) and its sleep, which holds the lock too
-        holder.wait()
 
 
 def test_the_folder_stays_locked_while_case_run_solves(tmp_path):
@@ -103,12 +111,7 @@ def test_pdsolve_started_by_hand_into_a_folder_a_run_holds_is_refused(tmp_path):
     out = tmp_path / "held"
     small_case().run(str(out), threads=1, figures=False)
     history = (out / "history.csv").read_bytes()
-    holder = subprocess.Popen(["flock", str(out / ".lock"), "sleep", "60"], start_new_session=True)
-    try:
-        deadline = time.monotonic() + 10
-        while subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode == 0:
-            assert time.monotonic() < deadline, "flock(1) did not take the lock"
-            time.sleep(0.05)
+    with held_as_make_holds_it(out / ".lock"):
         env = {k: v for k, v in os.environ.items() if k != "PD_LOCK_FD"}
         result = subprocess.run([SOLVER, str(out / "case.json"), "--quiet"], capture_output=True, text=True,
                                 env=env, timeout=60)
@@ -121,9 +124,6 @@ def test_pdsolve_started_by_hand_into_a_folder_a_run_holds_is_refused(tmp_path):
                                     env=dict(env, PD_LOCK_FD=str(stream.fileno())), pass_fds=(stream.fileno(),),
                                     timeout=60)
         assert handed.returncode == 75, handed.stderr
-    finally:
-        os.killpg(holder.pid, signal.SIGKILL)   # flock(1) and its sleep, which holds the lock too
-        holder.wait()
     # The lock free: pdsolve by hand takes it, runs, and leaves it free again.
     result = subprocess.run([SOLVER, str(out / "case.json"), "--quiet"], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr

@@ -81,13 +81,17 @@ def test_a_body_moving_with_its_edge_held_is_no_mistake(tmp_path):
     assert check_condition_overlaps(case, cloud().sets) == []
 
 
-def test_a_horizon_of_one_spacing_stops_the_run_with_the_bond_count(tmp_path, monkeypatch):
-    text = CASE.replace("  dx: 0.001\n", "  dx: 0.001\n  horizon_factor: 1.0\n")
+def with_horizon(tmp_path, line):
+    """The test's plate with `line` added under dx: (path, case, cloud, resolved case.json)."""
     path = tmp_path / "plate.yaml"
-    path.write_text(text)
+    path.write_text(CASE.replace("  dx: 0.001\n", f"  dx: 0.001\n  {line}\n"))
     case = load_case(str(path))
     c = cloud()
-    resolved = resolve(case, node_sets=list(c.sets), grid_spacing=DX, nodes_file="nodes.vtu")
+    return path, case, c, resolve(case, node_sets=list(c.sets), grid_spacing=DX, nodes_file="nodes.vtu")
+
+
+def test_a_horizon_of_one_spacing_stops_the_run_with_the_bond_count(tmp_path, monkeypatch):
+    path, case, c, resolved = with_horizon(tmp_path, "horizon_factor: 1.0")
     # at δ = dx: 80 interior nodes have 4 bonds, 36 edge nodes 3, the 4 corners 2; 120 nodes
     mean = (4 * 10 * 8 + 3 * 2 * (10 + 8) + 2 * 4) / 120
     message = (f"{path}:5: discretization.horizon_factor: the horizon 0.001 m is 1 × the node spacing 0.001 m: "
@@ -104,12 +108,7 @@ def test_a_horizon_of_one_spacing_stops_the_run_with_the_bond_count(tmp_path, mo
 
 def test_a_horizon_in_metres_left_behind_by_a_coarser_dx_names_the_key_to_change(tmp_path, monkeypatch):
     """Issue 39, item 7: `horizon` fixed in metres, dx coarsened alone: δ = 1 dx ran after a warning."""
-    text = CASE.replace("  dx: 0.001\n", "  dx: 0.001\n  horizon: 0.0015\n")
-    path = tmp_path / "plate.yaml"
-    path.write_text(text)
-    case = load_case(str(path))
-    c = cloud()
-    resolved = resolve(case, node_sets=list(c.sets), grid_spacing=DX, nodes_file="nodes.vtu")
+    _, case, c, resolved = with_horizon(tmp_path, "horizon: 0.0015")
     monkeypatch.delenv("FORCE", raising=False)
     with pytest.raises(CaseError, match=r"plate.yaml:5: discretization.horizon: the horizon 0.0015 m is 1.5 × the node "
                                         r"spacing 0.001 m: .* discretization.horizon is fixed in metres, so it did not "
