@@ -404,6 +404,9 @@ CASE = {
                   "before the first break; otherwise four frames spread over the run); at most 24, each a "
                   "damage and a displacement map",
                   default=None, unit="s"),
+        dpi=Key("integer", "resolution of the PNG figures in dots per inch: 300 prints sharp; 100–150 for "
+                "the screen (smaller files); the layout in points is the same at every value",
+                default=300, minimum=50, maximum=1200),
         displacement_component=Key("choice", "displacement component coloured in the maps",
                                    default="x", choices=("x", "y", "z")),
         probe=Key("point_or_name", "where probe.png follows the displacement component: a point "

@@ -9,6 +9,10 @@ from .errors import PostprocessError
 
 AXES = "xyz"
 GMSH_CHOICES = ("all", "figures", "none")
+# figures.dpi's default (pipeline/schema.py), also for a case.json written before the key existed,
+# and the validation report's figures: fit for print.
+DEFAULT_DPI = 300
+DPI_RANGE = (50, 1200)   # pipeline/schema.py's range: below 50 text is unreadable, above 1200 a map is ~100 MB
 
 
 @dataclasses.dataclass
@@ -19,6 +23,7 @@ class CaseSettings:
     grid_spacing: float | None = None   # dx [m]: sizes the markers of the maps
     times: list | None = None       # `figures.times` [s], or None for four frames spread over the run
     component: int = 0              # `figures.displacement_component`: 0, 1, 2 for x, y, z
+    dpi: int = DEFAULT_DPI          # `figures.dpi`: the PNGs' resolution; the layout is in points
     block_names: dict = dataclasses.field(default_factory=dict)  # block id -> name, for Gmsh
     gmsh: str = "figures"           # `output.gmsh`: frames copied to gmsh/results.msh: all | figures | none
     integrator: str | None = None   # `time.integrator`: what timestep.png shows (None: not in case.json)
@@ -78,6 +83,9 @@ def load_case_settings(path: str) -> CaseSettings:
     component = figures.get("displacement_component", 0)
     if component not in (0, 1, 2) or isinstance(component, bool):
         fail("figures.displacement_component", f"expected 0, 1 or 2 (x, y, z), got {component!r}")
+    dpi = figures.get("dpi", DEFAULT_DPI)
+    if not (isinstance(dpi, int) and not isinstance(dpi, bool) and DPI_RANGE[0] <= dpi <= DPI_RANGE[1]):
+        fail("figures.dpi", f"expected a whole number of dots per inch in [{DPI_RANGE[0]}, {DPI_RANGE[1]}], got {dpi!r}")
     output = case.get("output") or {}
     gmsh = output.get("gmsh", "figures") if isinstance(output, dict) else "figures"
     if gmsh not in GMSH_CHOICES:
@@ -104,6 +112,6 @@ def load_case_settings(path: str) -> CaseSettings:
                    and isinstance(b.get("id"), int) and isinstance(b.get("name"), str)}
     return CaseSettings(name=name, dimension=dimension, title=title,
                         grid_spacing=None if spacing is None else float(spacing),
-                        times=times, component=int(component), block_names=block_names, gmsh=gmsh,
+                        times=times, component=int(component), dpi=dpi, block_names=block_names, gmsh=gmsh,
                         integrator=integrator, probe=probe, cracks=cracks,
                         breakable=any(isinstance(b, dict) and b.get("fracture_energy") is not None for b in blocks))

@@ -138,7 +138,7 @@ def plot_crack_path(times, x, crack_masks, tracks: list[Track], case: CaseSettin
     if tracks and ax_speed.get_lines():
         place_legend(ax_speed, fontsize="small")
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return (f"crack_path.png and crack_tips.csv: {len(tracks)} crack tip(s) over {len(times)} frames; "
             f"peak speed {'; '.join(peaks) if peaks else 'none'}" +
             ("; frames more often (output.every_time) would follow the crack's run" if unresolved else ""))

@@ -92,5 +92,5 @@ def plot_energy(history: dict, case: CaseSettings, path: str) -> str:
     end = 100.0 * float(drift[-1])
     bottom.set_title(f"drift at the end: {end:+.3g} % of {reference}", fontsize="small")
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return f"energy.png: {', '.join(drawn)} and their balance (drift at the end {end:+.3g} % of {reference})"

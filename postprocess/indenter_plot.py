@@ -33,5 +33,5 @@ def plot_indenter_forces(history: dict, case: CaseSettings, path: str):
         place_legend(ax, fontsize="small")
     axes[-1, 0].set_xlabel(t_label)
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return f"indenter_force.png: reaction force on indenter(s) {', '.join(names)}"

@@ -161,4 +161,4 @@ def plot_map(frame: Frame, case: CaseSettings, path: str, *, quantity: str, time
         fig.colorbar(scatter3, cax=cax, label=label)
         plain_ticks(cax)
         _size_markers(ax, scatter, spacing)
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)

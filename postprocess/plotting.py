@@ -18,6 +18,10 @@ from matplotlib.ticker import ScalarFormatter  # noqa: E402
 
 from pipeline.atomic import atomic_path  # noqa: E402
 
+from .casefile import DEFAULT_DPI  # noqa: E402
+
+# The figures' layout resolution: sizes are in points and marker sizes are computed at this
+# resolution (maps.py); the PNG is written at the case's figures.dpi, which scales the pixels only.
 DPI = 150
 # SI prefixes from large to small: the first whose factor is ≤ the largest value is used.
 PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"))
@@ -30,12 +34,12 @@ def new_figure(rows: int = 1, cols: int = 1, *, size=(7.0, 5.0), **kwargs):
     return plt.subplots(rows, cols, figsize=size, dpi=DPI, squeeze=False, **kwargs)
 
 
-def save_figure(fig, path: str):
-    """Write the figure as PNG under a temporary name, rename it into place, and free it.
-    The page is cropped to what is drawn (bbox "tight"), which keeps every size in points."""
+def save_figure(fig, path: str, dpi: int = DEFAULT_DPI):
+    """Write the figure as PNG at `dpi` (figures.dpi) under a temporary name, rename it into place,
+    and free it. The page is cropped to what is drawn (bbox "tight"), which keeps every size in points."""
     try:
         with atomic_path(path) as tmp:
-            fig.savefig(tmp, format="png", dpi=DPI, bbox_inches="tight", pad_inches=0.15)
+            fig.savefig(tmp, format="png", dpi=dpi, bbox_inches="tight", pad_inches=0.15)
     finally:
         plt.close(fig)
 

@@ -27,5 +27,5 @@ def plot_probe(times, values, case: CaseSettings, path: str, *, where: str, posi
     plain_ticks(ax)
     place_legend(ax, fontsize="small")
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return f"probe.png: u_{axis} of {where} over {len(times)} frames"

@@ -76,5 +76,5 @@ def plot_reactions(history: dict, case: CaseSettings, case_json_path: str, path:
         if ax.get_lines():
             place_legend(ax, fontsize="small")
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return f"reaction_force.png: reaction force on node set(s) {', '.join(names)}"

@@ -66,7 +66,7 @@ def plot_damage_3d_matplotlib(points, damage, case: CaseSettings, path: str, *, 
     t_factor, t_unit = si_scale([time], "s")
     ax.set_title(short_title(case, f"damage at t = {time * t_factor:.4g} {t_unit}")
                  + (f"\n(drawn stretched: {', '.join(stretched)})" if stretched else ""))
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return (f"damage_3d.png (matplotlib): {len(shown)} nodes with damage > {DAMAGED_SHOWN:g} of {len(p)}"
             + ("" if shutil.which("pvpython") else "; pvpython not found: ParaView renders it when installed"))
 

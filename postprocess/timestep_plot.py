@@ -102,7 +102,7 @@ def _plot_verlet(history: dict, case, path: str, limits: dict) -> str:
     b.grid(alpha=0.3)
     plain_ticks(b)
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return "timestep.png: Verlet's constant Δt against its stability limit" + (
         f" ({', '.join(margins)})" if margins else " (no run.log: limits unknown)") + ", and the wall-clock time"
 
@@ -160,7 +160,7 @@ def _plot_controlled(history: dict, case, path: str) -> str:
     if rejected:
         place_legend(c, fontsize="small")
     fig.tight_layout()
-    save_figure(fig, path)
+    save_figure(fig, path, case.dpi)
     return (f"timestep.png: Δt of {len(step)} steps ({float(np.min(dt)):.3g} … {float(np.max(dt)):.3g} s), "
             f"iterations K (mean {float(np.mean(history['iterations'])):.3g})"
             + (f", {int(np.sum(history['rejected']))} rejected attempts" if rejected else "")

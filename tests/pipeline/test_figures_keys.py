@@ -60,3 +60,21 @@ def test_an_unknown_probe_set_is_named_with_the_mesh_groups(tmp_path):
     with pytest.raises(CaseError, match=r"plate.yaml:12: node set 'egde' is not a physical group of the mesh "
                                         r"\(did you mean 'edge'\?\)"):
         check_set_names(case, ["plate", "edge"])
+
+
+def test_figures_dpi_defaults_to_print_and_reaches_case_json(tmp_path):
+    case = load(tmp_path, "null")
+    assert case["figures"]["dpi"] == 300
+    resolved = resolve(case, node_sets=["plate"], grid_spacing=0.001, nodes_file="nodes.vtu")
+    assert resolved["figures"]["dpi"] == 300
+    path = tmp_path / "plate.yaml"
+    path.write_text(path.read_text() + "  dpi: 150\n")
+    assert load_case(str(path))["figures"]["dpi"] == 150
+
+
+@pytest.mark.parametrize("dpi", ["20", "1300", "150.5"])
+def test_figures_dpi_outside_its_range_names_the_line(tmp_path, dpi):
+    path = tmp_path / "plate.yaml"
+    path.write_text(textwrap.dedent(CASE.format(probe="null", dimension=2)) + f"  dpi: {dpi}\n")
+    with pytest.raises(CaseError, match=r"plate\.yaml:\d+: figures\.dpi"):
+        load_case(str(path))

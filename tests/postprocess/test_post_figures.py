@@ -1,4 +1,5 @@
 """The figures: every PNG is written, valid and non-trivial, and the maps show the nearest frames."""
+import json
 import os
 
 import matplotlib.image
@@ -7,6 +8,7 @@ import pytest
 
 import synthetic_output as synth
 from postprocess import cli, maps
+from postprocess.errors import PostprocessError
 from pipeline.atomic import atomic_path
 from postprocess.energy_plot import energy_balance
 from postprocess.history import read_history
@@ -127,3 +129,28 @@ def test_an_interrupted_write_leaves_the_old_file_and_no_temporary(tmp_path):
             raise RuntimeError("interrupted")
     assert target.read_bytes() == b"old"
     assert os.listdir(tmp_path) == ["figure.png"]
+
+
+def test_figures_dpi_scales_the_pixels_not_the_layout(run2d):
+    """figures.dpi (default 300, fit for print): the same figure at 150 dpi has half the pixels
+    each way, within the one pixel that the tight bounding box rounds."""
+    case = json.loads(run2d.case_json.read_text())
+    assert "dpi" not in case["figures"]   # a case.json from before the key: the default applies
+    run_quietly(run2d.out, only="figures")
+    at_300 = synth.png_size(run2d.out / "figures" / "energy.png")
+    case["figures"]["dpi"] = 150
+    run2d.case_json.write_text(json.dumps(case))
+    run_quietly(run2d.out, only="figures")
+    at_150 = synth.png_size(run2d.out / "figures" / "energy.png")
+    assert at_300[0] == pytest.approx(2 * at_150[0], abs=2) and at_300[1] == pytest.approx(2 * at_150[1], abs=2)
+    assert at_150[0] > 600   # 7 in wide at 150 dpi, less what tight cropping removes
+
+
+@pytest.mark.parametrize("dpi", [49, 1201, 300.0, True, "300"])
+def test_figures_dpi_out_of_range_names_the_key(run2d, dpi):
+    case = json.loads(run2d.case_json.read_text())
+    case["figures"]["dpi"] = dpi
+    run2d.case_json.write_text(json.dumps(case))
+    with pytest.raises(PostprocessError, match=r"case\.json: figures\.dpi: expected a whole number of dots per "
+                                               r"inch in \[50, 1200\], got"):
+        run_quietly(run2d.out, only="figures")
