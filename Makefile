@@ -184,6 +184,7 @@ help:
 all: run
 run: $(OUT)/figures/.done
 	@echo "results in $(OUT)/: frames.pvd (ParaView), history.csv, figures/, gmsh/results.msh (Gmsh)"
+	@$(PY) -m postprocess.sizes '$(OUT)'   # what the run left on disk, by kind
 
 deps: $(DEPS)
 $(DEPS): pipeline/install-deps.sh
