@@ -132,14 +132,14 @@ override DEPS    := build/.deps-ok
 override GIVEN_MESH := $(firstword $(wildcard $(CASEDIR)/$(case).unv $(CASEDIR)/$(case).msh))
 override MESH       := $(if $(GIVEN_MESH),$(GIVEN_MESH),$(OUT)/mesh.msh)
 
-PRE_SOURCES    := $(wildcard pipeline/*.py preprocess/*.py preprocess/*/*.py)
-POST_SOURCES   := $(wildcard postprocess/*.py)
+PRE_SOURCES    := $(wildcard common/*.py pipeline/*.py preprocess/*.py preprocess/*/*.py)
+POST_SOURCES   := $(wildcard common/*.py postprocess/*.py)
 SOLVER_SOURCES := $(shell find solver -name '*.cpp' -o -name '*.hpp' -o -name 'CMakeLists.txt' 2>/dev/null)
 
 # One writer at a time per case output folder (issue 17, item 8; issue 36, items 5-7): two
 # `make case=X` in one tree drew each other's frames in progress and read half-written history rows.
 # A goal that writes out/<case>/ takes flock(2) on $(OUT)/.lock, the lock peridyn's Case.run,
-# validation and bench take too (pipeline/output_lock.py), and re-runs make holding it; a second
+# validation and bench take too (common/output_lock.py), and re-runs make holding it; a second
 # writer fails at once saying who holds it, or waits LOCK_WAIT seconds for it (LOCK_WAIT=600).
 # The shell opens the lock as fd 9, locks it and then *becomes* the inner make (exec), which hands fd
 # 9 down to the solver: so (a) the lock is held exactly as long as a process of this run lives, and

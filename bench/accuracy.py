@@ -35,21 +35,17 @@ import argparse
 import csv
 import json
 import os
-import platform
-import re
-import subprocess
 import sys
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-
-from postprocess.series import read_frame, read_series  # noqa: E402
-from preprocess.cloud import NodeCloud  # noqa: E402
-from preprocess.node_file import write_node_file  # noqa: E402
-from bench import quasi_static_cases, tension  # noqa: E402
-from pipeline.output_lock import exit_code, output_lock  # noqa: E402
+from bench import quasi_static_cases, tension
+from bench.solver_runs import machine, run, stable_dt
+from common.output_lock import exit_code, output_lock
+from common.paths import REPOSITORY as ROOT, pdsolve
+from postprocess.series import read_frame, read_series
+from preprocess.cloud import NodeCloud
+from preprocess.node_file import write_node_file
 
 DX = 1.0e-3
 PROBLEMS = ("wave", "fracture", "tension", "traction", "plate_with_hole")
@@ -133,54 +129,6 @@ def write_case(directory: str, problem: dict, name: str, time: dict, adaptive: d
     with open(path, "w", encoding="utf-8") as stream:
         json.dump(case, stream, indent=1)
     return path
-
-
-def run_once(solver: str, case_path: str, threads: int) -> dict:
-    result = subprocess.run([solver, case_path, "--threads", str(threads), "--quiet"], capture_output=True, text=True)
-    try:
-        with open(os.path.join(os.path.dirname(case_path), "run.log"), encoding="utf-8") as stream:
-            log = stream.read()
-    except OSError:
-        log = ""
-    counts = log_counts(log)
-    if result.returncode != 0 or counts is None:
-        last = (result.stderr.strip().splitlines() or ["no message"])[-1]
-        return {"status": f"failed ({result.returncode}: {last[:80]})", "steps": 0, "wall": float("nan"),
-                "evaluations": 0, "broken_bonds": -1, "log": log}
-    return dict(counts, status="ok", log=log)
-
-
-def log_counts(log: str) -> dict | None:
-    """steps, wall (the time loop's), evaluations and broken_bonds from run.log's `done:` line;
-    None when it has none."""
-    done = re.search(r"(\d+) steps to t = \S+ s in ([0-9.]+) s wall.*?(\d+) force evaluations", log)
-    if not done:
-        return None
-    broken = re.search(r"(\d+) broken bonds", log)
-    return {"steps": int(done.group(1)), "wall": float(done.group(2)), "evaluations": int(done.group(3)),
-            "broken_bonds": int(broken.group(1)) if broken else -1}
-
-
-def run(solver: str, case_path: str, threads: int, repeat: int = 1) -> dict:
-    """Run the case; rerun a run shorter than 2 s up to `repeat` times in all and keep the smallest
-    wall time (the runs are deterministic: the same steps and force evaluations every time)."""
-    best = run_once(solver, case_path, threads)
-    for _ in range(repeat - 1):
-        if best["status"] != "ok" or best["wall"] > 2.0:
-            break
-        again = run_once(solver, case_path, threads)
-        if again["status"] != "ok" or (again["steps"], again["evaluations"]) != (best["steps"], best["evaluations"]):
-            raise RuntimeError(f"{case_path}: a rerun differs ({again['status']}, {again['steps']} steps)")
-        best["wall"] = min(best["wall"], again["wall"])
-    return best
-
-
-def stable_dt(log: str) -> float:
-    """eq. 2.5 (without safety factor) as the solver computed it, from run.log's dt line."""
-    found = re.search(r"\(stable (\S+) s", log)
-    if not found:
-        raise RuntimeError("run.log has no 'stable' time step")
-    return float(found.group(1))
 
 
 def fields(run_dir: str, measure: str) -> list[np.ndarray]:
@@ -315,21 +263,10 @@ def tension_runs(args, repeat: int, rows: list[dict]) -> None:
         rows.append(row(scheme, ref_speed, r, os.path.dirname(case_path), ref_speed, p["end"]))
 
 
-def machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as stream:
-            found = re.search(r"model name\s*:\s*(.+)", stream.read())
-            model = found.group(1).strip() if found else model
-    except OSError:
-        pass
-    return f"{model}, {os.cpu_count()} logical CPUs"
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description="Error against run time and force evaluations: velocity Verlet and "
                                      "the adaptive step on a wave and a fracture problem (docs/accuracy.md).")
-    parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"), help="pdsolve to run")
+    parser.add_argument("--solver", default=pdsolve(), help="pdsolve to run")
     parser.add_argument("--threads", type=int, default=1,
                         help="OpenMP threads of every run (default 1: the clouds have 2880 and 3088 nodes)")
     parser.add_argument("--repeat", type=int, default=3, help="runs of a case shorter than 2 s; the fastest counts")
@@ -347,7 +284,7 @@ def main(argv=None) -> int:
                      f"choose from {', '.join(PROBLEMS)}")
     if not os.path.isfile(args.solver):
         parser.error(f"{args.solver} is missing: build it with `make solver`")
-    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    # One writer per output folder, the lock make and peridyn take too (common/output_lock.py).
     with output_lock(args.out, "make bench-accuracy (bench.accuracy)"):
         return measure(args, chosen)
 

@@ -31,6 +31,7 @@ import os
 import re
 
 from bench.result_hashes import history_without_wall_time
+from bench.solver_runs import log_counts
 
 RECORD = "bench_run.json"
 _SHA_CACHE: dict[tuple, str] = {}
@@ -193,8 +194,6 @@ class ExplicitSource:
     def run(self, problem: str, case_path: str, timed_run) -> tuple[dict, str, str]:
         """(result, run folder holding its outputs, note) of the explicit run of `case_path`:
         `timed_run(solver, case_path, threads)` here, or DIR's reused (see the module docstring)."""
-        from bench.accuracy import log_counts
-
         note = ""
         if self.directory is not None:
             old, why = self.find(problem, case_path)

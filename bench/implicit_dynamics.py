@@ -42,14 +42,12 @@ import sys
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-
-from bench.accuracy import machine, run, stable_dt  # noqa: E402  (read-only use of its runner)
-from postprocess.series import read_frame, read_series  # noqa: E402
-from preprocess.cloud import NodeCloud  # noqa: E402
-from preprocess.node_file import write_node_file  # noqa: E402
-from pipeline.output_lock import exit_code, output_lock  # noqa: E402
+from bench.solver_runs import machine, run, stable_dt
+from common.output_lock import exit_code, output_lock
+from common.paths import REPOSITORY as ROOT, pdsolve
+from postprocess.series import read_frame, read_series
+from preprocess.cloud import NodeCloud
+from preprocess.node_file import write_node_file
 
 L = 0.05           # m: free span, as cases/drum
 EPS0 = 1.0e-3      # pre-strain
@@ -209,7 +207,7 @@ def bench_load(args, load: str) -> list[dict]:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"), help="pdsolve to run")
+    parser.add_argument("--solver", default=pdsolve(), help="pdsolve to run")
     parser.add_argument("--threads", type=int, default=1)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--span", type=int, default=30, help="free span in grid spacings (cases/drum: 100)")
@@ -222,7 +220,7 @@ def main(argv=None) -> int:
     parser.add_argument("--tols", default="1e-2,1e-3,1e-4,1e-5", help="implicit.tol values")
     parser.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
     args = parser.parse_args(argv)
-    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    # One writer per output folder, the lock make and peridyn take too (common/output_lock.py).
     with output_lock(args.out, "make bench-implicit (bench.implicit_dynamics)"):
         return measure(args)
 

@@ -27,7 +27,7 @@ import subprocess
 import sys
 import tempfile
 
-from pipeline.output_lock import exit_code, output_lock
+from common.output_lock import exit_code, output_lock
 
 # 40³: 100 steps, a timed window of ~1.5 s on 2 ranks; at 40 steps (~0.6 s) one preemption by another
 # process moved the 2-rank row by 10 % or more.
@@ -75,7 +75,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--out", default="out/bench/mpi.csv")
     args = ap.parse_args()
-    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    # One writer per output folder, the lock make and peridyn take too (common/output_lock.py).
     with output_lock(os.path.dirname(args.out) or ".", "make bench (bench.mpi_ranks)"):
         return measure(args)
 

@@ -41,8 +41,8 @@ import numpy as np
 
 from bench import tension
 from bench.explicit_reuse import ExplicitSource
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from bench.solver_runs import run_once, stable_dt
+from common.paths import REPOSITORY as ROOT
 
 # The explicit case's grip speed (traction.yaml, plate_with_hole.yaml): the first rate tried.
 CASES = {"traction": {"explicit_speed": 0.5}, "plate_with_hole": {"explicit_speed": 0.25}}
@@ -270,10 +270,8 @@ def speedup_line(problem: str, mixed_wall: float, explicit: dict | None, explici
 
 # ---------------------------------------------------------------- running
 def timed_run(solver: str, case_path: str, threads: int) -> dict:
-    """bench.accuracy's run_once, plus the CPU time (user + system) of the solver process, which
+    """solver_runs.run_once, plus the CPU time (user + system) of the solver process, which
     the load of a shared machine disturbs less than the wall time."""
-    from bench.accuracy import run_once
-
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     r = run_once(solver, case_path, threads)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -304,7 +302,6 @@ def runs(args, rows: list[dict], name: str) -> str:
         if notes[run_dir]:
             print(f"    {os.path.basename(run_dir)}: {notes[run_dir]}", flush=True)
         if r["status"] == "ok" and dt_guess[0] is None:
-            from bench.accuracy import stable_dt
             dt_guess[0] = 0.8 * stable_dt(r["log"])
         return case, run_dir, r
 

@@ -15,7 +15,7 @@ prepare: the runs are
     `python3 -m pipeline.run mesh` then `preprocess`, run in --repo; a case's own
     <case>.unv / .msh is used instead of meshing, as the Makefile does). Run name: <case>, or
     <case>-<config> for a variant (the Makefile's out/ folder name);
-  - the runs of `make bench-accuracy` (bench/accuracy.py of --repo, imported, not copied): the
+  - the runs of `make bench-accuracy` (bench/accuracy.py of --repo, run there, not copied): the
     wave and the fracture problem, each with its reference (Verlet at 0.05 × eq. 2.5) and every
     scheme of accuracy.schemes() (the full set by default, `--accuracy quick` for its --quick set,
     `none` for no such runs). Run name: accuracy-<problem>-<scheme>-<parameter>. One difference
@@ -53,7 +53,7 @@ compare: per run and per file, equal or different (or missing on one side); exit
   difference, 0 when every hash of every run is the same. --common: only the runs both files have
   (to check a `run --only` subset).
 
-Stdlib and numpy only (numpy through the imported project modules, in prepare).
+Stdlib only: the project's modules (numpy with them) run in processes started in --repo, in prepare.
 """
 from __future__ import annotations
 
@@ -140,35 +140,52 @@ def stage(repo: str, args: list[str]) -> bool:
     return True
 
 
+# prepare_accuracy's part that runs in --repo, on that checkout's own bench/accuracy.py, pipeline and
+# preprocess: a Python started in the folder finds them first (its sys.path begins with it). It
+# writes each problem's cases under the scratch folder and prints where, as JSON.
+ACCURACY_INPUTS = r"""
+import json, os, sys
+import numpy as np
+from bench import accuracy
+from pipeline.stability import micromodulus, stable_time_step
+from preprocess.node_file import read_node_file
+repo, scratch, quick = sys.argv[1], sys.argv[2], sys.argv[3] == "quick"
+if os.path.dirname(os.path.abspath(accuracy.__file__)) != os.path.join(repo, "bench"):
+    raise SystemExit(f"imported {accuracy.__file__}, not the one of {repo}")
+problems = []
+for problem_name, make in (("wave", accuracy.strip_problem), ("fracture", accuracy.hole_problem)):
+    directory = os.path.join(scratch, "accuracy", problem_name)
+    os.makedirs(directory)
+    problem = make(directory)
+    cloud = read_node_file(os.path.join(directory, "nodes.vtu"))
+    (block,) = problem["blocks"]
+    c = micromodulus(problem["analysis"], block["youngs_modulus"], problem["horizon"], problem["thickness"])
+    dt_stable, _ = stable_time_step(cloud.points, cloud.volume, cloud.block, np.array([block["density"]]),
+                                    np.array([[c]]), problem["horizon"])
+    # The reference run of accuracy.main(), then every scheme it sweeps.
+    runs = [("reference", 0.05, {"integrator": "verlet", "dt": "stable", "safety_factor": 0.05}, None)]
+    runs += list(accuracy.schemes(quick, dt_stable))
+    cases = []
+    for scheme, parameter, time_section, adaptive in runs:
+        label = "reference" if scheme == "reference" else f"{scheme}-{parameter:g}"
+        cases.append([label, accuracy.write_case(directory, problem, label, time_section, adaptive)])
+    problems.append({"problem": problem_name, "dt_stable": repr(dt_stable), "cases": cases})
+json.dump(problems, sys.stdout)
+"""
+
+
 def prepare_accuracy(repo: str, runs: str, scratch: str, manifest: dict, quick: bool) -> None:
     """The runs of bench/accuracy.py (make bench-accuracy), with its own problem and case writers."""
-    sys.path.insert(0, repo)
-    import numpy as np
-    from bench import accuracy
-    from pipeline.stability import micromodulus, stable_time_step
-    from preprocess.node_file import read_node_file
-    if os.path.dirname(os.path.abspath(accuracy.__file__)) != os.path.join(repo, "bench"):
-        raise SystemExit(f"imported {accuracy.__file__}, not the one of {repo}")
-
-    for problem_name, make in (("wave", accuracy.strip_problem), ("fracture", accuracy.hole_problem)):
-        directory = os.path.join(scratch, "accuracy", problem_name)
-        os.makedirs(directory)
-        problem = make(directory)
-        cloud = read_node_file(os.path.join(directory, "nodes.vtu"))
-        (block,) = problem["blocks"]
-        c = micromodulus(problem["analysis"], block["youngs_modulus"], problem["horizon"], problem["thickness"])
-        dt_stable, _ = stable_time_step(cloud.points, cloud.volume, cloud.block, np.array([block["density"]]),
-                                        np.array([[c]]), problem["horizon"])
-        # The reference run of accuracy.main(), then every scheme it sweeps.
-        runs_of_problem = [("reference", 0.05, {"integrator": "verlet", "dt": "stable", "safety_factor": 0.05}, None)]
-        runs_of_problem += list(accuracy.schemes(quick, dt_stable))
-        for scheme, parameter, time_section, adaptive in runs_of_problem:
-            label = "reference" if scheme == "reference" else f"{scheme}-{parameter:g}"
-            case_path = accuracy.write_case(directory, problem, label, time_section, adaptive)
-            name = f"accuracy-{problem_name}-{label}"
+    made = subprocess.run([sys.executable, "-c", ACCURACY_INPUTS, repo, scratch, "quick" if quick else "full"],
+                          cwd=repo, stdout=subprocess.PIPE, text=True)
+    if made.returncode != 0:
+        raise SystemExit(f"failed ({made.returncode}) in {repo}: the inputs of bench/accuracy.py")
+    for problem in json.loads(made.stdout):
+        for label, case_path in problem["cases"]:
+            name = f"accuracy-{problem['problem']}-{label}"
             install_input(case_path, os.path.join(runs, name))
-            manifest[name] = {"from": f"bench/accuracy.py {problem_name} {label}" + (" (quick)" if quick else "")}
-        print(f"prepared accuracy-{problem_name}-* ({len(runs_of_problem)} runs; eq. 2.5 = {dt_stable!r} s)",
+            manifest[name] = {"from": f"bench/accuracy.py {problem['problem']} {label}" + (" (quick)" if quick else "")}
+        print(f"prepared accuracy-{problem['problem']}-* ({len(problem['cases'])} runs; eq. 2.5 = {problem['dt_stable']} s)",
               flush=True)
 
 

@@ -25,7 +25,7 @@ import subprocess
 import sys
 import tempfile
 
-from pipeline.output_lock import exit_code, output_lock
+from common.output_lock import exit_code, output_lock
 
 STEPS = {40: 40, 46: 30, 100: 10}  # ~0.1–1 s of loop per run at the target rate
 
@@ -155,7 +155,7 @@ def main():
     ap.add_argument("--order-side", type=int, default=40,
                     help="brick side of the node-order study (0: skip it)")
     args = ap.parse_args()
-    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py).
+    # One writer per output folder, the lock make and peridyn take too (common/output_lock.py).
     with output_lock(os.path.dirname(args.out) or ".", "make bench (bench.speed)"):
         return measure(args)
 

@@ -1,22 +1,17 @@
 """A case file held in memory: read, changed by dotted keys, written and run stage by stage."""
 from __future__ import annotations
 
-import argparse
 import copy
 import glob
-import json
 import os
-import subprocess
 
 import yaml
 
-from pipeline.atomic import write_atomically
+from common.atomic import write_atomically
 from pipeline.case import CaseError, load_case
-from pipeline.output_lock import FolderInUse, output_lock
+from common.output_lock import FolderInUse, output_lock
+from common.paths import REPOSITORY, pdsolve
 from pipeline.yaml_lines import load_with_lines
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PYTHON = "/usr/bin/python3"
 
 
 class RunError(RuntimeError):
@@ -154,7 +149,7 @@ class Case:
 
         The YAML is made in memory first (values put into self.data directly, not through
         case[key] = value, are made plain here too) and written under a temporary name and renamed
-        (pipeline/atomic.py): a value YAML cannot hold leaves no file, half-written or not."""
+        (common/atomic.py): a value YAML cannot hold leaves no file, half-written or not."""
         plain = {str(name): _plain(value, str(name)) for name, value in self.data.items()}
         text = yaml.safe_dump(plain, sort_keys=False, allow_unicode=True)
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
@@ -198,7 +193,7 @@ class Case:
         """
         say = log or (lambda text: None)
         out_dir = os.path.abspath(out_dir)
-        # The lock make takes too (pipeline/output_lock.py): two runs into one folder, or a run beside
+        # The lock make takes too (common/output_lock.py): two runs into one folder, or a run beside
         # `make case=X` into out/X/, wrote each other's files (issue 36, item 5).
         try:
             with output_lock(out_dir, f"peridyn Case.run of {self.source}") as lock_fd:
@@ -209,7 +204,7 @@ class Case:
     def _run_locked(self, out_dir, lock_fd, figures, threads, solver, say):
         """run()'s stages, with out_dir locked by lock_fd (handed to the solver: the folder stays
         locked while it runs, even if this process is killed)."""
-        from pipeline import run as stages
+        from pipeline import stages
 
         from .results import Run
 
@@ -219,32 +214,29 @@ class Case:
         if kind == "geo":
             params, target = os.path.join(out_dir, "mesh-parameters.json"), os.path.join(out_dir, "mesh.msh")
             before = os.path.getmtime(params) if os.path.isfile(params) else None
-            stages.cmd_mesh_parameters(argparse.Namespace(case=yaml_path, out=params))
+            stages.mesh_parameters(yaml_path, params)
             if not os.path.isfile(target) or os.path.getmtime(params) != before:
                 say(f"mesh: {mesh} → {target}")
-                stages.cmd_mesh(argparse.Namespace(case=yaml_path, geo=mesh, out=target))
+                stages.mesh(yaml_path, mesh, target)
             mesh = target
         say(f"preprocess: {yaml_path} + {mesh} → {out_dir}/nodes.vtu, case.json")
-        stages.cmd_preprocess(argparse.Namespace(case=yaml_path, mesh=mesh, out_dir=out_dir))
-        solver = solver or os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+        stages.preprocess(yaml_path, mesh, out_dir)
+        solver = solver or pdsolve()
         if not os.path.isfile(solver):
-            raise RunError(f"{solver}: the solver is not built; run `make solver` in {ROOT}")
+            raise RunError(f"{solver}: the solver is not built; run `make solver` in {REPOSITORY}")
         for stale in glob.glob(os.path.join(out_dir, "frames", "*.vtu")):
             os.unlink(stale)  # frames of an earlier, longer run would stay listed nowhere but on disk
-        command = [solver, os.path.join(out_dir, "case.json")] + (["--threads", str(threads)] if threads else [])
-        say("solve: " + " ".join(command))
-        with open(os.path.join(out_dir, "solver.log"), "w", encoding="utf-8") as stream:
-            # The lock's descriptor, and its number for pdsolve, which locks its folder itself
-            # (io/output_lock.hpp) and finds it held for it here.
-            status = subprocess.run(command, stdout=stream, stderr=subprocess.STDOUT, pass_fds=(lock_fd,),
-                                    env=dict(os.environ, PD_LOCK_FD=str(lock_fd))).returncode
-        if status != 0:
-            raise RunError(f"{' '.join(command)} failed (exit {status}); see {out_dir}/solver.log and run.log")
+        case_json = os.path.join(out_dir, "case.json")
+        say("solve: " + " ".join(stages.solve_command(case_json, solver=solver, threads=threads)))
+        # The lock's descriptor goes to pdsolve, which locks its folder itself and finds it held for it.
+        result = stages.solve(case_json, solver=solver, threads=threads, log=os.path.join(out_dir, "solver.log"),
+                              lock_fd=lock_fd)
+        if result.returncode != 0:
+            raise RunError(f"{' '.join(result.args)} failed (exit {result.returncode}); see {out_dir}/solver.log "
+                           "and run.log")
         if figures:
-            from postprocess.cli import run as postprocess
-
             say(f"postprocess: {out_dir}")
-            postprocess(out_dir, log=say)
+            stages.postprocess(out_dir, log=say)
         return Run(out_dir)
 
     def __repr__(self) -> str:

@@ -22,11 +22,13 @@ import os
 import subprocess
 import sys
 
-from .cost import MAX_HOURS, MEMORY_PER_BOND, MEMORY_PER_NODE, _available_memory, _duration, _free_disk
+from common.memory import available_memory
+from common.paths import PYTHON, REPOSITORY
+
+from .cost import MAX_HOURS, MEMORY_PER_BOND, MEMORY_PER_NODE, _duration, _free_disk
 from .resolve import check_set_names
 from .yaml_lines import CaseError
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PROBE_TIMEOUT = 120.0  # s: building a shipped case's geometry takes well under 1 s
 
 # gmsh's cost, measured with `gmsh -2` on plate_with_hole (lc = 3e-4 m: 65,340 nodes, 3.5 s of CPU,
@@ -73,11 +75,11 @@ def probe_geometry(case: dict, geo: str) -> dict:
     # gmsh.open parses the .geo as gmsh does (a SystemCall there would run): in the sandbox too,
     # with the case folder and the Python code the probe imports read-only, and nothing writable.
     # Debian's python3 (in /usr), the one the sandbox holds, with python3-gmsh.
-    python = sys.executable if sys.executable.startswith("/usr/") or not sandbox.enabled() else "/usr/bin/python3"
+    python = sys.executable if sys.executable.startswith("/usr/") or not sandbox.enabled() else PYTHON
     command = [python, "-m", "preprocess.geo_probe", real, str(case["dimension"]), json.dumps(parameters)]
-    code = [os.path.join(ROOT, package) for package in ("preprocess", "pipeline")]
+    code = [os.path.join(REPOSITORY, package) for package in ("common", "preprocess")]
     try:
-        result = sandbox.run(command, geo, read_only=[os.path.dirname(real), *code], cwd=ROOT,
+        result = sandbox.run(command, geo, read_only=[os.path.dirname(real), *code], cwd=REPOSITORY,
                              timeout=PROBE_TIMEOUT)
     except subprocess.TimeoutExpired:
         raise CaseError(f"{case['_path']}:{_line(case)}: gmsh did not build the geometry of {geo} within "
@@ -241,7 +243,7 @@ def check_mesh_growth(case: dict, geo: str, probe: dict, out_dir: str, force: bo
     est = estimate_mesh(case, geo, probe)
     h = boundary["size"]
     n = est["measure"] / ((AREA_PER_NODE if dim == 2 else VOLUME_PER_NODE) * h ** dim)
-    found = _gmsh_over_limits(n, _available_memory(), _free_disk(out_dir))
+    found = _gmsh_over_limits(n, available_memory(), _free_disk(out_dir))
     if not found:
         return
     what = "curves" if dim == 2 else "surfaces"
@@ -258,7 +260,7 @@ def check_mesh_cost(case: dict, geo: str, probe: dict, out_dir: str, force: bool
     """CaseError (naming the mesh size's or dx's line, the estimate and FORCE=1) above a limit."""
     force = os.environ.get("FORCE") == "1" if force is None else force
     est = estimate_mesh(case, geo, probe)
-    memory, disk = _available_memory(), _free_disk(out_dir)
+    memory, disk = available_memory(), _free_disk(out_dir)
     reasons, parts = [], []
     where = None
     lines = case["_lines"]

@@ -39,6 +39,8 @@ import shutil
 
 import numpy as np
 
+from common.memory import available_memory
+
 from .validate import MAX_FRAMES
 from .yaml_lines import CaseError
 
@@ -51,18 +53,6 @@ MAX_HOURS = 1.0
 NEWTON_STEP_SECONDS_PER_BOND = {2: 3.5e-6, 3: 1.4e-5}   # by dimension (measured, see above)
 IMPLICIT_STEP_PER_EQ25 = 2.0       # mean implicit Δt / eq. 2.5 at tol 1e-3 (measured, see above)
 IMPLICIT_TOL_EXPONENT = 0.55       # ... and how it grows with tol
-
-
-def _available_memory() -> float:
-    """MemAvailable of /proc/meminfo [bytes], or infinity where it cannot be read."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as stream:
-            for line in stream:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
-    return math.inf
 
 
 def _free_disk(folder: str) -> float:
@@ -185,7 +175,7 @@ def check_cost(case: dict, cost: dict, out_dir: str, force: bool | None = None) 
     if cost["seconds"] is not None and cost["seconds"] > MAX_HOURS * 3600:
         reasons.append(f"it would run {'at least' if cost.get('at_least') else 'about'} "
                        f"{_duration(cost['seconds'])} (more than {MAX_HOURS:g} h)")
-    memory = _available_memory()
+    memory = available_memory()
     if cost["memory"] > 0.5 * memory:
         reasons.append(f"it needs about {cost['memory'] / 1e6:.0f} MB of memory, more than half of the "
                        f"{memory / 1e6:.0f} MB available")

@@ -24,8 +24,8 @@ import time
 import traceback
 
 from .case import CaseError, load_case
-from .memory_limit import limit_address_space
-from .regular_file import read_regular
+from common.memory import limit_address_space
+from common.regular_file import read_regular
 from .yaml_lines import MAX_BYTES
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

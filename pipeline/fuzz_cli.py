@@ -21,7 +21,8 @@ import time
 
 import numpy as np
 
-from .memory_limit import limit_address_space
+from common.memory import limit_address_space
+from common.paths import pdsolve
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PER_RUN_SECONDS = 20
@@ -112,7 +113,7 @@ def main(argv=None) -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--seed", type=int, default=None)
-    parser.add_argument("--solver", default=os.path.join(ROOT, "build", "solver", "pdsolve"))
+    parser.add_argument("--solver", default=pdsolve())
     args = parser.parse_args(argv)
     seed = args.seed if args.seed is not None else int(time.time())
     limit_address_space(MEMORY_LIMIT_MB)  # bounds make fuzz's memory, pdsolve's runs included

@@ -2,7 +2,7 @@
 
 The loader is safe and bounded, because a case file comes from other people (issue 17, item 3):
 - the file is a regular UTF-8 text file of at most MAX_BYTES (a binary file, /dev/zero, a FIFO or a
-  directory is refused before it is parsed, and a FIFO without blocking: pipeline/regular_file.py);
+  directory is refused before it is parsed, and a FIFO without blocking: common/regular_file.py);
 - nesting is at most MAX_DEPTH deep, and the tree, with every alias expanded, has at most
   MAX_NODES values (a "billion laughs" file of nested aliases fails at once instead of expanding
   10¹⁰ items), no alias may contain itself;
@@ -27,7 +27,7 @@ import sys
 import yaml
 from yaml.events import AliasEvent, CollectionStartEvent, ScalarEvent
 
-from .regular_file import NotRegularFile, read_regular
+from common.regular_file import NotRegularFile, read_regular
 
 MAX_BYTES = 1 << 20      # 1 MiB: the shipped cases are below 3 kB
 MAX_DEPTH = 64           # the schema nests 4 deep; a table of rows is 2 more

@@ -19,7 +19,7 @@ import sys
 
 import numpy as np
 
-from pipeline.atomic import DISK_FULL_EXIT, WriteError
+from common.atomic import DISK_FULL_EXIT, WriteError
 
 from .casefile import load_case_settings
 from .errors import PostprocessError
@@ -248,7 +248,7 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
-    from pipeline.output_lock import FolderInUse, output_lock
+    from common.output_lock import FolderInUse, output_lock
 
     try:
         # The run folder's lock (make's, handed down as PD_LOCK_FD, or our own): figures drawn by

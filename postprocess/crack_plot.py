@@ -18,7 +18,7 @@ import io
 
 import numpy as np
 
-from pipeline.atomic import write_atomically
+from common.atomic import write_atomically
 
 from .casefile import CaseSettings
 from .crack_tip import DAMAGED, SPEED_LAG, Track, not_resolved, tip_positions, tip_speeds, typical_spacing

@@ -29,7 +29,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from pipeline.atomic import atomic_path
+from common.atomic import atomic_path
 from .errors import PostprocessError
 from .series import Frame
 

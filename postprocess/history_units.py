@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import re
 
-from pipeline.atomic import atomic_path
+from common.atomic import atomic_path
 
 FORMAT_VERSION = 2  # 2: fixed_columns (issue 16)
 

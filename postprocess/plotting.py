@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import ScalarFormatter  # noqa: E402
 
-from pipeline.atomic import atomic_path  # noqa: E402
+from common.atomic import atomic_path  # noqa: E402
 
 from .casefile import DEFAULT_DPI  # noqa: E402
 

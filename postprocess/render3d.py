@@ -16,7 +16,7 @@ import sys
 
 import numpy as np
 
-from pipeline.atomic import atomic_path
+from common.atomic import atomic_path
 
 from .casefile import CaseSettings
 from .plotting import DPI, plt, save_figure, short_title, si_scale

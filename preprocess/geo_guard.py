@@ -246,7 +246,7 @@ def check_inside(path: str, case_dir: str):
         raise PreprocessError(f"{path}: leads outside the case folder {case_dir} (a symbolic link to {real}); "
                               "a case reads only its own files: copy the file into the case folder")
     if not os.path.isfile(real):
-        from pipeline.regular_file import kind_of
+        from common.regular_file import kind_of
 
         what = "does not exist" if not os.path.exists(real) else f"{kind_of(os.stat(real).st_mode)}, not a regular file"
         raise PreprocessError(f"{path}: {what}; a case input must be a regular file in {case_dir}")

@@ -6,7 +6,7 @@ import shutil
 import subprocess
 import tempfile
 
-from pipeline.atomic import WriteError, atomic_path, disk_full_message, free_megabytes
+from common.atomic import WriteError, atomic_path, disk_full_message, free_megabytes
 
 from . import sandbox
 from .errors import PreprocessError

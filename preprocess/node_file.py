@@ -10,7 +10,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from pipeline.atomic import atomic_path
+from common.atomic import atomic_path
 
 from .cloud import NodeCloud
 from .errors import PreprocessError

@@ -96,9 +96,9 @@ def memory_cap() -> int:
     all of it with FORCE=1, which runs a mesh above the estimate's limits), at least 2 GiB (Python
     with numpy and OpenBLAS maps a few hundred MB it never touches). gmsh meshed a mesh size field
     of 2e-6 m with no cap until its time limit; at the cap its allocations fail and it stops."""
-    from pipeline.cost import _available_memory
+    from common.memory import available_memory
 
-    available = _available_memory()
+    available = available_memory()
     if available == float("inf"):
         return resource.RLIM_INFINITY
     share = 1.0 if os.environ.get("FORCE") == "1" else 0.5

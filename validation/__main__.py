@@ -12,10 +12,12 @@ import subprocess
 import sys
 import time
 
+from common.output_lock import exit_code, output_lock
+from common.paths import given_pdsolve
+
 from . import branching, c3_lps, convergence, drum, plate_with_hole, static, three_point_bending, traction, wave, wave_lps
 from .figures import FIGURES
 from .runner import ROOT
-from pipeline.output_lock import exit_code, output_lock
 
 CHECKS = {"plate_with_hole": plate_with_hole.checks, "traction": traction.checks, "branching": branching.checks,
           "branching-lps": functools.partial(branching.checks, case="branching-lps"), "drum": drum.checks,
@@ -29,7 +31,7 @@ MODEL_CHECKS = {"drum_convergence": drum.validate_convergence, "wave": wave.vali
 
 
 def main(argv: list[str]) -> int:
-    # One writer per output folder, the lock make and peridyn take too (pipeline/output_lock.py); the
+    # One writer per output folder, the lock make and peridyn take too (common/output_lock.py); the
     # cases' own folders are locked by the make that runs each.
     with output_lock(os.path.join(ROOT, "out", "validate"), "make validate"):
         return validate(argv)
@@ -66,8 +68,8 @@ def validate(argv: list[str]) -> int:
         # (-o: make must not try to rebuild a solver built elsewhere; it also means that a case
         # already solved is not solved again when that solver changes: clean out/<case> first.
         # `make validate` leaves PDSOLVE unset, so its cases follow build/solver like `make case=X`.)
-        solver = ([f"SOLVER={os.environ['PDSOLVE']}", "-o", os.environ["PDSOLVE"]]
-                  if os.environ.get("PDSOLVE") else [])
+        given = given_pdsolve()
+        solver = [f"SOLVER={given}", "-o", given] if given else []
         target = [f"case={CONFIGS[case][0]}", f"config={CONFIGS[case][1]}"] if case in CONFIGS else [f"case={case}"]
         make = subprocess.run(["make", "--no-print-directory", *target, *solver], cwd=ROOT)
         if make.returncode != 0:

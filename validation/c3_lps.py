@@ -15,6 +15,8 @@ import os
 import re
 import subprocess
 
+from common.paths import pdsolve
+
 from .common import Check
 from .runner import ROOT
 
@@ -26,8 +28,7 @@ ROW = re.compile(r"\[ c3 lps   \] (corrected|uncorrected)\s+3d\s+nu=(\S+) .* cg=
 
 def tests_binary() -> str:
     """pd_tests beside the solver ($PDSOLVE's folder, else build/solver)."""
-    solver = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
-    return os.path.join(os.path.dirname(os.path.abspath(solver)), "pd_tests")
+    return os.path.join(os.path.dirname(os.path.abspath(pdsolve())), "pd_tests")
 
 
 def parse(text: str) -> list[dict]:

@@ -1,23 +1,19 @@
-"""Run a case, or a variant of it, through every stage exactly as the Makefile does (pipeline.run
-mesh and preprocess, pdsolve, postprocess) into a chosen directory: the fast versions of the checks
-in `make test` and the runs of `make validate` both use it."""
+"""Run a case, or a variant of it, through every stage the Makefile runs (pipeline/stages.py: mesh,
+preprocess, solve, postprocess) into a chosen directory: the fast versions of the checks in
+`make test` and the runs of `make validate` both use it."""
 from __future__ import annotations
 
+import contextlib
 import copy
+import io
 import os
 import shutil
-import subprocess
 import time
 
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PY = "/usr/bin/python3"
-
-
-def solver_path() -> str:
-    """The pdsolve to run: $PDSOLVE if set, else the Makefile's build/solver/pdsolve."""
-    return os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+from common.paths import REPOSITORY as ROOT, pdsolve
+from pipeline import stages
 
 
 def deep_update(base: dict, changes: dict) -> dict:
@@ -39,7 +35,7 @@ def run_case(case: str, work: str, changes: dict | None = None, *, figures: bool
     run every stage into work/out/<case>/, and return (out_dir, solver wall seconds).
     source: another folder holding <case>.geo and <case>.yaml (validation/models/); config: the
     variant <config>.yaml of that folder instead of <case>.yaml (as `make case=X config=Y`)."""
-    solver = solver_path()
+    solver = pdsolve()
     if not os.path.exists(solver):
         raise FileNotFoundError(f"{solver} is missing: build it with `make solver` (make test does)")
     source = source or os.path.join(ROOT, "cases", case)
@@ -52,23 +48,28 @@ def run_case(case: str, work: str, changes: dict | None = None, *, figures: bool
     with open(yaml_path, "w", encoding="utf-8") as stream:
         yaml.safe_dump(deep_update(data, changes or {}), stream)
     out = os.path.join(work, "out", case)
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    stages = [
-        (PY, "-m", "pipeline.run", "mesh", yaml_path, os.path.join(case_dir, f"{case}.geo"), os.path.join(out, "mesh.msh")),
-        (PY, "-m", "pipeline.run", "preprocess", yaml_path, os.path.join(out, "mesh.msh"), out),
-        (solver, os.path.join(out, "case.json"), "--quiet"),
-    ]
+    mesh = os.path.join(out, "mesh.msh")
+    quietly(f"mesh {yaml_path}", stages.mesh, yaml_path, os.path.join(case_dir, f"{case}.geo"), mesh)
+    quietly(f"preprocess {yaml_path}", stages.preprocess, yaml_path, mesh, out)
+    start = time.monotonic()
+    result = stages.solve(os.path.join(out, "case.json"), solver=solver, quiet=True, timeout=timeout)
+    solver_seconds = time.monotonic() - start
+    if result.returncode != 0:
+        raise RuntimeError(f"{' '.join(result.args)} failed:\n{result.stdout}\n{result.stderr}")
     if figures:
-        stages.append((PY, "-m", "postprocess", out))
-    solver_seconds = 0.0
-    for args in stages:
-        start = time.monotonic()
-        result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
-        if args[0] == solver:
-            solver_seconds = time.monotonic() - start
-        if result.returncode != 0:
-            raise RuntimeError(f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}")
+        quietly(f"postprocess {out}", stages.postprocess, out)
     return out, solver_seconds
+
+
+def quietly(what: str, stage, *args):
+    """stage(*args) with what it prints kept back, as a stage run by make would keep it in its log:
+    shown only in the RuntimeError of a stage that fails."""
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            stage(*args)
+    except Exception as error:
+        raise RuntimeError(f"{what} failed: {error}\n{said.getvalue()}") from error
 
 
 def geometry_parameters(out_dir: str) -> dict:

@@ -4,15 +4,16 @@ broken bonds and the crack tip's position against time, one curve per G0, into
 docs/examples/fracture_energy_study.png.
 
     /usr/bin/python3 docs/examples/fracture_energy_study.py [OUT_DIR]     (from the repository root)
+
+peridyn installed as docs/python-api.md says; without the install, PYTHONPATH=. in front does it.
 """
 import os
 import sys
 
 import numpy as np
 
-sys.path.insert(0, os.getcwd())
-import peridyn  # noqa: E402
-from postprocess.plotting import new_figure, save_figure  # noqa: E402
+import peridyn
+from postprocess.plotting import new_figure, save_figure
 
 OUT = sys.argv[1] if len(sys.argv) > 1 else "out/study"
 ENERGIES = (2.0, 3.8, 8.0)  # J/m²; 3.8 is soda-lime glass (validation.md C7)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 import stat
 
-from pipeline.regular_file import kind_of
+from common.regular_file import kind_of
 
 from ..errors import PreprocessError
 from ..mesh import Mesh
@@ -50,10 +50,10 @@ def read_mesh(path: str) -> Mesh:
 
 def check_mesh_size(path: str):
     """PreprocessError, before reading, for a mesh file too large to read (see MAX_MESH_BYTES)."""
-    from pipeline.cost import _available_memory
+    from common.memory import available_memory
 
     size = os.path.getsize(path)
-    half = 0.5 * _available_memory()
+    half = 0.5 * available_memory()
     if READ_MEMORY_FACTOR * size > half:
         raise PreprocessError(f"{path}: {size / 1e6:.0f} MB; reading it takes up to {READ_MEMORY_FACTOR}x that, more "
                               f"than half of the {2 * half / 1e6:.0f} MB of memory available: use a coarser mesh or a "

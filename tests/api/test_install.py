@@ -8,8 +8,10 @@ import sys
 
 import pytest
 
+from common.paths import pdsolve
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+SOLVER = pdsolve()
 
 
 def documented_example():

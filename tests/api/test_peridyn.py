@@ -1,19 +1,17 @@
 """peridyn, the Python API: load a case, change keys, run make's stages, read the results as arrays.
 Runs the membrane case coarsened to 20 × 20 nodes and 0.1 ms (a second or two)."""
 import os
-import sys
 
 import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
-import peridyn  # noqa: E402
-from pipeline.case import CaseError  # noqa: E402
+import peridyn
+from common.paths import pdsolve
+from pipeline.case import CaseError
 
-SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+SOLVER = pdsolve()
 
 
 @pytest.fixture(scope="module")

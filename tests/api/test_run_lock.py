@@ -11,12 +11,11 @@ import time
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
-import peridyn  # noqa: E402
+import peridyn
+from common.paths import pdsolve
 
-SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+SOLVER = pdsolve()
 
 
 def small_case(end=1.0e-4):
@@ -59,7 +58,7 @@ def test_the_folder_stays_locked_while_case_run_solves(tmp_path):
     if not os.path.isfile(SOLVER):
         pytest.fail(f"{SOLVER} is missing: build it with `make solver`")
     out = tmp_path / "busy"
-    script = (f"import sys; sys.path.insert(0, {ROOT!r}); import peridyn\n"
+    script = (f"import peridyn\n"
               f"from tests.api.test_run_lock import small_case\n"
               f"small_case(end=1.0).run({str(out)!r}, threads=1, figures=False)\n")
     first = subprocess.Popen([sys.executable, "-c", script], cwd=ROOT, stdout=subprocess.PIPE,

@@ -5,13 +5,10 @@ and a frame, counting its calls); under a second."""
 import json
 import os
 import stat
-import sys
 
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
 from bench import quasi_static_cases as qs  # noqa: E402
 from bench.explicit_reuse import RECORD, ExplicitSource, result_digests  # noqa: E402

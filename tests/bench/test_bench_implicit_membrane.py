@@ -3,13 +3,10 @@ writes are cases/membrane's (2500 nodes, dx = 1 mm, a clamped layer 3 mm deep, t
 at 10 m/s, damping 300 1/s), so that its rows measure that case and not another."""
 import json
 import os
-import sys
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
 from bench import implicit_dynamics  # noqa: E402
 from preprocess.node_file import read_node_file  # noqa: E402

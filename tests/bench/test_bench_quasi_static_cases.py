@@ -7,16 +7,14 @@ full benchmark takes minutes."""
 import math
 import os
 import re
-import sys
 
 import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
-from bench import quasi_static_cases as qs  # noqa: E402
+from bench import quasi_static_cases as qs
+from common.paths import PYTHON, pdsolve
 
 
 def test_reference_search_stops_at_the_first_halving_within_half_a_percent():
@@ -101,10 +99,10 @@ def test_quick_traction_runs_end_to_end_and_its_speedup_line_matches_the_rows(tm
     import csv
     import subprocess
 
-    solver = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+    solver = pdsolve()
     if not os.path.exists(solver):
         pytest.fail(f"{solver} is missing: build it with `make solver`")
-    result = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+    result = subprocess.run([PYTHON, "-m", "bench.accuracy", "--quick", "--problems", "traction",
                              "--solver", solver, "--out", str(tmp_path)], cwd=ROOT, capture_output=True, text=True,
                             timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr
@@ -126,7 +124,7 @@ def test_quick_traction_runs_end_to_end_and_its_speedup_line_matches_the_rows(tm
     # --reuse-explicit the folder just written: every explicit row taken (same inputs, same solver),
     # mixed, quasi_static and the paired reruns run again, the rival rerun in the new folder.
     again = tmp_path / "again"
-    second = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+    second = subprocess.run([PYTHON, "-m", "bench.accuracy", "--quick", "--problems", "traction",
                              "--solver", solver, "--out", str(again), "--reuse-explicit", str(tmp_path)], cwd=ROOT,
                             capture_output=True, text=True, timeout=600)
     assert second.returncode == 0, second.stdout + second.stderr
@@ -145,7 +143,7 @@ def test_quick_traction_runs_end_to_end_and_its_speedup_line_matches_the_rows(tm
     assert re.match(r"^speedup traction: mixed [0-9.]+ s against explicit", second.stdout.splitlines()[-1])
 
     # --explicit-only: the explicit rows alone (here all reused again), no mixed, no speedup line.
-    only = subprocess.run(["/usr/bin/python3", "-m", "bench.accuracy", "--quick", "--problems", "traction",
+    only = subprocess.run([PYTHON, "-m", "bench.accuracy", "--quick", "--problems", "traction",
                            "--solver", solver, "--out", str(tmp_path / "only"), "--reuse-explicit", str(tmp_path),
                            "--explicit-only"], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert only.returncode == 0, only.stdout + only.stderr

@@ -6,18 +6,16 @@ import csv
 import os
 import re
 import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
-from bench import tension  # noqa: E402
+from bench import tension
+from common.paths import PYTHON, pdsolve
 
-SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
+SOLVER = pdsolve()
 LINE = re.compile(r"^speedup tension: mixed ([0-9.]+) s against explicit ([0-9.]+) s \((verlet-alpha[0-9.e+]+), "
                   r"([0-9.e+-]+) m/s\): ([0-9.e+]+)x, peak force ([0-9.e+-]+)$")
 
@@ -57,7 +55,7 @@ def quick_run(tmp_path_factory):
     if not os.path.exists(SOLVER):
         pytest.fail(f"{SOLVER} is missing: build it with `make solver`")
     out = tmp_path_factory.mktemp("bench")
-    result = subprocess.run(["/usr/bin/python3", "-m",
+    result = subprocess.run([PYTHON, "-m",
                              "bench.accuracy", "--quick", "--problems", "tension", "--solver", SOLVER,
                              "--out", str(out)], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr

@@ -4,10 +4,11 @@ import os
 
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from common.paths import PYTHON as PY, REPOSITORY as ROOT, pdsolve  # noqa: F401  (PY: for the tests' own commands)
+from pipeline import stages
+
 # PDSOLVE points the tests at another build (a sanitizer build, a helper's own build folder).
-SOLVER = os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
-PY = "/usr/bin/python3"
+SOLVER = pdsolve()
 
 
 def new_case_folder(tmp_path_factory, work_name: str, case_name: str):
@@ -23,21 +24,21 @@ def new_case_folder(tmp_path_factory, work_name: str, case_name: str):
 
 def _run(args):
     import subprocess
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    result = subprocess.run(list(args), cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    result = subprocess.run(list(args), cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, f"{' '.join(args)} failed:\n{result.stdout}\n{result.stderr}"
 
 
 def prepare_stages(yaml_path, geo_path, out):
-    """The Makefile's first two stages on one case: mesh, then preprocess into out/ (case.json and
-    the node file); each must exit 0 (the failure names the stage and shows its output)."""
-    _run((PY, "-m", "pipeline.run", "mesh", str(yaml_path), str(geo_path), str(out / "mesh.msh")))
-    _run((PY, "-m", "pipeline.run", "preprocess", str(yaml_path), str(out / "mesh.msh"), str(out)))
+    """The Makefile's first two stages on one case (pipeline/stages.py): mesh, then preprocess into
+    out/ (case.json and the node file); a failing stage raises its error, naming the file."""
+    stages.mesh(str(yaml_path), str(geo_path), str(out / "mesh.msh"))
+    stages.preprocess(str(yaml_path), str(out / "mesh.msh"), str(out))
 
 
 def run_stages(yaml_path, geo_path, out):
     """The Makefile's stages on one case, in order: mesh, preprocess, solve, postprocess; each must
-    exit 0 (the failure names the stage and shows its output)."""
+    succeed (a failing solve shows its output)."""
     prepare_stages(yaml_path, geo_path, out)
-    _run((SOLVER, str(out / "case.json"), "--quiet"))
-    _run((PY, "-m", "postprocess", str(out)))
+    result = stages.solve(str(out / "case.json"), solver=SOLVER, quiet=True, timeout=600)
+    assert result.returncode == 0, f"{' '.join(result.args)} failed:\n{result.stdout}\n{result.stderr}"
+    stages.postprocess(str(out))

@@ -9,14 +9,12 @@ import json
 import os
 import re
 import shutil
-import sys
 
 import pytest
 
 from e2e_support import ROOT, SOLVER, new_case_folder, prepare_stages  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from disk_full import run_on_small_disk  # noqa: E402
+from tests.disk_full import run_on_small_disk
 
 
 @pytest.fixture(scope="module")

@@ -1,10 +1,10 @@
-"""pipeline/atomic.py, the one atomic-file writer: content, plain-open() mode, nothing left behind."""
+"""common/atomic.py, the one atomic-file writer: content, plain-open() mode, nothing left behind."""
 import os
 import stat
 
 import pytest
 
-from pipeline.atomic import atomic_path, write_atomically
+from common.atomic import atomic_path, write_atomically
 
 
 @pytest.fixture
@@ -73,9 +73,8 @@ import sys  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 WRITER = """
-import sys, time
-sys.path.insert(0, {root!r})
-from pipeline.atomic import atomic_path
+import time
+from common.atomic import atomic_path
 with atomic_path({target!r}) as tmp:
     with open(tmp, "w") as stream:
         stream.write("half of a 90 MB node file")
@@ -85,7 +84,7 @@ with atomic_path({target!r}) as tmp:
 
 
 def start_writer(target):
-    process = subprocess.Popen([sys.executable, "-c", WRITER.format(root=ROOT, target=str(target))],
+    process = subprocess.Popen([sys.executable, "-c", WRITER.format(target=str(target))], cwd=ROOT,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert process.stdout.readline() == "writing\n"
     return process

@@ -116,10 +116,10 @@ def test_mixed_counts_its_start_scheme_as_a_lower_bound(tmp_path):
 
 
 def test_run_cost_passes_eq_2_5_to_the_implicit_estimate(tmp_path):
-    """The stage's own wiring (pipeline/run.py run_cost): eq. 2.5 of the cloud sets the implicit step."""
+    """The stage's own wiring (pipeline/stages.py run_cost): eq. 2.5 of the cloud sets the implicit step."""
     import math
     from pipeline.resolve import resolve
-    from pipeline.run import run_cost
+    from pipeline.stages import run_cost
     from pipeline.stability import case_stable_time_step
     from scipy.spatial import cKDTree
     case = newton_case(tmp_path, "implicit", end=1.0e-3)

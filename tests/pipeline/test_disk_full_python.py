@@ -3,13 +3,11 @@
 import os
 import shutil
 import subprocess
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from disk_full import run_on_small_disk  # noqa: E402
+from tests.disk_full import run_on_small_disk
+from common.paths import PYTHON as PY
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-PY = "/usr/bin/python3"
 
 
 def test_preprocess_on_a_full_disk(tmp_path):
@@ -29,13 +27,13 @@ def test_preprocess_on_a_full_disk(tmp_path):
     code, _, err, left = run_on_small_disk(out, command, size_kb=16, cwd=ROOT, env=env)
     assert code == 2 and "Traceback" not in err, err
     assert f"MB of disk, " in err and f"; it writes about 6 MB, more than half of the 0 MB free in {out}" in err
-    assert left in ([], [".lock"])   # at most the folder's lock (pipeline/output_lock.py)
+    assert left in ([], [".lock"])   # at most the folder's lock (common/output_lock.py)
     # ... and with FORCE=1 the node file itself does not fit.
     code, _, err, left = run_on_small_disk(out, command, size_kb=16, cwd=ROOT, env=dict(env, FORCE="1"))
     assert "Traceback" not in err, err
     assert code == 3, err
     assert f"error: disk full writing {out}/nodes.vtu: 0 MB free in {out}; free some space and run make again" in err
-    assert left in ([], [".lock"])   # at most the folder's lock (pipeline/output_lock.py)
+    assert left in ([], [".lock"])   # at most the folder's lock (common/output_lock.py)
 
 
 def test_gmsh_on_a_full_disk_keeps_no_truncated_mesh(tmp_path):
@@ -52,7 +50,7 @@ def test_gmsh_on_a_full_disk_keeps_no_truncated_mesh(tmp_path):
     assert "Traceback" not in err, err
     assert code == 3, err
     assert f"error: disk full writing {out}/mesh.msh: 0 MB free in {out}; free some space and run make again" in err
-    assert left in ([], [".lock"])   # at most the folder's lock (pipeline/output_lock.py)
+    assert left in ([], [".lock"])   # at most the folder's lock (common/output_lock.py)
 
 
 def test_a_cut_mesh_file_is_refused(tmp_path):

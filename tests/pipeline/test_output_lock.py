@@ -1,16 +1,13 @@
-"""pipeline/output_lock.py: the one lock of an output folder, shared with make's flock(1)."""
+"""common/output_lock.py: the one lock of an output folder, shared with make's flock(1)."""
 import os
 import subprocess
-import sys
 import time
 
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
 
-from pipeline.output_lock import FolderInUse, exit_code, output_lock  # noqa: E402
+from common.output_lock import FolderInUse, exit_code, output_lock  # noqa: E402
 
 
 def test_a_second_holder_is_refused_naming_the_first_and_the_lock_goes_with_the_first(tmp_path):

@@ -14,6 +14,7 @@ from pipeline.resolve import resolve
 from pipeline.stability import check_discretized_case, micromodulus, stable_time_step
 from preprocess.cloud import NodeCloud
 from minimal_case import PMMA_PLATE, lattice_cloud
+from common.paths import PYTHON
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -161,13 +162,13 @@ def test_driver_refuses_before_writing_anything(tmp_path):
     case.write_text(CASE.replace("youngs_modulus: 3.2e9", "youngs_modulus: 3.2e21").replace("end: 1.0e-4", "end: 10.0")
                     + "boundary_conditions:\n  - set: left\n    displacement: {x: 0.0}\n")
     out = tmp_path / "out"
-    result = subprocess.run(["/usr/bin/python3", "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
+    result = subprocess.run([PYTHON, "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
                             cwd=ROOT, capture_output=True, text=True)
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith(f"error: {case}:10: time.end: the run would need")
     assert not out.exists() or [p.name for p in out.iterdir()] in ([], [".lock"])   # at most its lock
     case.write_text(CASE.replace("density: 1190", "density: 1.19"))
-    result = subprocess.run(["/usr/bin/python3", "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
+    result = subprocess.run([PYTHON, "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
                             cwd=ROOT, capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert f"warning: {case}:7: materials.plate.density: 1.19 kg/m³" in result.stderr
@@ -195,7 +196,7 @@ def test_a_material_that_is_no_physical_group_is_reported_at_its_case_line(tmp_p
     case = tmp_path / "square.yaml"
     case.write_text(CASE.replace("time:\n", "  gripp:\n    density: 7800\n    youngs_modulus: 2.0e11\ntime:\n"))
     out = tmp_path / "out"
-    result = subprocess.run(["/usr/bin/python3", "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
+    result = subprocess.run([PYTHON, "-m", "pipeline.run", "preprocess", str(case), str(mesh), str(out)],
                             cwd=ROOT, capture_output=True, text=True)
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith(f"error: {case}:9: materials.gripp: block 'gripp' is not a physical group of "

@@ -1,17 +1,8 @@
 """Fixtures of the postprocess tests: a small synthetic solver output that follows formats.md §4."""
-import os
-import sys
 
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if ROOT not in sys.path:  # so that plain `pytest` finds the package as `python3 -m pytest` does
-    sys.path.insert(0, ROOT)
-HERE = os.path.dirname(os.path.abspath(__file__))
-if HERE not in sys.path:
-    sys.path.insert(0, HERE)
-
-import synthetic_output  # noqa: E402
+import synthetic_output
 
 
 @pytest.fixture

@@ -6,9 +6,9 @@ import subprocess
 import pytest
 
 from postprocess import cli
+from common.paths import PYTHON as PY
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-PY = "/usr/bin/python3"
 
 
 def python_m(*args, cwd=ROOT):

@@ -8,8 +8,8 @@ import pytest
 
 import synthetic_output as synth
 from postprocess import cli, maps
+from common.atomic import atomic_path
 from postprocess.errors import PostprocessError
-from pipeline.atomic import atomic_path
 from postprocess.energy_plot import energy_balance
 from postprocess.history import read_history
 

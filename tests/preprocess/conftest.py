@@ -1,17 +1,11 @@
 """Shared fixtures: gmsh meshes of the test geometries, made once per test session."""
 import os
 import subprocess
-import sys
 
 import pytest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from preprocess_testdata import BOX, DATA, PLATE, ROOT  # noqa: E402
-
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
-
-from preprocess.gmsh_mesh import mesh_geo  # noqa: E402
+from preprocess.gmsh_mesh import mesh_geo
+from preprocess_testdata import BOX, DATA, PLATE
 
 
 @pytest.fixture(scope="session")

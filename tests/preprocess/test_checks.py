@@ -9,6 +9,7 @@ from preprocess_testdata import ROOT
 from preprocess import Group, Mesh, PreprocessError, PreprocessWarning
 from preprocess.discretize import discretize
 from preprocess.node_file import read_node_file
+from common.paths import PYTHON
 
 # the unit square as two triangles, its left edge as a line
 SQUARE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
@@ -95,7 +96,7 @@ def test_group_names_and_empty_sets():
 
 def test_command_line(meshes, tmp_path):
     out = tmp_path / "nodes.vtu"
-    result = subprocess.run(["/usr/bin/python3", "-m", "preprocess", meshes["plate.unv"], "-o", str(out),
+    result = subprocess.run([PYTHON, "-m", "preprocess", meshes["plate.unv"], "-o", str(out),
                              "--dim", "2", "--thickness", "1e-3", "--method", "lattice", "--dx", "1e-3",
                              "--block", "main", "--block", "grip", "--layer", "left=2e-3"],
                             cwd=ROOT, capture_output=True, text=True)
@@ -104,7 +105,7 @@ def test_command_line(meshes, tmp_path):
     cloud = read_node_file(str(out))
     assert cloud.sets["left"].sum() == 2 * 50 and set(np.unique(cloud.block)) == {1, 2}
     assert f"{out}: {len(cloud.volume)} nodes" in result.stdout
-    result = subprocess.run(["/usr/bin/python3", "-m", "preprocess", meshes["plate"], "-o", str(out),
+    result = subprocess.run([PYTHON, "-m", "preprocess", meshes["plate"], "-o", str(out),
                              "--dim", "2", "--thickness", "1e-3", "--dx", "1e-3", "--block", "steel"],
                             cwd=ROOT, capture_output=True, text=True)
     assert result.returncode == 2

@@ -11,6 +11,7 @@ from preprocess import PreprocessError
 from preprocess.geo_guard import check_geo
 from preprocess.gmsh_mesh import mesh_geo
 from preprocess_testdata import ROOT
+from common.paths import PYTHON
 
 SQUARE = """DefineConstant[ a = {1.0, Name "a"} ];
 Point(1) = {0, 0, 0, 0.5}; Point(2) = {a, 0, 0, 0.5}; Point(3) = {a, a, 0, 0.5}; Point(4) = {0, a, 0, 0.5};
@@ -150,7 +151,7 @@ def test_the_mesh_stage_on_a_malicious_case_runs_nothing(tmp_path):
                    + f'SystemCall "touch {marker}";\n')
     line = geo.read_text().count("\n")
     out = tmp_path / "out" / "mesh.msh"
-    result = subprocess.run(["/usr/bin/python3", "-m", "pipeline.run", "mesh", str(case / "evil.yaml"), str(geo),
+    result = subprocess.run([PYTHON, "-m", "pipeline.run", "mesh", str(case / "evil.yaml"), str(geo),
                              str(out)], cwd=ROOT, capture_output=True, text=True, stdin=subprocess.DEVNULL)
     assert result.returncode == 2
     assert f"error: {geo}:{line}: 'SystemCall' runs a shell command" in result.stderr, result.stderr

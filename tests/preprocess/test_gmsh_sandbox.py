@@ -11,6 +11,7 @@ from preprocess import PreprocessError
 from preprocess.geo_guard import check_geo
 from preprocess.gmsh_mesh import mesh_geo
 from preprocess_testdata import ROOT
+from common.paths import PYTHON
 
 SQUARE = """Point(1) = {0, 0, 0, 0.5}; Point(2) = {1, 0, 0, 0.5}; Point(3) = {1, 1, 0, 0.5}; Point(4) = {0, 1, 0, 0.5};
 Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
@@ -35,7 +36,7 @@ def test_the_report_string_split_at_1023_characters_is_refused_by_check(tmp_path
     text = open(os.path.join(ROOT, "cases", "membrane", "membrane.geo")).read()
     geo.write_text(text + split_string(marker))
     line = text.count("\n") + 2
-    result = subprocess.run(["/usr/bin/python3", "-m", "pipeline.run", "check", str(case / "evil.yaml")], cwd=ROOT,
+    result = subprocess.run([PYTHON, "-m", "pipeline.run", "check", str(case / "evil.yaml")], cwd=ROOT,
                             capture_output=True, text=True, stdin=subprocess.DEVNULL)
     assert result.returncode == 2, result.stdout + result.stderr
     length = 1023 + len(f"'; SystemCall 'touch {marker}'; n2 = '")

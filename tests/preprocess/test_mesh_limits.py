@@ -32,12 +32,12 @@ def test_gmsh_stops_at_its_memory_cap_with_a_clear_error(tmp_path, monkeypatch):
 def test_the_memory_cap_is_half_of_the_available_memory(monkeypatch):
     from preprocess import sandbox
 
-    monkeypatch.setattr("pipeline.cost._available_memory", lambda: 16e9)
+    monkeypatch.setattr("common.memory.available_memory", lambda: 16e9)
     monkeypatch.delenv("FORCE", raising=False)
     assert sandbox.memory_cap() == 8_000_000_000
     monkeypatch.setenv("FORCE", "1")
     assert sandbox.memory_cap() == 16_000_000_000
-    monkeypatch.setattr("pipeline.cost._available_memory", lambda: 1e9)
+    monkeypatch.setattr("common.memory.available_memory", lambda: 1e9)
     assert sandbox.memory_cap() == 2 * 1024 ** 3   # Python with numpy maps more than it uses
 
 
@@ -52,7 +52,7 @@ def big_sparse_file(path, size):
 def test_a_mesh_file_above_the_size_cap_is_refused_before_it_is_read(tmp_path, monkeypatch, name):
     """A 3 GB .msh was read for 61 s before failing with an empty reason."""
     monkeypatch.delenv("FORCE", raising=False)
-    monkeypatch.setattr("pipeline.cost._available_memory", lambda: 64e9)
+    monkeypatch.setattr("common.memory.available_memory", lambda: 64e9)
     path = tmp_path / name
     big_sparse_file(path, 3 * 10 ** 9)
     start = time.monotonic()
@@ -65,7 +65,7 @@ def test_a_mesh_file_above_the_size_cap_is_refused_before_it_is_read(tmp_path, m
 
 def test_a_mesh_file_that_would_not_fit_in_memory_is_refused_even_with_force(tmp_path, monkeypatch):
     monkeypatch.setenv("FORCE", "1")
-    monkeypatch.setattr("pipeline.cost._available_memory", lambda: 1e9)
+    monkeypatch.setattr("common.memory.available_memory", lambda: 1e9)
     path = tmp_path / "big.msh"
     big_sparse_file(path, 100 * 10 ** 6)
     with pytest.raises(PreprocessError) as err:
