@@ -151,7 +151,8 @@ def solve(case_json: str, *, solver: str | None = None, threads: int | None = No
     (stdout and stderr together), else is captured as text in the result. lock_fd: the output
     folder's lock, handed to the solver (PD_LOCK_FD: it locks its folder itself, io/output_lock.hpp)
     so that the folder stays locked while it runs. The exit code (result.returncode, the command
-    result.args) is the caller's to judge: make, peridyn and the tests each say it their own way."""
+    result.args) is the caller's to judge: peridyn, validation, bench and the tests each say it their
+    own way. make runs pdsolve itself, with exec, so that a SIGTERM it passes on reaches the solver."""
     command = solve_command(case_json, solver=solver, threads=threads, quiet=quiet)
     handed = {} if lock_fd is None else {"pass_fds": (lock_fd,), "env": dict(os.environ, PD_LOCK_FD=str(lock_fd))}
     if log is None:

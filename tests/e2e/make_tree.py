@@ -1,6 +1,6 @@
 """A copy of the repository's Makefile with its stages, in a temporary folder, for tests that run
 the real `make case=X` on a short case of their own (signals, locks): cases/<name>/ is the test's,
-the stages (pipeline/, preprocess/, postprocess/) and the built solver are the repository's, by
+the stages (common/, pipeline/, preprocess/, postprocess/) and the built solver are the repository's, by
 symbolic link, and make is told not to rebuild the solver (SOLVER_SOURCES empty)."""
 import os
 import shutil
@@ -19,7 +19,7 @@ def make_tree(work, name="sig", end=10.0):
     tree = work / "tree"
     (tree / "cases" / name).mkdir(parents=True)
     shutil.copy(os.path.join(ROOT, "Makefile"), tree / "Makefile")
-    for folder in ("pipeline", "preprocess", "postprocess"):
+    for folder in ("common", "pipeline", "preprocess", "postprocess"):
         os.symlink(os.path.join(ROOT, folder), tree / folder)
     (tree / "build").mkdir()
     os.symlink(os.path.dirname(SOLVER), tree / "build" / "solver")

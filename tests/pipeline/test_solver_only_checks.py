@@ -17,7 +17,7 @@ from pipeline.case import CaseError, load_case
 from pipeline.resolve import resolve
 from preprocess.node_file import write_node_file
 
-from conftest import ROOT
+from common.paths import REPOSITORY as ROOT
 from minimal_case import MINIMAL, lattice_cloud
 
 # name: (YAML appended to MINIMAL, the error's line, the error after "plate.yaml:LINE: ",

@@ -12,7 +12,7 @@ from pipeline.case import load_case
 from pipeline.stability import case_stable_time_step
 from preprocess.node_file import read_node_file
 
-from conftest import ROOT
+from common.paths import REPOSITORY as ROOT
 
 CASES = sorted(glob.glob(os.path.join(ROOT, "cases", "*", "*.yaml")))
 

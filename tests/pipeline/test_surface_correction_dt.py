@@ -14,7 +14,7 @@ from pipeline.case import load_case
 from pipeline.stability import case_stable_time_step
 from preprocess.node_file import read_node_file
 
-from conftest import ROOT
+from common.paths import REPOSITORY as ROOT
 
 LPS = "    model: lps\n    poisson_ratio: 0.3\n"
 # (case, the text to change, its replacement): the 3D plate at 2 dx (40 × 20 × 3 nodes) and the
