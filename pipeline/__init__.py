@@ -1,1 +1,2 @@
-"""The case schema, the case-file loader and the driver that chains the stages (see formats.md)."""
+"""The case schema, the case-file loader, the stages as functions (stages.py) and make's command
+line for them (run.py); see formats.md."""
