@@ -12,6 +12,7 @@
 #include "run/loop.hpp"
 #include "run/prepare.hpp"
 #include "run/report.hpp"
+#include "run/run_log.hpp"
 #include "run/signals.hpp"
 #include "run/start.hpp"
 
@@ -31,10 +32,10 @@ int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryC
     if (!s.restarting && out) std::filesystem::remove(checkpoint_path(p.c));
     log = std::make_unique<RunLog>(out ? p.c.output_dir / "run.log" : std::filesystem::path(), opt.quiet,
                                    s.restarting);
-    log_title(*log, opt, p);
-    if (s.restarting) log->line(restart_line(opt, s));
+    log->title(opt, p);
+    if (s.restarting) log->restarted(opt, s);
     if (!s.solver_changed.empty()) log->error(s.solver_changed);  // stderr once (rank 0), and run.log
-    log_setup(*log, p);
+    log->setup(p);
     const LoopEnd end = run_loop(opt, p, s, columns, out, *log);
     return report(opt, p, s.loop, end, out ? out->frames_written() : 0, *log);
   } catch (const Error& e) {

@@ -143,6 +143,25 @@ TEST(TimeLoop, ExactTimeStepRunsStablyAtSafetyFactor095) {
   EXPECT_LT(std::stod(m[1]), 1.9);
 }
 
+// A step the integrator cannot take (here adaptive at 10 × eq. 2.5 with no room to shorten it) goes
+// through the loop's one failure exit: exit 3, the error on stderr and in run.log, and the closing
+// line "stopped" with the state before it kept (frame 0, nothing removed).
+TEST(TimeLoop, AStepThatFailsStopsTheRunAndKeepsTheLastAcceptedState) {
+  const fs::path dir = temp_dir("step_failed");
+  write_case(dir, R"({"end": 1e-5, "integrator": "adaptive"})",
+             R"(, "adaptive": {"tol": 1e-3, "dt_initial": 1e-6, "dt_min": 1e-6, "dt_max": 1e-6})");
+  ASSERT_EQ(run_solver(dir), 3) << slurp(dir / "log.txt");
+  const std::string message = slurp(dir / "log.txt");
+  EXPECT_NE(message.find("pdsolve: error: step 1: the adaptive step did not converge at dt_min"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("; stopped, the last accepted state is kept"), std::string::npos) << message;
+  const std::string log = slurp(dir / "out" / "run.log");
+  EXPECT_NE(log.find("pdsolve: error: step 1: "), std::string::npos) << log;
+  EXPECT_NE(log.find("stopped: 0 steps to t = 0 s"), std::string::npos) << log;
+  EXPECT_EQ(log.find("removed "), std::string::npos) << log;
+  EXPECT_EQ(frame_times(dir / "out"), std::vector<double>{0.0});
+}
+
 TEST(TimeLoop, BadAdaptiveValueIsAnInputError) {
   const fs::path dir = temp_dir("bad");
   write_case(dir, R"({"end": 1e-6, "integrator": "adaptive"})", R"(, "adaptive": {"tol": 1e-3, "phi": 0.2})");

@@ -1,4 +1,4 @@
-// Writers of frames, the .pvd collection, history.csv and run.log.
+// Writers of frames, the .pvd collection and history.csv (run.log: run/run_log.hpp).
 #include "io/output.hpp"
 
 #include <fcntl.h>
@@ -12,8 +12,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <iostream>
-#include <iterator>
 #include <regex>
 #include <sstream>
 
@@ -376,32 +374,6 @@ void OutputWriter::finish() {
   const int fd = history_fd_;
   history_fd_ = -1;
   if (fd >= 0 && ::close(fd) != 0) throw_write_error(dir_ / "history.csv", "write failed", errno, 0);
-}
-
-RunLog::RunLog(std::filesystem::path path, bool quiet, bool append) : path_(std::move(path)), quiet_(quiet) {
-  if (!append) return;
-  std::ifstream in(path_, std::ios::binary);
-  text_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void RunLog::line(const std::string& text) {
-  if (path_.empty()) return;  // a rank other than 0 of a decomposed run: rank 0 writes the log
-  if (!quiet_) std::cout << text << std::endl;
-  text_ += text + "\n";
-  write_file_atomically(path_, text_);
-}
-
-void RunLog::note(const std::string& text) {
-  if (path_.empty()) return;
-  text_ += text + "\n";
-  write_file_atomically(path_, text_);
-}
-
-void RunLog::error(const std::string& text) {
-  if (path_.empty()) return;
-  std::cerr << text << std::endl;
-  text_ += text + "\n";
-  write_file_atomically(path_, text_);
 }
 
 }  // namespace pd

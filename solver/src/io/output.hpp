@@ -1,5 +1,6 @@
-// Solver output (pipeline/formats.md §4): frames/frame_NNNNNN.vtu, frames.pvd, history.csv, run.log.
-// Frames, frames.pvd and run.log are written under a temporary name and renamed into place;
+// Solver output (pipeline/formats.md §4): frames/frame_NNNNNN.vtu, frames.pvd, history.csv (run.log:
+// run/run_log.hpp).
+// Frames and frames.pvd are written under a temporary name and renamed into place;
 // history.csv grows in place by whole lines (see OutputWriter).
 #pragma once
 #include <cstdint>
@@ -132,23 +133,6 @@ class OutputWriter {
   std::uint64_t history_bytes_ = 0;
   double last_flush_ = 0.0;  // steady-clock seconds
   bool finished_ = false;
-};
-
-// What the solver says at start and end: to stdout (unless quiet) and to run.log, rewritten
-// atomically after every message so run.log is complete even if the run is killed.
-class RunLog {
- public:
-  // append: keep what run.log holds already (a restarted run adds to it). An empty path: a log that
-  // says nothing (the ranks other than 0 of a decomposed run).
-  RunLog(std::filesystem::path path, bool quiet, bool append = false);
-  void line(const std::string& text);
-  void error(const std::string& text);  // stderr always, and run.log
-  void note(const std::string& text);   // run.log only (the progress lines: run/progress.hpp)
-
- private:
-  std::filesystem::path path_;
-  bool quiet_;
-  std::string text_;
 };
 
 }  // namespace pd

@@ -5,6 +5,7 @@
 #include "run.hpp"
 #include "run/history_columns.hpp"
 #include "run/prepare.hpp"
+#include "run/run_log.hpp"
 #include "run/start.hpp"
 
 namespace pd {
@@ -19,7 +20,8 @@ struct LoopEnd {
   std::int64_t steps = 0;    // steps this run took (a restarted run's steps before its restart not counted)
 };
 
-// s.loop and s.state are advanced in place. Throws pd::Error if output fails (a full disk).
+// A TimeLoop (loop.cpp) from s's step: its methods step, watch (each watch's verdict goes to the one
+// failure exit), write on schedule and checkpoint. s.loop and s.state are advanced in place. Throws pd::Error if output fails (a full disk).
 // out is null on the ranks other than 0 of a decomposed run: they take part in every gather and
 // sum, and write nothing.
 LoopEnd run_loop(const RunOptions& options, Prepared& p, Start& s, const HistoryColumns& columns, OutputWriter* out,

@@ -1,4 +1,4 @@
-// The prepare phase of a run: case, nodes, model, time step, integrator, run.log header (run/prepare.hpp).
+// The prepare phase of a run: case, nodes, model, time step, integrator (run/prepare.hpp).
 #include "run/prepare.hpp"
 
 #include <omp.h>
@@ -17,8 +17,6 @@
 #include "core/error.hpp"
 #include "core/stability.hpp"
 #include "core/time_step_rule.hpp"
-#include "core/work_plan.hpp"
-#include "forces/indenter.hpp"
 #include "io/case_reader.hpp"
 #include "io/node_file.hpp"
 #include "materials/bond_model.hpp"
@@ -270,79 +268,6 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   // After configure(): the integrator sees the same dt_exact as before this check existed.
   if (p->integrator->explicit_step() && !p->integrator->controls_step()) p->step_warnings = step_warnings(*p);
   return p;
-}
-
-void log_title(RunLog& log, const RunOptions& opt, const Prepared& p) {
-  log.line("pdsolve " PD_VERSION ": case " + (p.c.name.empty() ? opt.case_file.string() : p.c.name) + " (" +
-           opt.case_file.string() + ")");
-}
-
-void log_setup(RunLog& log, const Prepared& p) {
-  const Case& c = p.c;
-  const Model& model = p.model;
-  const auto n = static_cast<std::size_t>(p.nodes);
-  log.line("nodes " + std::to_string(n) + ", bonds " + std::to_string(p.directed_bonds() / 2) + " (" +
-           format("%.1f", static_cast<double>(p.directed_bonds()) / static_cast<double>(n)) +
-           " per node), built in " + format("%.3f", p.build_seconds) + " s");
-  log.line("analysis " + c.analysis + ", horizon " + format("%.6g", c.horizon) + " m = " +
-           format("%.4g", c.horizon / c.grid_spacing) + " dx");
-  for (std::size_t b = 0; b < model.material.block.size(); ++b)
-    log.line("block " + std::to_string(b + 1) + " '" + c.blocks[b].name + "': c " +
-             format("%.6g", model.material.block[b].micromodulus) + ", s0 " +
-             (std::isinf(model.material.block[b].critical_stretch) ? std::string("none (unbreakable)")
-                                                                   : format("%.6g", model.material.block[b].critical_stretch)));
-  log.line("dt " + format("%.6g", p.dt) + " s (" +
-           (c.time.dt_rule == "stable" ? "stable " + format("%.6g", p.dt_stable) + " s × safety factor " + format("%g", c.time.safety_factor)
-            : c.time.dt_rule == "exact" ? "exact limit " + format("%.6g", p.dt_exact) + " s = " + format("%.4g", p.dt_exact / p.dt_stable) +
-                                              " × eq. 2.5, × safety factor " + format("%g", c.time.safety_factor)
-                                        : "fixed; stable " + format("%.6g", p.dt_stable) + " s") +
-           (p.integrator->controls_step() ? ", the initial step" : "") +
-           "), integrator " + p.integrator->name() + ", damping " + format("%g", c.damping) + " 1/s");
-  if (p.isolated > 0 && p.writes_output())  // node_text reads the whole positions, which rank 0 keeps
-    log.line("warning: " + std::to_string(p.isolated) + " of " + std::to_string(n) +
-             " nodes have no bond within the horizon (isolated: only loads and contact act on them); the first is " +
-             node_text(model, p.first_isolated));
-  for (const auto& text : p.step_warnings) log.line(text);
-  for (const auto& text : work_summary(*p.op, c)) log.line(text);
-  if (p.decomposed) {
-    const Decomposed& d = *p.decomposed;
-    const std::int64_t ghosts = d.total(static_cast<std::int64_t>(d.piece().ghost_local.size()));
-    log.line("decomposed over " + std::to_string(d.ranks()) + " MPI ranks (Morton pieces balanced by bond count): " +
-             std::to_string(ghosts) + " ghosts in all, " +
-             format("%.3f", static_cast<double>(ghosts) / static_cast<double>(n)) + " per owned node; " +
-             "frames, history and run.log from rank 0");
-    // What each rank holds of the bonds: its piece's rows, and the whole list too if it kept it.
-    const std::vector<double> held = d.per_rank(static_cast<double>(d.piece().model.bonds.directed() + model.bonds.directed()));
-    std::string text = "directed bonds held per rank (of " + std::to_string(p.directed_bonds()) + "):";
-    for (std::size_t r = 0; r < held.size(); ++r) text += " rank " + std::to_string(r) + " " + format("%.0f", held[r]) + (r + 1 < held.size() ? "," : "");
-    log.line(text + (p.whole_bonds ? "; every rank holds the whole bond list too, for " + whole_bonds_reason(c)
-                                   : "; each rank built only the rows of its own nodes"));
-    // What each rank holds of the per-node data after set-up: the whole cloud's arrays (rank 0, which
-    // writes the output, and every rank that keeps the whole bond list) and its piece's.
-    const std::vector<double> whole = d.per_rank(static_cast<double>(node_data_bytes(model)));
-    const std::vector<double> own = d.per_rank(static_cast<double>(node_data_bytes(d.piece().model)));
-    text = "node data held per rank after set-up (bytes: the whole cloud's arrays + the piece's):";
-    for (std::size_t r = 0; r < whole.size(); ++r)
-      text += " rank " + std::to_string(r) + " " + format("%.0f", whole[r]) + " + " + format("%.0f", own[r]) + (r + 1 < whole.size() ? "," : "");
-    log.line(text);
-  }
-  if (p.indenter_watch)
-    for (const auto& ind : model.indenters) {
-      const double depth = indenter_stable_depth(model, ind, p.dt, p.omega2_exact);
-      const std::string basis = std::string("its stiffness 2K·h with ") + (p.omega2_exact > 0.0 ? "the exact limit" : "eq. 2.5");
-      // A sphere or a disk cannot push a node deeper than its radius: a bound past it (1.007 m for a
-      // 1.5 mm disk, issue 16) says only that the stiffness never limits the step.
-      if (ind.shape != "plane" && depth >= ind.radius)
-        log.line("indenter '" + ind.name + "': dt stays stable at any depth (" + basis + " allows " +
-                 format("%.4g", depth) + " m, more than its radius " + format("%.4g", ind.radius) + " m)");
-      else
-        log.line("indenter '" + ind.name + "': dt stays stable while no node is deeper than " + format("%.4g", depth) +
-                 " m (" + basis + "; a bound, the step may hold deeper)");
-    }
-  for (const auto& text : p.integrator->describe(p.dt_exact_configured)) log.line(text);
-  log.line("end time " + format("%.6g", c.time.end) + " s, steps expected " + std::to_string(p.steps_expected) +
-           (p.integrator->controls_step() ? " at the initial step (the integrator sets its own)" : "") +
-           (p.steps_for_end > p.max_steps ? " (capped by max_steps)" : "") + ", threads " + std::to_string(p.threads));
 }
 
 }  // namespace pd

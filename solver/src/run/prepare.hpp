@@ -1,5 +1,5 @@
 // Phase 1 of a run: read the case and the node file, build the model, choose the time step,
-// construct the integrator; and the run.log lines that say what was prepared. Every input error is
+// construct the integrator (run/run_log.hpp says what was prepared). Every input error is
 // thrown here or in the start phase, before any output file exists.
 #pragma once
 #include <string>
@@ -87,10 +87,5 @@ std::int64_t node_data_bytes(const Model& model);
 // which are in the whole list's order; release_whole_rows_offsets frees them then.
 void release_whole_node_data(Prepared& p);
 void release_whole_rows_offsets(Prepared& p);
-
-// run.log's first line: the version and the case.
-void log_title(RunLog& log, const RunOptions& options, const Prepared& p);
-// The rest of the header: model, materials, time step, warnings, what runs, the integrator, the end.
-void log_setup(RunLog& log, const Prepared& p);
 
 }  // namespace pd

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <string>
 
-#include "io/output.hpp"
 #include "run/eta.hpp"
+#include "run/run_log.hpp"
 
 namespace pd {
 

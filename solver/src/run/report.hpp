@@ -1,8 +1,8 @@
 // Phase 4 of a run: the closing lines of run.log and the exit status.
 #pragma once
-#include "io/output.hpp"
 #include "run.hpp"
 #include "run/loop.hpp"
+#include "run/run_log.hpp"
 
 namespace pd {
 

@@ -192,12 +192,6 @@ std::unique_ptr<OutputWriter> open_output(const RunOptions& opt, const Prepared&
   return out;
 }
 
-std::string restart_line(const RunOptions& opt, const Start& s) {
-  return "restart from " + opt.restart.string() + ": step " + std::to_string(s.loop.step) + ", t = " +
-         format("%.6g", s.loop.t) + " s, " + std::to_string(s.resume.frame_times.size()) +
-         " frames kept (frames after it, history.csv rows after it: dropped)";
-}
-
 Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
                          const OutputWriter& out, std::vector<char> integrator_state, const Vec3Array& contact_u_build) {
   const Model& model = p.model;

@@ -40,9 +40,6 @@ std::filesystem::path checkpoint_path(const Case& c);
 std::unique_ptr<OutputWriter> open_output(const RunOptions& options, const Prepared& p, const Start& s,
                                           const HistoryColumns& columns);
 
-// run.log's line after the title on a restart.
-std::string restart_line(const RunOptions& options, const Start& s);
-
 // Everything the loop carries from step to step, for checkpoint.bin. loop.wall_time: the time
 // loop's seconds up to now.
 // `whole`: the run's state in the whole model's numbering (on a decomposed run, gathered on rank 0;
