@@ -231,6 +231,10 @@ class WatchedDecomposed : public pd::Decomposed {
   std::vector<double> gather(const std::vector<double>& v, int width) const override { return d_.gather(v, width); }
   void broadcast(std::vector<double>& v) const override { d_.broadcast(v); }
   void gather_broken(const pd::BondList& l, pd::BondList& g) const override { d_.gather_broken(l, g); }
+  std::vector<double> gather_bond_values(const pd::BondList& l, const std::vector<double>& v, int w,
+                                         const pd::BondList& g) const override {
+    return d_.gather_bond_values(l, v, w, g);
+  }
   void gather_broken_lines(const pd::BondList& l, pd::BondList& g) const override { d_.gather_broken_lines(l, g); }
   std::vector<double> per_rank(double v) const override { return d_.per_rank(v); }
   std::string broadcast(const std::string& b) const override { return d_.broadcast(b); }
