@@ -28,6 +28,7 @@
 #include "run.hpp"
 #include "run/prepare.hpp"
 #include "run/start.hpp"
+#include "pmb_s0.hpp"
 
 namespace fs = std::filesystem;
 
@@ -205,10 +206,13 @@ TEST_P(Restart, SigtermThenRestartIsBitwiseTheUninterruptedRun) {
   EXPECT_EQ(ck.integrator, v.integrator);
   EXPECT_EQ(ck.linear_solver, "");  // an explicit scheme solves no linear system
   // LAMMPS's α rule: the per-node s0 is state the checkpoint carries (and has moved off s00).
-  EXPECT_EQ(ck.node_critical_stretch.size(), v.lammps ? 16u * 8u : 0u);
-  if (v.lammps)
-    EXPECT_NE(*std::min_element(ck.node_critical_stretch.begin(), ck.node_critical_stretch.end()),
-              *std::max_element(ck.node_critical_stretch.begin(), ck.node_critical_stretch.end()));
+  ASSERT_EQ(ck.state_arrays.size(), v.lammps ? 1u : 0u);  // PMB's declared state: s0_i with α > 0
+  if (v.lammps) {
+    const std::vector<double>& s0 = ck.state_arrays[0].values;
+    EXPECT_EQ(ck.state_arrays[0].declaration.name, pd::kNodeCriticalStretch);
+    EXPECT_EQ(s0.size(), 16u * 8u);
+    EXPECT_NE(*std::min_element(s0.begin(), s0.end()), *std::max_element(s0.begin(), s0.end()));
+  }
   EXPECT_EQ(ck.history_bytes, fs::file_size(cut / "out" / "history.csv"));  // whole rows only, all on disk
   EXPECT_NE(slurp(cut / "out" / "run.log").find("interrupted by SIGTERM after step " + std::to_string(stop)),
             std::string::npos)
@@ -260,16 +264,18 @@ TEST(Checkpoint, RestoresThePerNodeCriticalStretchOfTheAlphaRule) {
   ASSERT_EQ(run(dir / "case.json", {}, {}, 25), pd::kOk);
   const pd::Checkpoint ck = pd::read_checkpoint(dir / "out" / "checkpoint.bin");
   ASSERT_EQ(ck.loop.step, 20);
-  ASSERT_EQ(ck.node_critical_stretch.size(), 16u * 8u);
+  ASSERT_EQ(ck.state_arrays.size(), 1u);
+  const std::vector<double>& saved = ck.state_arrays[0].values;
+  ASSERT_EQ(saved.size(), 16u * 8u);
   pd::RunOptions o;
   o.case_file = dir / "case.json";
   o.quiet = true;
   o.restart = dir / "out" / "checkpoint.bin";
   std::unique_ptr<pd::Prepared> p = pd::prepare(o);
-  const std::vector<double> fresh = p->model.node_critical_stretch;  // at rest: s00 everywhere
+  const std::vector<double> fresh = pdtest::s0_of(p->model);  // at rest: s00 everywhere
   pd::start_or_restore(o, *p);
-  EXPECT_EQ(p->model.node_critical_stretch, ck.node_critical_stretch);
-  EXPECT_NE(p->model.node_critical_stretch, fresh);  // the stretched plate moved s0 off s00
+  EXPECT_EQ(pdtest::s0_of(p->model), saved);
+  EXPECT_NE(pdtest::s0_of(p->model), fresh);  // the stretched plate moved s0 off s00
   fs::remove_all(dir);
 }
 
@@ -357,11 +363,12 @@ TEST(Checkpoint, RefusedForAnotherCaseOrWhenDamaged) {
   EXPECT_NE(error_of(dir / "case.json").find("truncated"), std::string::npos) << error_of(dir / "case.json");
   std::ofstream(ck, std::ios::binary) << "not a checkpoint";
   EXPECT_NE(error_of(dir / "case.json").find("not a pdsolve checkpoint"), std::string::npos);
-  // Of version 3, before the linear solver was recorded (issue 36): refused, saying how to start over.
+  // Of version 4, before the declared state and the list of term energies (issue 37): refused,
+  // saying how to start over.
   std::string old = good;
-  old[8] = 3;  // the uint32 version after the 8-byte magic, little-endian
+  old[8] = 4;  // the uint32 version after the 8-byte magic, little-endian
   std::ofstream(ck, std::ios::binary) << old;
-  EXPECT_NE(error_of(dir / "case.json").find("checkpoint format version 3, this pdsolve reads version 4; to start the "
+  EXPECT_NE(error_of(dir / "case.json").find("checkpoint format version 4, this pdsolve reads version 5; to start the "
                                              "run over instead, delete"),
             std::string::npos) << error_of(dir / "case.json");
   // Still good after all that.
@@ -592,7 +599,7 @@ TEST(Checkpoint, MixedStartedImplicitShowsItsModesInHistoryAndRestartsBitwise) {
     const pd::Checkpoint ck = pd::read_checkpoint(cut / "out" / "checkpoint.bin");
     EXPECT_EQ(ck.loop.step, stop / 7 * 7);
     EXPECT_EQ(ck.integrator, "mixed");
-    EXPECT_EQ(ck.linear_solver, "direct");  // implicit's, on one process (format version 4)
+    EXPECT_EQ(ck.linear_solver, "direct");  // implicit's, on one process (format version 4 on)
     ASSERT_EQ(run(cut / "case.json", {}, cut / "out" / "checkpoint.bin"), pd::kOk);
     expect_same_output(whole / "out", cut / "out");
   }

@@ -17,6 +17,7 @@
 #include "io/case_reader.hpp"
 #include "lattice.hpp"
 #include "run/history_columns.hpp"
+#include "forces/force_term.hpp"
 
 namespace {
 
@@ -144,7 +145,7 @@ TEST(Contact, SingleBodyBuildsNoContactList) {
   }
   EXPECT_EQ(m.contact_list.rebuilds(), 0);
   EXPECT_EQ(m.contact_list.pairs().directed(), 0u);
-  EXPECT_EQ(s.contact_energy, 0.0);
+  EXPECT_EQ(pd::term_energy(s, "contact"), 0.0);
   // contact: off wins over two blocks; self_contact turns the search on for one body.
   pd::Case two;
   pd::Model off_model = two_bodies(4, 10 * kDx, &two);
@@ -177,15 +178,15 @@ TEST(Indenter, ReactionOfAPlaneIsKTimesDepthSquaredOnTheTopRow) {
     EXPECT_EQ(s.indenter_force[0][0], 0.0);
     // history.csv's indenter_energy (issue 16): the indenter's own, Σ V K h³/3, with contact off.
     EXPECT_FALSE(m.contact.pairs);
-    EXPECT_NEAR(s.indenter_energy, plane.stiffness * h * h * h / 3.0 * row_volume, 1e-12 * s.indenter_energy);
-    EXPECT_EQ(s.contact_energy, 0.0);
+    EXPECT_NEAR(pd::term_energy(s, "indenters"), plane.stiffness * h * h * h / 3.0 * row_volume, 1e-12 * pd::term_energy(s, "indenters"));
+    EXPECT_EQ(pd::term_energy(s, "contact"), 0.0);
     pd::HistoryRow row;
     pd::HistoryColumns(m, c).fill(row, pd::HistoryInputs{s, h / 1.0, 0.0});
     const auto& names = pd::fixed_history_columns();
     const auto column = [&](const char* name) {
       return row.extra[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin())];
     };
-    EXPECT_EQ(column("indenter_energy"), s.indenter_energy);
+    EXPECT_EQ(column("indenter_energy"), pd::term_energy(s, "indenters"));
     EXPECT_EQ(column("contact_energy"), 0.0);
   }
   // A slow push on a block clamped at its bottom rows: the block is far stiffer than the indenter
@@ -228,7 +229,7 @@ TEST(Indenter, ReactionOfAPlaneIsKTimesDepthSquaredOnTheTopRow) {
     for (std::size_t i = 0; i < ps.size(); ++i)
       ke += 0.5 * pm.density[i] * pm.nodes.volume[i] * (ps.v[0][i] * ps.v[0][i] + ps.v[1][i] * ps.v[1][i]);
     const double strain = pd::strain_energy(pm, ps.u);
-    const double balance = ke + strain + ps.contact_energy + ps.indenter_energy - ps.external_work;
+    const double balance = ke + strain + pd::term_energy(ps, "contact") + pd::term_energy(ps, "indenters") - ps.external_work;
     e0 = std::max(e0, ps.external_work);
     // Energy in = work of the moving indenter (trapezoidal in time, so loose while F ∝ t² is tiny).
     if (depth > 0.1 * kDx) EXPECT_NEAR(balance, 0.0, 0.01 * e0) << "t " << t;

@@ -14,6 +14,7 @@
 #include "materials/pmb/pmb.hpp"
 #include "parallel/decomposition.hpp"
 #include "parallel/local_model.hpp"
+#include "pmb_s0.hpp"
 
 namespace {
 
@@ -162,30 +163,33 @@ TEST(LocalPiece, OwnedRowsOfTheKernelOnAPieceAreTheSerialRowsBitwise) {
 TEST(LocalPiece, CarriesTheBreakingOrderThePerNodeCriticalStretchAndTheSurfaceFactors) {
   pd::Model m = lattice_model(10, 9, 8, 0.5);
   m.break_after_force = true;
-  m.node_critical_stretch.resize(m.nodes.size());
-  for (std::size_t i = 0; i < m.nodes.size(); ++i) m.node_critical_stretch[i] = 1e-3 * (1.0 + 1e-3 * static_cast<double>(i));
+  for (double& alpha : m.material.alpha_pair) alpha = 0.25;  // the α rule: PMB declares s0_i
+  pd::declare_state(m);
+  std::vector<double>& s0 = *pd::node_critical_stretch(m);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) s0[i] = 1e-3 * (1.0 + 1e-3 * static_cast<double>(i));
   m.bonds.surface_factor.resize(m.bonds.directed());
   for (std::size_t k = 0; k < m.bonds.directed(); ++k) m.bonds.surface_factor[k] = 1.0 + 1e-5 * static_cast<double>(k);
   const pd::Decomposition d = pd::decompose(m.nodes.x, m.bonds, 3, m.horizon);
   for (int r = 0; r < 3; ++r) {
     const pd::LocalPiece p = pd::make_local_piece(m, d.owner, r);
     EXPECT_TRUE(p.model.break_after_force);
-    ASSERT_EQ(p.model.node_critical_stretch.size(), p.size());
+    ASSERT_EQ(pdtest::s0_of(p.model).size(), p.size());
     ASSERT_EQ(p.model.bonds.surface_factor.size(), p.model.bonds.directed());
     for (std::size_t l = 0; l < p.size(); ++l) {
       const auto i = static_cast<std::size_t>(p.global[l]);
-      EXPECT_EQ(p.model.node_critical_stretch[l], m.node_critical_stretch[i]);
+      EXPECT_EQ(pdtest::s0_of(p.model)[l], s0[i]);
       for (std::int64_t q = 0; q < p.model.bonds.offsets[l + 1] - p.model.bonds.offsets[l]; ++q)
         EXPECT_EQ(p.model.bonds.surface_factor[static_cast<std::size_t>(p.model.bonds.offsets[l] + q)],
                   m.bonds.surface_factor[static_cast<std::size_t>(m.bonds.offsets[i] + q)]);
     }
   }
   m.break_after_force = false;
-  m.node_critical_stretch.clear();
+  for (double& alpha : m.material.alpha_pair) alpha = 0.0;  // no α: no s0_i declared
+  pd::declare_state(m);
   m.bonds.surface_factor.clear();
   const pd::LocalPiece plain = pd::make_local_piece(m, d.owner, 1);
   EXPECT_FALSE(plain.model.break_after_force);
-  EXPECT_TRUE(plain.model.node_critical_stretch.empty());
+  EXPECT_TRUE(pdtest::s0_of(plain.model).empty());
   EXPECT_FALSE(plain.model.bonds.corrected());
 }
 

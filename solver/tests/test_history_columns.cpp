@@ -50,8 +50,7 @@ TEST(HistoryColumns, IndentersAndBreakingAddOnlyTheNamedTriplesAfterTheFixedColu
     expected.push_back(name);
   EXPECT_EQ(columns.names(), expected);
   pd::State state(0);
-  state.contact_energy = 2.0;
-  state.indenter_energy = 3.0;                // its own column, no longer added into contact_energy
+  state.term_energies = {2.0, 3.0};  // contact's, then the indenters' (no longer added into contact_energy)
   state.indenter_force = {{1.0, 2.0, 3.0}};  // the second indenter's force not yet computed: 0
   pd::HistoryRow row;
   columns.fill(row, pd::HistoryInputs{state, 0.0, 5.0});
@@ -64,7 +63,7 @@ TEST(HistoryColumns, ContactGivesItsEnergyAndTheListBuildsInTheFixedColumns) {
   const pd::HistoryColumns columns(m, pd::Case{});
   EXPECT_EQ(columns.names(), kFixed);
   pd::State state(0);
-  state.contact_energy = 0.25;
+  state.term_energies = {0.25};  // contact's; the indenters' not yet computed: 0
   pd::HistoryRow row;
   columns.fill(row, pd::HistoryInputs{state, 0.0, 0.0});
   EXPECT_EQ(row.extra, (std::vector<double>{0.25, 0.0, 0.0, 0.0, 0.0}));

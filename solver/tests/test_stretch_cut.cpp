@@ -18,6 +18,7 @@
 #include "lattice.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "one_thread.hpp"
+#include "pmb_s0.hpp"
 
 namespace {
 
@@ -70,9 +71,10 @@ pd::StretchRatio brute_force(const pd::Model& m, const pd::Vec3Array& u, bool lp
       const double e0 = (x[0][j] + u[0][j]) - (x[0][i] + u[0][i]), e1 = (x[1][j] + u[1][j]) - (x[1][i] + u[1][i]),
                    e2 = (x[2][j] + u[2][j]) - (x[2][i] + u[2][i]);
       const double y = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-      const double s0 = m.node_critical_stretch.empty()
+      const std::vector<double>& s0_node = pdtest::s0_of(m);
+      const double s0 = s0_node.empty()
                             ? m.material.critical_pair[static_cast<std::size_t>(m.block_index[i] * m.material.blocks + m.block_index[j])]
-                            : std::min(m.node_critical_stretch[i], m.node_critical_stretch[j]);
+                            : std::min(s0_node[i], s0_node[j]);
       double ratio = 0.0;
       bool over = false;
       if (lps) {
@@ -154,8 +156,8 @@ TEST(StretchRatio, IsTheBruteForceMaximumAndCountsWhatBreakBondsBreaksForLammpsR
   pd::Model m = breakable_bar();
   const double s0 = m.material.critical_pair[0];
   const pd::Vec3Array spread = pdtest::pseudo_random(m.nodes.size(), 9);
-  m.node_critical_stretch.resize(m.nodes.size());
-  for (std::size_t i = 0; i < m.nodes.size(); ++i) m.node_critical_stretch[i] = s0 * (1.0 + 0.05 * spread[0][i]);
+  std::vector<double>& s0_node = pdtest::declare_s0(m, s0);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) s0_node[i] = s0 * (1.0 + 0.05 * spread[0][i]);
   ASSERT_TRUE(pd::uses_lammps_rules(m));
   expect_ratio_is_the_brute_force_and_counts_what_breaks(m, false);
 }

@@ -53,7 +53,7 @@ struct MaterialTable {
   std::vector<double> critical_pair;      // s0_ab
   std::vector<double> alpha_pair;         // α_ab: the mean of the blocks' α, as c_ab
 
-  // True when some α_ab > 0: then the critical stretch is a per-node state (Model::node_critical_stretch).
+  // True when some α_ab > 0: then the critical stretch is a per-node state (materials/pmb/ declares it).
   bool node_rule() const;
 
   // False when no bond can ever break (every pair unbreakable): then no pass tests breaking.

@@ -14,22 +14,10 @@
 
 namespace pd {
 
-// LAMMPS's s0_i at rest (core/model.hpp).
-std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
-                                                  const BondList& bonds) {
-  const std::size_t n = bonds.nodes(), nb = static_cast<std::size_t>(table.blocks);
-  std::vector<double> s0(n, std::numeric_limits<double>::infinity());
-  for (std::size_t i = 0; i < n; ++i) {
-    bool first = true;
-    for (std::int64_t k = bonds.offsets[i]; k < bonds.offsets[i + 1]; ++k) {
-      if (bonds.broken[static_cast<std::size_t>(k)]) continue;
-      const std::size_t j = static_cast<std::size_t>(bonds.neighbour[static_cast<std::size_t>(k)]);
-      const double pair = table.critical_pair[static_cast<std::size_t>(block[i]) * nb + static_cast<std::size_t>(block[j])];
-      s0[i] = first ? pair : std::max(s0[i], pair);
-      first = false;
-    }
-  }
-  return s0;
+void declare_state(Model& m, bool at_rest) {
+  // Per bond: the rows the model holds (none for a whole model whose rows are on the ranks).
+  m.state_arrays = StateArrays(m.bond_model->state_declarations(m), m.nodes.size(), m.bonds.neighbour.size());
+  if (at_rest) m.bond_model->initialise_state(m);
 }
 
 double bond_search_cutoff(const Case& c) {
@@ -97,13 +85,14 @@ Model build_model(const Case& c, Nodes nodes) {
   bonds.volume_weight = m.bonds.volume_weight;
   m.bonds = std::move(bonds);
   cut_crossing_bonds(c.cracks, m.nodes.x, m.bonds);  // pre-cracks (notches) start broken
-  if (m.material.node_rule()) m.node_critical_stretch = initial_node_critical_stretch(m.material, m.block_index, m.bonds);
   m.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(m);
   // Factors from the law's own energy on each node's family (pre-cracks are free surfaces); every
   // kernel reads them from the bonds.
   apply_surface_correction(c.surface_correction, m);
   // A law that precomputes from the weights (LPS's bound of the stable step) is made again with them.
   if (m.bonds.corrected()) m.bond_model = material_registry().get(c.blocks[0].model).make(m);
+  // The law's history at rest, from the bonds (pre-cracks included).
+  declare_state(m);
   return m;
 }
 

@@ -9,6 +9,7 @@
 #include "core/conditions.hpp"
 #include "core/material.hpp"
 #include "core/nodes.hpp"
+#include "core/state_arrays.hpp"
 #include "core/neighbour_list.hpp"
 #include "materials/bond_model.hpp"
 
@@ -35,11 +36,10 @@ struct Model {
   // order (they break before the force at the new state); true, LAMMPS peri/pmb's (they carry their
   // force in the step they break and are gone from the next one).
   bool break_after_force = false;
-  // LAMMPS's critical-stretch rule (validation.md F5), when some α > 0 (MaterialTable::node_rule):
-  // s0_i = max_j (s0_ij − α_ij·s_ij) over i's intact bonds at the previous breaking pass (= s0 −
-  // α·min_j s_ij for one block), +inf for a node without intact bonds; a bond breaks when
-  // s > min(s0_i, s0_j). State, like bonds.broken: every breaking pass updates it. Empty otherwise.
-  std::vector<double> node_critical_stretch;
+  // The law's history (core/state_arrays.hpp): the arrays it declared, per node or per bond, which
+  // its breaking passes update (LAMMPS's per-node critical stretch: materials/pmb/). State, like
+  // bonds.broken; empty for a law without history.
+  StateArrays state_arrays;
   Conditions conditions;
   // Short-range contact (validation.md F4) and rigid indenters: what the scene needs is decided
   // once from the case (core/work_plan); contact.pairs is false when nothing can touch.
@@ -58,11 +58,11 @@ Model build_model(const Case& c, Nodes nodes);
 Model build_model_without_bonds(const Case& c, Nodes nodes);
 // The bond search's cut-off: the horizon, widened by the partial-volume rule's family (HHB).
 double bond_search_cutoff(const Case& c);
-// s0_i of LAMMPS's rule at rest (every s_ij = 0): max_j s0_ij over i's intact bonds, +inf without
-// one — what LAMMPS's set-up force pass leaves before the first step (validation.md F5). A row of
-// `bonds` per node of `block` (an empty row: +inf).
-std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
-                                                  const BondList& bonds);
+// The law's declared state (bond_model->state_declarations, core/state_arrays.hpp) sized for the
+// model's nodes and the bonds of the rows it holds (none for a whole model whose rows are on the
+// ranks: rank 0 gathers per-bond arrays only for a checkpoint), each array at its declared initial
+// value; then, with `at_rest`, filled by the law from the bonds (BondModel::initialise_state).
+void declare_state(Model& model, bool at_rest = true);
 
 // Broken bonds, each counted once (both stored copies of a bond break together).
 std::int64_t broken_bond_count(const Model& model);

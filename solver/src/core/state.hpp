@@ -12,8 +12,11 @@ struct State {
   Vec3Array v;  // velocity [m/s]
   Vec3Array f;  // force density at u of every operator term (bonds, contact, indenters, body force; damping acts in the integrator) [N/m³]
   std::vector<double> w;  // strain-energy density W_i at u, from the last force evaluation [J/m³]
-  double contact_energy = 0.0;   // potential of the contact pairs at u [J]
-  double indenter_energy = 0.0;  // potential of the rigid indenters at u, Σ V K h³/3 [J]
+  // The potential energy at u of each force term that has one [J], in the force-term registry's
+  // order (forces/force_term.hpp term_energy_names: contact pairs, rigid indenters Σ V K h³/3): a
+  // list, so that a new term's energy needs no field here. The operator sets it at every force
+  // evaluation; empty before the first.
+  std::vector<double> term_energies;
   std::vector<std::array<double, 3>> indenter_force;  // force of each indenter on the body at u [N]
 
   // Work ledger, integrated with the trapezoidal rule over each step.
@@ -24,13 +27,18 @@ struct State {
 
   explicit State(std::size_t n = 0) : u(make_vec3(n)), v(make_vec3(n)), f(make_vec3(n)), w(n, 0.0) {}
   std::size_t size() const { return u[0].size(); }
+  // start + every term's energy, added one after the other in the list's order: the energy held
+  // beside the kinetic and strain energy (run/loop.cpp's balance), the same bits wherever it is summed.
+  double plus_term_energies(double start) const {
+    for (double e : term_energies) start += e;
+    return start;
+  }
 
   // Copies every whole-body value (the energies, the indenters' forces, the work ledger) of `from`,
   // not the per-node fields: what a decomposed run's pieces and its gathered state share (run/).
   // A new whole-body member belongs here, so that output and restarts under MPI carry it.
   void copy_totals(const State& from) {
-    contact_energy = from.contact_energy;
-    indenter_energy = from.indenter_energy;
+    term_energies = from.term_energies;
     indenter_force = from.indenter_force;
     external_power = from.external_power;
     damping_power = from.damping_power;

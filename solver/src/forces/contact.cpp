@@ -142,10 +142,10 @@ class ContactTerm : public ForceTerm {
   void add_force(State& s, double) const override {
     if (decomposed_) {  // a piece of a decomposed run: its pairs reach other ranks (forces/contact_on_piece)
       if (!on_piece_) on_piece_ = std::make_unique<ContactOnPiece>(model_, *decomposed_);
-      s.contact_energy += on_piece_->add_force(s.u, s.f);
+      add_energy(s, "contact", on_piece_->add_force(s.u, s.f));
       return;
     }
-    s.contact_energy += ShortRangeForce(model_).AddMult(s.u, s.f);
+    add_energy(s, "contact", ShortRangeForce(model_).AddMult(s.u, s.f));
   }
   void add_power(const State&, double, double&) const override {}  // conservative, at rest
   void add_jacobian_product(const State& s, double, const Vec3Array& x, Vec3Array& y) const override {

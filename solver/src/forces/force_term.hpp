@@ -20,9 +20,9 @@ class ForceTerm {
   // a sum over nodes (its power, the indenters' force on the body, its energy) must be the serial
   // sum's bits on every rank: the term reduces it through `d` (parallel/decomposed.hpp). Null: serial.
   void set_decomposed(const Decomposed* d) { decomposed_ = d; }
-  // s.f += the term's force density at (s.u, t); adds its potential energy to s.contact_energy (contact pairs)
-  // or s.indenter_energy (indenters)
-  // and sets what it reports (the indenters' forces on the body). Accumulates; never clears.
+  // s.f += the term's force density at (s.u, t); adds its potential energy, if it has one, to its
+  // entry of s.term_energies (add_energy), and sets what it reports (the indenters' forces on the
+  // body). Accumulates; never clears.
   virtual void add_force(State& s, double t) const = 0;
   // p += the power the term puts into the body at (s.u, s.v, t) [W] (0 for a conservative term
   // that does not move: contact).
@@ -52,6 +52,8 @@ class ForceTerm {
   virtual std::vector<std::string> work_plan() const = 0;
 
  protected:
+  // s.term_energies[entry of the registry's term `term`] += energy (the list sized first if need be).
+  static void add_energy(State& s, const std::string& term, double energy);
   const Decomposed* decomposed_ = nullptr;
 };
 
@@ -65,10 +67,21 @@ struct ForceTermEntry {
   int power_order = 0;
   std::unique_ptr<ForceTerm> (*make)(const Model& model) = nullptr;
   std::string (*absent)(const Model& model, const Case& c) = nullptr;  // work-plan line when not built; may be ""
+  // The history.csv column of the term's potential energy ("contact_energy"); "" for a term without one.
+  std::string energy = {};
 };
 
 // Every force term, sorted by `order`.
 const std::vector<ForceTermEntry>& force_term_registry();
+// The energy columns of the registry's terms that have one, in its order: what State::term_energies
+// holds, entry by entry, whether or not the scene built the term (then 0), and history.csv's
+// columns for them.
+const std::vector<std::string>& term_energy_names();
+// The entry of State::term_energies that holds the energy of the registry's term `term` (its name);
+// throws std::logic_error for a term without an energy.
+std::size_t term_energy_index(const std::string& term);
+// That entry of s (0 before the first force evaluation).
+double term_energy(const State& s, const std::string& term);
 
 // The factories, one per file of forces/ (force_terms.cpp lists them).
 std::unique_ptr<ForceTerm> make_contact_term(const Model& model);

@@ -294,8 +294,9 @@ class IndenterTerm : public ForceTerm {
  public:
   explicit IndenterTerm(const Model& model) : model_(model) {}
   void add_force(State& s, double t) const override {
-    s.indenter_energy += decomposed_ ? IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force, *decomposed_)
-                                     : IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force);
+    add_energy(s, "indenters",
+               decomposed_ ? IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force, *decomposed_)
+                           : IndenterForce(model_).AddMult(t, s.u, s.f, s.indenter_force));
   }
   // A moving indenter works on the body at the rate (force on the body)·(indenter velocity): the
   // contact potential depends on y − c(t), so d(KE + potential)/dt = F·ċ.

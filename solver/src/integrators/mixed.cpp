@@ -194,7 +194,7 @@ void Mixed::step(State& state, double& t, double& dt) {
   if (mode_ == kImplicit && implicit_step(state, t, dt, evaluations, rejected)) return;
   if (mode_ == kQuasiStatic) {
     broken_before_ = op_.model().bonds.broken;
-    critical_before_ = op_.model().node_critical_stretch;  // LAMMPS's per-node s0 (empty unless α > 0)
+    history_before_ = op_.model().state_arrays.save_rollback();  // the law's declared history (core/state_arrays.hpp)
     static_dt_ = dt;
     static_.guess_from_velocity(step_mode_ == kQuasiStatic);  // not from an explicit step's velocity
     // The first load step after a return on the separation rule is tentative: the pieces left
@@ -242,7 +242,7 @@ void Mixed::step(State& state, double& t, double& dt) {
       // state's force is already that of this state with these bonds (evaluated when the step that
       // reached it ended), so Verlet's first half kick needs no new evaluation.
       op_.model().bonds.broken = broken_before_;
-      op_.model().node_critical_stretch = critical_before_;
+      op_.model().state_arrays.restore_rollback(history_before_);
       static_.forget_factorisation();
       // A step cut to the first bond failure (quasi_static.hpp) failed there: the load step to try
       // on the return is that cut one, not the long step asked for, which would carry the crack on

@@ -235,7 +235,7 @@ class Mixed : public Integrator {
   int pause_factorisations_ = kPauseFactorisations;
   static constexpr int kProbationSteps = 3;
   std::vector<std::uint8_t> broken_before_;  // the bonds' state before a quasi-static attempt
-  std::vector<double> critical_before_;      // and the per-node s0 of LAMMPS's α rule
+  std::vector<std::vector<double>> history_before_;  // and the law's declared history with `rollback`
   std::vector<std::string> log_lines_;
 };
 

@@ -97,6 +97,32 @@ void text(IO& io, std::string& s) {
   s.assign(chars.begin(), chars.end());
 }
 
+// The declared state: the arrays' count, then per array its name, extent, components and values.
+template <class IO>
+void declared_state(IO& io, std::vector<StateArray>& arrays) {
+  auto count = static_cast<std::uint64_t>(arrays.size());
+  io.scalar(count);
+  if constexpr (std::is_same_v<IO, Reader>) {
+    if (count > 1024) io.fail("more declared state arrays than any law declares (" + std::to_string(count) + ")");
+    arrays.resize(static_cast<std::size_t>(count));
+  }
+  for (StateArray& a : arrays) {
+    StateDeclaration& d = a.declaration;
+    text(io, d.name);
+    auto extent = static_cast<std::uint8_t>(d.extent);
+    auto components = static_cast<std::int32_t>(d.components);
+    io.scalar(extent), io.scalar(components);
+    io.array(a.values);
+    if constexpr (std::is_same_v<IO, Reader>) {
+      if (extent > 1) io.fail("declared state '" + d.name + "' is neither per node nor per bond");
+      if (components < 1 || a.values.size() % static_cast<std::size_t>(components) != 0)
+        io.fail("declared state '" + d.name + "' has no whole entries");
+      d.extent = static_cast<StateExtent>(extent);
+      d.components = components;
+    }
+  }
+}
+
 template <class IO>
 void fields(IO& io, Checkpoint& c) {
   io.scalar(c.case_hash), io.scalar(c.nodes_hash), io.scalar(c.nodes), io.scalar(c.directed_bonds);
@@ -109,7 +135,7 @@ void fields(IO& io, Checkpoint& c) {
   io.array(c.integrator_state);
   State& s = c.state;
   io.vec3(s.u), io.vec3(s.v), io.vec3(s.f), io.array(s.w);
-  io.scalar(s.contact_energy);
+  io.array(s.term_energies);  // version 5: one list (version 4: contact's, then indenters' at the end)
   std::vector<double> indenter;
   for (const auto& force : s.indenter_force) indenter.insert(indenter.end(), force.begin(), force.end());
   io.array(indenter);
@@ -121,10 +147,9 @@ void fields(IO& io, Checkpoint& c) {
     for (std::size_t d = 0; d < 3; ++d) s.indenter_force[k][d] = indenter[3 * k + d];
   io.scalar(s.external_power), io.scalar(s.damping_power), io.scalar(s.external_work), io.scalar(s.damping_work);
   io.array(c.broken_flags);
-  io.array(c.node_critical_stretch);
+  declared_state(io, c.state_arrays);  // version 5 (version 2 to 4: LAMMPS's s0 alone)
   io.scalar(c.contact_rebuilds), io.scalar(c.contact_seconds), io.vec3(c.contact_u_build);
   io.array(c.frame_times), io.scalar(c.history_bytes);
-  io.scalar(s.indenter_energy);  // version 3 (issue 16): before, it was part of contact_energy
   text(io, c.linear_solver);     // version 4 (issue 36)
 }
 

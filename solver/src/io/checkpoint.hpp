@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/nodes.hpp"
+#include "core/state_arrays.hpp"
 #include "core/state.hpp"
 #include "run/loop_state.hpp"
 
@@ -20,7 +21,9 @@ namespace pd {
 
 // 2: the per-node critical stretch of LAMMPS's α rule after the broken flags (docs/lammps.md).
 // 3: the indenter energy apart from the contact energy. 4: the linear solver in use (issue 36).
-constexpr std::uint32_t kCheckpointVersion = 4;
+// 5: the law's declared state by name in place of the per-node critical stretch, and the force
+// terms' energies as one list (issue 37).
+constexpr std::uint32_t kCheckpointVersion = 5;
 
 struct Checkpoint {
   // What it belongs to: a restart refuses a checkpoint of another case or node file.
@@ -35,7 +38,10 @@ struct Checkpoint {
 
   State state;
   std::vector<std::uint8_t> broken_flags;  // BondList::broken
-  std::vector<double> node_critical_stretch;  // Model::node_critical_stretch (empty unless α > 0)
+  // Model::state_arrays' arrays with `checkpoint`, in declaration order, in the whole model's node
+  // and bond order. In the file: their count, then each one's name, extent (0 per node, 1 per
+  // bond), components and values; the other fields of a declaration are the law's, not the file's.
+  std::vector<StateArray> state_arrays;
 
   // The contact Verlet list: rebuilt at restart from the displacement of its last build.
   std::int64_t contact_rebuilds = 0;

@@ -65,6 +65,15 @@ VtuGrid frame_grid(const Model& model, const State& state, double time, std::int
     g.point_data.push_back(format.float32 ? make_array_as<float>("damage", damage) : make_array("damage", damage));
   }
   if (wanted("block")) g.point_data.push_back(make_array("block", model.nodes.block));  // an integer: as is
+  // The law's declared per-node history with `frames` (core/state_arrays.hpp), under its declared
+  // name, after the fields output.fields chooses, at the frames' precision.
+  for (const StateArray& a : model.state_arrays.all()) {
+    const StateDeclaration& d = a.declaration;
+    if (!d.frames || d.extent != StateExtent::per_node) continue;
+    if (d.components == 1) g.point_data.push_back(format.float32 ? make_array_as<float>(d.name, a.values) : make_array(d.name, a.values));
+    else g.point_data.push_back(format.float32 ? make_array(d.name, std::vector<float>(a.values.begin(), a.values.end()), d.components)
+                                               : make_array(d.name, a.values, d.components));
+  }
 
   // Cells: a vertex per node, then a line per broken bond (each once, from its end i < j), in node
   // order. Counted per node in parallel, so a frame does not walk every bond on one thread.

@@ -12,7 +12,10 @@
 // To add a model: a folder materials/<name>/ whose .cpp files define
 //   void register_material_<name>(MaterialRegistry&);
 // (CMake finds the folder and calls it: no other file lists the models), a test file
-// tests/materials/test_<name>.cpp, and its schema entry in pipeline/schema.py.
+// tests/materials/test_<name>.cpp, and its schema entry in pipeline/schema.py. A model with history
+// (a value per node or per bond that its breaking passes carry on) declares it
+// (state_declarations, core/state_arrays.hpp): the checkpoint, the halo, mixed's rollback and the
+// frames carry it without naming it.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -24,6 +27,7 @@
 
 #include "core/material.hpp"
 #include "core/nodes.hpp"
+#include "core/state_arrays.hpp"
 #include "core/registry.hpp"
 #include "parallel/row_split.hpp"
 
@@ -116,8 +120,8 @@ class BondModel {
   // their way (parallel/row_split.hpp says why): the law sweeps u_ghosts.rows.interior, calls
   // u_ghosts.wait(), then sweeps u_ghosts.rows.boundary; the same f, w, flags and report as the
   // plain call after the exchange, bit for bit. By default: wait, then the plain call (no overlap).
-  // With LAMMPS's per-node s0 (Model::node_critical_stretch) the breaking call's u_ghosts carries
-  // the ghosts' s0 too, in the same exchange: its wait() fills both.
+  // The breaking call's u_ghosts carries the ghosts' entries of the declared per-node arrays with
+  // `halo` too (state_declarations), in the same exchange: its wait() fills them all.
   virtual void add_force_overlapped(const Model& model, const Vec3Array& u, Vec3Array& f, double* w,
                                     const GhostsInFlight& u_ghosts) const {
     u_ghosts.wait();
@@ -129,6 +133,17 @@ class BondModel {
     u_ghosts.wait();
     return break_bonds_and_add_force(model, u, f, w, want_energy, lost_per_node);
   }
+  // The law's history (core/state_arrays.hpp): the arrays it keeps in Model::state_arrays, per node
+  // or per bond, and what the run does with each. Asked once the bonds exist (core/model.cpp
+  // declare_state); by default none.
+  virtual std::vector<StateDeclaration> state_declarations(const Model& model) const {
+    (void)model;
+    return {};
+  }
+  // Fills the declared arrays at rest (no displacement yet) from the model's bonds: their values
+  // before the first step. On a decomposed run it is called on each piece, whose ghosts have empty
+  // rows: the ghosts' entries of `halo` arrays are then their owners' (parallel/mpi_decomposed).
+  virtual void initialise_state(Model& model) const { (void)model; }
   // Only the breaking of break_bonds_and_add_force.
   virtual BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const = 0;
   // The largest stretch ratio over the intact bonds with no no-fail end and how many of them are

@@ -45,8 +45,7 @@ void ForceOperator::evaluate(State& s, double t) const {
     model_.bond_model->add_force_overlapped(model_, s.u, s.f, s.w.data(), u_ghosts);
     u_ghosts.wait();  // the terms below read the ghosts' u (a law waits before its boundary rows anyway)
   }
-  s.contact_energy = 0.0;
-  s.indenter_energy = 0.0;
+  s.term_energies.assign(term_energy_names().size(), 0.0);  // a term the scene lacks stays 0
   for (const auto& term : terms_) term->add_force(s, t);
 }
 
@@ -55,8 +54,7 @@ BreakReport ForceOperator::break_bonds_and_evaluate(State& s, double t) {
   BreakReport report;
   if (!decomposed_) report = model_.bond_model->break_bonds_and_add_force(model_, s.u, s.f, s.w.data(), true);
   else report = break_on_piece(s.u, s.f, s.w.data());
-  s.contact_energy = 0.0;
-  s.indenter_energy = 0.0;
+  s.term_energies.assign(term_energy_names().size(), 0.0);  // a term the scene lacks stays 0
   for (const auto& term : terms_) term->add_force(s, t);
   return report;
 }
@@ -73,10 +71,10 @@ BreakReport ForceOperator::break_bonds(State& s) {
 BreakReport ForceOperator::break_on_piece(Vec3Array& u, Vec3Array& f, double* w) {
   // Both ends of a bond that crosses ranks compute the same stretch from exact copies of the
   // displacements, so both break it in this call; the i < j copy counts it, on one rank only.
-  // LAMMPS's α rule: a bond's threshold min(s0_i, s0_j) reads its ghost end's s0, which the
-  // previous pass updated on the owner only (a ghost's empty row leaves +inf): it travels with u,
-  // in the same exchange (one message per neighbour), while the law sweeps the rows that read no
-  // ghost (parallel/row_split.hpp).
+  // A law's declared per-node history with `halo` (LAMMPS's α rule: a bond's threshold
+  // min(s0_i, s0_j) reads its ghost end's s0), which the previous pass updated on the owner only (a
+  // ghost's empty row leaves +inf): it travels with u, in the same exchange (one message per
+  // neighbour), while the law sweeps the rows that read no ghost (parallel/row_split.hpp).
   const GhostsInFlight ghosts = decomposed_->send_ghosts(breaking_ghost_values(u));
   lost_.assign(u[0].size(), 0.0);
   BreakReport report =
@@ -100,13 +98,12 @@ void ForceOperator::reduce_break_report(BreakReport& report) {
 
 NodeColumns ForceOperator::breaking_ghost_values(Vec3Array& u) const {
   NodeColumns values(u);
-  if (!model_.node_critical_stretch.empty()) values.add(model_.node_critical_stretch);
-  return values;
+  return add_halo_state(values, model_.state_arrays);
 }
 
 StretchRatio ForceOperator::stretch_ratio(State& s) const {
   if (!decomposed_) return model_.bond_model->stretch_ratio(model_, s.u);
-  // The ratio reads what the breaking test reads of a ghost (break_on_piece): u and LAMMPS's s0.
+  // The ratio reads what the breaking test reads of a ghost (break_on_piece): u and the declared history.
   decomposed_->update_ghosts(breaking_ghost_values(s.u));
   StretchRatio r = model_.bond_model->stretch_ratio(model_, s.u);  // a ghost's row is empty: owned rows only
   r.largest = -decomposed_->minimum(-r.largest);  // the maximum over the ranks, exactly

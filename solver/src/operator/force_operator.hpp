@@ -40,7 +40,7 @@ class ForceOperator {
   const Decomposed* decomposed() const { return decomposed_; }
 
   // s.f = force density at (s.u, t) (cleared, then the bonds and every active term add into it);
-  // also s.w (strain-energy density), s.contact_energy, s.indenter_energy and s.indenter_force.
+  // also s.w (strain-energy density), s.term_energies and s.indenter_force.
   void evaluate(State& s, double t) const;
   // Bonds over their critical stretch at s.u break (thesis §2.2: after the state update, before the
   // force there), then evaluate(s, t) in the same sweep over the bonds. Returns what broke now.
@@ -141,11 +141,11 @@ class ForceOperator {
   // reduction (decomposed only).
   void reduce_break_report(BreakReport& report);
   // A decomposed run's breaking pass with the force into f and w (break_bonds_and_evaluate's s.f and
-  // s.w, break_bonds' scratch arrays): u's ghosts (and LAMMPS's s0) travel while the law sweeps the
+  // s.w, break_bonds' scratch arrays): u's ghosts (and the declared history) travel while the law sweeps the
   // interior rows; the report summed over the ranks.
   BreakReport break_on_piece(Vec3Array& u, Vec3Array& f, double* w);
-  // u and, under LAMMPS's α rule, the per-node s0: what a breaking test reads of a ghost, in one
-  // halo exchange (one message per neighbour).
+  // u and the law's declared per-node history with `halo` (LAMMPS's s0 under its α rule): what a
+  // breaking test reads of a ghost, in one halo exchange (one message per neighbour).
   NodeColumns breaking_ghost_values(Vec3Array& u) const;
 };
 

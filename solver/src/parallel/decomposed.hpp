@@ -87,6 +87,11 @@ class Decomposed {
   // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
   // frames' damage reads). Collective.
   virtual void gather_broken(const BondList& local, BondList& global) const = 0;
+  // `width` values per directed bond of the owned rows of `local` (a per-bond array of the piece, as
+  // a law's declared history) in the whole model's bond order — the rows of `global`, whose offsets
+  // rank 0 holds — on rank 0 (empty elsewhere). Collective.
+  virtual std::vector<double> gather_bond_values(const BondList& local, const std::vector<double>& per_bond, int width,
+                                                 const BondList& global) const = 0;
   // The broken bonds of the owned rows, each once from its lower-numbered end (j > i), as rows of
   // the whole model on rank 0: lines.offsets over every node, lines.neighbour the global j's in row
   // order, lines.broken all 1 (empty elsewhere). What a gathered frame's line cells need, without

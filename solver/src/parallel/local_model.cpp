@@ -17,6 +17,15 @@ std::vector<T> pick(const std::vector<T>& a, const std::vector<std::int32_t>& gl
   return out;
 }
 
+// `width` values per entry: entry global[l]'s of `a` for every l.
+std::vector<double> pick_rows(const std::vector<double>& a, const std::vector<std::int32_t>& global, int width) {
+  const auto w = static_cast<std::size_t>(width);
+  std::vector<double> out(global.size() * w);
+  for (std::size_t l = 0; l < global.size(); ++l)
+    std::copy_n(a.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(global[l]) * w), w, out.begin() + static_cast<std::ptrdiff_t>(l * w));
+  return out;
+}
+
 // A list of global node numbers → the local numbers of those this rank owns, in the same order.
 std::vector<std::int32_t> owned_only(const std::vector<std::int32_t>& nodes, const std::vector<std::int32_t>& local_of,
                                      const std::vector<std::int32_t>& owner, int rank) {
@@ -64,10 +73,7 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
   m.density = pick(g.density, p.global);
   m.block_index = pick(g.block_index, p.global);
   m.no_fail = pick(g.no_fail, p.global);
-  // The breaking rules (Model::break_after_force, LAMMPS's per-node s0): the ghosts' s0 are copies
-  // that the operator refreshes from their owners before each breaking pass.
   m.break_after_force = g.break_after_force;
-  if (!g.node_critical_stretch.empty()) m.node_critical_stretch = pick(g.node_critical_stretch, p.global);
   m.nodes.dimension = g.nodes.dimension;
   m.nodes.grid_spacing = g.nodes.grid_spacing;
   for (int d = 0; d < 3; ++d) m.nodes.x[static_cast<std::size_t>(d)] = pick(g.nodes.x[static_cast<std::size_t>(d)], p.global);
@@ -142,6 +148,17 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
   // The law for the piece (materials/bond_model.hpp for_piece): by default built again from the
   // registry on the local model; a law whose per-node constants need whole rows copies them.
   m.bond_model = g.bond_model->for_piece(m, p.global, material_registry().get(g.bond_model->name()).make);
+  // The law's history (core/state_arrays.hpp) as the whole model holds it: per node, the local
+  // nodes' entries (a ghost's are copies that the operator refreshes from their owners before each
+  // breaking pass, for an array with `halo`); per bond, the owned rows'. A whole model that holds no
+  // rows (take) leaves the piece's at their initial value, for its maker to fill from the rows.
+  declare_state(m, false);
+  for (StateArray& a : m.state_arrays.all()) {
+    const StateArray* whole = g.state_arrays.find(a.declaration.name);
+    if (!whole) continue;
+    if (a.declaration.extent == StateExtent::per_node) a.values = pick_rows(whole->values, p.global, a.declaration.components);
+    else if (!take) a.values = rows_to_local(p, g.bonds, whole->values, m.bonds, a.declaration.components);
+  }
   return p;
 }
 
@@ -165,6 +182,28 @@ LocalPiece make_local_piece(const Model& g, const std::vector<std::int32_t>& own
 }
 
 std::vector<double> to_local(const LocalPiece& piece, const std::vector<double>& a) { return pick(a, piece.global); }
+
+std::vector<double> rows_to_local(const LocalPiece& piece, const BondList& global, const std::vector<double>& per_bond,
+                                  const BondList& local, int width) {
+  const auto w = static_cast<std::size_t>(width);
+  std::vector<double> out(static_cast<std::size_t>(local.offsets.back()) * w, 0.0);
+  for (std::int32_t l : piece.owned_local) {
+    const auto i = static_cast<std::size_t>(piece.global[static_cast<std::size_t>(l)]);
+    std::copy(per_bond.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(global.offsets[i]) * w),
+              per_bond.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(global.offsets[i + 1]) * w),
+              out.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(local.offsets[static_cast<std::size_t>(l)]) * w));
+  }
+  return out;
+}
+
+void state_to_local(const LocalPiece& piece, const BondList& global_bonds, const StateArrays& whole, StateArrays& local) {
+  for (StateArray& a : local.all()) {
+    const StateArray* from = whole.find(a.declaration.name);
+    if (!from || !a.declaration.checkpoint) continue;
+    if (a.declaration.extent == StateExtent::per_node) a.values = pick_rows(from->values, piece.global, a.declaration.components);
+    else a.values = rows_to_local(piece, global_bonds, from->values, piece.model.bonds, a.declaration.components);
+  }
+}
 
 void rows_to_local(const LocalPiece& piece, const BondList& global, BondList& local) {
   for (std::int32_t l : piece.owned_local) {

@@ -45,5 +45,13 @@ std::vector<double> to_local(const LocalPiece& piece, const std::vector<double>&
 // The broken flags of the piece's owned rows from the same rows of the whole model's bond list (a
 // restart: the checkpoint holds the whole model's flags). Ghost rows are empty.
 void rows_to_local(const LocalPiece& piece, const BondList& global, BondList& local);
+// The same for `width` values per directed bond of the whole model's `per_bond` (rows of `global`):
+// the piece's per-bond array over its rows `local` (a ghost's row is empty).
+std::vector<double> rows_to_local(const LocalPiece& piece, const BondList& global, const std::vector<double>& per_bond,
+                                  const BondList& local, int width);
+// A restart: every checkpointed array of the piece's declared state (core/state_arrays.hpp) from
+// the whole model's `whole` — per node, the local nodes' entries; per bond, the owned rows' over
+// `global_bonds`, the whole model's rows.
+void state_to_local(const LocalPiece& piece, const BondList& global_bonds, const StateArrays& whole, StateArrays& local);
 
 }  // namespace pd

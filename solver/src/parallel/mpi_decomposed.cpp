@@ -52,12 +52,14 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   row_split_ = split_rows(piece_);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
-  // LAMMPS's s0 at rest: the owned rows give the owned nodes' (the serial values: the same rows),
-  // and the ghosts take their owners' (a ghost's row is empty here).
-  if (skeleton.material.node_rule()) {
-    piece_.model.node_critical_stretch =
-        initial_node_critical_stretch(piece_.model.material, piece_.model.block_index, piece_.model.bonds);
-    halo_->exchange(piece_.model.node_critical_stretch);
+  // The law's history at rest (core/state_arrays.hpp): the owned rows give the owned nodes' and
+  // bonds' values (the serial values: the same rows), and the ghosts take their owners' for the
+  // arrays that travel with them (a ghost's row is empty here).
+  if (!piece_.model.state_arrays.empty()) {
+    piece_.model.bond_model->initialise_state(piece_.model);
+    NodeColumns ghosts;
+    add_halo_state(ghosts, piece_.model.state_arrays);
+    if (ghosts.width() > 0) halo_->exchange(ghosts);
   }
 }
 

@@ -59,6 +59,10 @@ class MpiDecomposed : public Decomposed {
   }
   void broadcast(std::vector<double>& values) const override;
   void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
+  std::vector<double> gather_bond_values(const BondList& local, const std::vector<double>& per_bond, int width,
+                                         const BondList& global) const override {
+    return sum_->gather_bond_values(local, per_bond, width, global);
+  }
   std::string broadcast(const std::string& bytes_on_rank_0) const override;
   std::vector<double> per_rank(double value) const override;
   void gather_broken_lines(const BondList& local, BondList& lines) const override;

@@ -88,14 +88,25 @@ std::vector<double> OrderedSum::gather(const std::vector<double>& per_node, int 
   return out;
 }
 
-void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
-  check_gather_size(directed_bonds_, "directed bonds' broken flags");  // the same on every rank
+// The MPI type of a gathered row entry.
+template <class T>
+MPI_Datatype mpi_type_of();
+template <>
+MPI_Datatype mpi_type_of<std::uint8_t>() { return MPI_UINT8_T; }
+template <>
+MPI_Datatype mpi_type_of<double>() { return MPI_DOUBLE; }
+
+template <class T>
+void OrderedSum::gather_row_values(const BondList& local, const std::vector<T>& local_values, int width,
+                                   const BondList& global, std::vector<T>& global_values, const char* what) const {
+  check_gather_size(directed_bonds_ * width, what);  // the same on every rank
   const double start = MPI_Wtime();
-  std::vector<std::uint8_t> flags;
+  const auto w = static_cast<std::size_t>(width);
+  std::vector<T> values;
   for (std::int32_t l : owned_local_)
-    flags.insert(flags.end(), local.broken.begin() + local.offsets[static_cast<std::size_t>(l)],
-                 local.broken.begin() + local.offsets[static_cast<std::size_t>(l) + 1]);
-  // Rank 0 knows every rank's owned rows (gathered_node_) and so how many flags each sends.
+    values.insert(values.end(), local_values.begin() + static_cast<std::ptrdiff_t>(w * static_cast<std::size_t>(local.offsets[static_cast<std::size_t>(l)])),
+                  local_values.begin() + static_cast<std::ptrdiff_t>(w * static_cast<std::size_t>(local.offsets[static_cast<std::size_t>(l) + 1])));
+  // Rank 0 knows every rank's owned rows (gathered_node_) and so how many values each sends.
   std::vector<int> counts, starts;
   if (rank_ == 0) {
     counts.assign(static_cast<std::size_t>(ranks_), 0);
@@ -103,23 +114,36 @@ void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
     for (int r = 0; r < ranks_; ++r) {
       for (int k = starts_[static_cast<std::size_t>(r)]; k < starts_[static_cast<std::size_t>(r) + 1]; ++k) {
         const auto g = static_cast<std::size_t>(gathered_node_[static_cast<std::size_t>(k)]);
-        counts[static_cast<std::size_t>(r)] += static_cast<int>(global.offsets[g + 1] - global.offsets[g]);
+        counts[static_cast<std::size_t>(r)] += width * static_cast<int>(global.offsets[g + 1] - global.offsets[g]);
       }
       starts[static_cast<std::size_t>(r) + 1] = starts[static_cast<std::size_t>(r)] + counts[static_cast<std::size_t>(r)];
     }
   }
-  std::vector<std::uint8_t> all(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
-  MPI_Gatherv(flags.data(), static_cast<int>(flags.size()), MPI_UINT8_T, all.data(), counts.data(), starts.data(),
-              MPI_UINT8_T, 0, comm_);
+  std::vector<T> all(rank_ == 0 ? static_cast<std::size_t>(starts.back()) : 0);
+  MPI_Gatherv(values.data(), static_cast<int>(values.size()), mpi_type_of<T>(), all.data(), counts.data(), starts.data(),
+              mpi_type_of<T>(), 0, comm_);
   ++calls_;
-  bytes_ += static_cast<std::int64_t>(flags.size());
+  bytes_ += static_cast<std::int64_t>(values.size() * sizeof(T));
   seconds_ += MPI_Wtime() - start;
   if (rank_ != 0) return;
+  global_values.resize(w * static_cast<std::size_t>(global.offsets.back()));
   std::size_t at = 0;
   for (std::int32_t g32 : gathered_node_) {
     const auto g = static_cast<std::size_t>(g32);
-    for (std::int64_t k = global.offsets[g]; k < global.offsets[g + 1]; ++k) global.broken[static_cast<std::size_t>(k)] = all[at++];
+    for (std::size_t e = w * static_cast<std::size_t>(global.offsets[g]); e < w * static_cast<std::size_t>(global.offsets[g + 1]); ++e)
+      global_values[e] = all[at++];
   }
+}
+
+void OrderedSum::gather_rows(const BondList& local, BondList& global) const {
+  gather_row_values(local, local.broken, 1, global, global.broken, "directed bonds' broken flags");
+}
+
+std::vector<double> OrderedSum::gather_bond_values(const BondList& local, const std::vector<double>& per_bond, int width,
+                                                   const BondList& global) const {
+  std::vector<double> out;
+  gather_row_values(local, per_bond, width, global, out, "values of directed bonds");
+  return out;
 }
 
 void OrderedSum::gather_lines(const BondList& local, const std::vector<std::int32_t>& global, BondList& lines) const {

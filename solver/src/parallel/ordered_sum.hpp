@@ -26,6 +26,10 @@ class OrderedSum {
   // The broken flags of the owned rows of `local` (the piece's bond list) into the same rows of
   // `global` (the whole model's), on rank 0. Collective.
   void gather_rows(const BondList& local, BondList& global) const;
+  // `width` values per directed bond of the owned rows of `local` (per_bond, over local's rows) in
+  // the whole model's bond order (rows of `global`), on rank 0 (empty elsewhere). Collective.
+  std::vector<double> gather_bond_values(const BondList& local, const std::vector<double>& per_bond, int width,
+                                         const BondList& global) const;
   // The broken bonds j > i of the owned rows of `local` (global: the piece's global numbers), as
   // rows of the whole model on rank 0 (Decomposed::gather_broken_lines). Collective.
   void gather_lines(const BondList& local, const std::vector<std::int32_t>& global, BondList& lines) const;
@@ -35,6 +39,10 @@ class OrderedSum {
   double seconds() const { return seconds_; }
 
  private:
+  // gather_rows and gather_bond_values: the owned rows' values into global_values over global's rows.
+  template <class T>
+  void gather_row_values(const BondList& local, const std::vector<T>& local_values, int width, const BondList& global,
+                         std::vector<T>& global_values, const char* what) const;
   MPI_Comm comm_;
   int rank_ = 0;
   std::int64_t global_nodes_ = 0;

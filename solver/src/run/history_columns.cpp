@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/reactions.hpp"
+#include "forces/force_term.hpp"
 
 namespace pd {
 
@@ -18,19 +19,24 @@ void HistoryColumns::add(std::vector<std::string> names, Fill fill) {
 // (issue 16 item 6: a program reads the same names from every run), then one triple per indenter
 // and per output.reactions set, which the case names.
 const std::vector<std::string>& fixed_history_columns() {
-  static const std::vector<std::string> names{"contact_energy", "indenter_energy", "broken_bond_energy",
-                                              "contact_rebuilds", "mode"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out = term_energy_names();  // contact_energy, indenter_energy
+    for (const char* name : {"broken_bond_energy", "contact_rebuilds", "mode"}) out.push_back(name);
+    return out;
+  }();
   return names;
 }
 
 HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrator* integrator,
                                const NeighbourList* contact_list) {
   const Model* m = &model;
-  // A term the case does not have is 0: the operator zeroes both energies before its terms add to
-  // them (operator/force_operator.cpp), and the broken-bond energy stays 0 when nothing can break.
-  add({"contact_energy", "indenter_energy", "broken_bond_energy"}, [](const HistoryInputs& in, std::vector<double>& out) {
-    out.push_back(in.state.contact_energy);
-    out.push_back(in.state.indenter_energy);
+  // A term the case does not have is 0: the operator zeroes every term's energy before the terms
+  // add to them (operator/force_operator.cpp), and the broken-bond energy stays 0 when nothing can break.
+  std::vector<std::string> energies = term_energy_names();
+  energies.push_back("broken_bond_energy");
+  add(energies, [](const HistoryInputs& in, std::vector<double>& out) {
+    for (std::size_t k = 0; k < term_energy_names().size(); ++k)
+      out.push_back(k < in.state.term_energies.size() ? in.state.term_energies[k] : 0.0);
     out.push_back(in.broken_energy);  // validation.md C4 with breaking
   });
   // The operator's list (contact_list; on a decomposed run the piece's: every rank builds together).

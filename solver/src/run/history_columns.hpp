@@ -20,8 +20,9 @@ struct HistoryInputs {
   double broken_energy;  // Σ energy of bonds at the moment they broke [J]
 };
 
-// The columns after wall_time that every history.csv has, in order: contact_energy,
-// indenter_energy, broken_bond_energy, contact_rebuilds, mode.
+// The columns after wall_time that every history.csv has, in order: the force terms' energies
+// (forces/force_term.hpp term_energy_names: contact_energy, indenter_energy), broken_bond_energy,
+// contact_rebuilds, mode.
 const std::vector<std::string>& fixed_history_columns();
 
 class HistoryColumns {

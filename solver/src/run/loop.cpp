@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "forces/indenter.hpp"
+#include "parallel/gather_state.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
 #include "run/progress.hpp"
@@ -157,7 +158,7 @@ TimeLoop::TimeLoop(const RunOptions& opt, Prepared& p, Start& s, const HistoryCo
 LoopEnd TimeLoop::run() {
   // The balance's constant: the energy at step 0, or E + D + B − W of the state a restart read back.
   energies.at(loop.step);
-  balance.start(energies.kinetic + energies.strain + state.contact_energy + state.indenter_energy, state.damping_work,
+  balance.start(state.plus_term_energies(energies.kinetic + energies.strain), state.damping_work,
                 loop.broken_energy,
                 state.external_work);
 
@@ -181,8 +182,8 @@ std::optional<Failure> TimeLoop::advance() {
   // E + D + B − W before the step (validation.md C4), for a quasi-static load step's ledger in
   // watch(); without the kinetic energy when the last step was a load step too (see there).
   const bool after_load_step = integrator.step_mode().value_or(0) == 1;
-  const double held_before = (after_load_step ? 0.0 : energies.kinetic) + energies.strain + state.contact_energy +
-                             state.indenter_energy + state.damping_work + loop.broken_energy - state.external_work;
+  const double held_before = state.plus_term_energies((after_load_step ? 0.0 : energies.kinetic) + energies.strain) +
+                             state.damping_work + loop.broken_energy - state.external_work;
   if (std::optional<Failure> failed = step(next, h)) return failed;
   if (std::optional<Failure> failed = watch(h, held_before)) return failed;
   warn_indenter_depth();
@@ -221,7 +222,7 @@ std::optional<Failure> TimeLoop::step(const NextStep& next, double& h) {
 std::optional<Failure> TimeLoop::watch(double h, double held_before) {
   if (std::optional<Failure> failed = non_finite(h)) return failed;
   energies.at(loop.step);
-  const double energy = energies.kinetic + energies.strain + state.contact_energy + state.indenter_energy;
+  const double energy = state.plus_term_energies(energies.kinetic + energies.strain);
   // A quasi-static load step neglects inertia: it jumps to the next equilibrium, and what the jump
   // gives up is dissipated by that assumption, not lost from the book — the kinetic energy left by
   // explicit steps before a return (mixed), and the strain energy that bonds breaking at a fixed
@@ -356,6 +357,7 @@ const State& TimeLoop::output_state() {
   gathered.w = dec->gather(state.w);
   gathered.copy_totals(state);
   if (p.whole_bonds) dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
+  gather_state(*dec, p.model, [](const StateDeclaration& d) { return d.frames; });  // the frames' declared fields
   return gathered;
 }
 
@@ -434,11 +436,8 @@ void TimeLoop::timed(Write write) {
 // a serial run: whole, of one step, and readable on any rank count. Collective.
 void TimeLoop::write_restart() {
   const State& whole = output_state();
-  // LAMMPS's α rule: the owners' s0 in global node order, as the serial run holds them.
-  if (dec && !p.model.node_critical_stretch.empty()) {
-    std::vector<double> s0 = dec->gather(dec->piece().model.node_critical_stretch);
-    if (out) p.model.node_critical_stretch = std::move(s0);
-  }
+  // The law's declared history (core/state_arrays.hpp) in the whole model's order, as the serial run holds it.
+  if (dec) gather_state(*dec, p.model, [](const StateDeclaration& d) { return d.checkpoint; });
   // The contact list's displacement at its last build, from the pieces (forces/contact_on_piece).
   const NeighbourList& contact_list = p.op->model().contact_list;
   const Vec3Array contact_u_build =

@@ -144,7 +144,7 @@ void release(std::vector<T>& a) {
 std::int64_t node_data_bytes(const Model& m) {
   std::int64_t bytes = bytes_of(m.nodes.volume) + bytes_of(m.nodes.block) + bytes_of(m.density) +
                        bytes_of(m.block_index) + bytes_of(m.no_fail) + bytes_of(m.bonds.offsets) +
-                       bytes_of(m.node_critical_stretch);
+                       m.state_arrays.bytes();
   for (const auto& x : m.nodes.x) bytes += bytes_of(x);
   for (const auto& set : m.nodes.sets) bytes += bytes_of(set.member);
   for (const auto& pm : m.conditions.prescribed) bytes += bytes_of(pm.nodes);
@@ -185,8 +185,9 @@ void release_whole_node_data(Prepared& p) {
 #ifdef __GLIBC__
   malloc_trim(0);
 #endif
-  // LAMMPS's s0 stays: a checkpoint's gather is collective and every rank decides by its emptiness
-  // (run/loop.cpp write_restart); 8 bytes a node, and only with the α rule.
+  // The declared per-node history stays: a checkpoint's gather is collective and every rank
+  // gathers what it declares (run/loop.cpp write_restart); 8 bytes a node each, and only for a law
+  // with history (PMB's α rule).
 }
 
 std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
@@ -211,10 +212,9 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
     p->model = build_model_without_bonds(c, std::move(nodes));
     p->model.bonds.offsets = count_bonds(p->model.nodes.x, bond_search_cutoff(c));
     p->model.bond_model = material_registry().get("pmb").make(p->model);
-    // LAMMPS's s0 per node: each piece computes its own; the whole array (8 bytes a node) is where
-    // rank 0 gathers it for a checkpoint and a restart reads it back.
-    if (p->model.material.node_rule())
-      p->model.node_critical_stretch.assign(p->model.nodes.size(), std::numeric_limits<double>::infinity());
+    // The law's per-node history: each piece computes its own; the whole arrays (8 bytes a node
+    // each) are where rank 0 gathers them for a checkpoint and a restart reads them back.
+    declare_state(p->model, false);
   }
   p->build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
   p->nodes = static_cast<std::int64_t>(p->model.nodes.size());

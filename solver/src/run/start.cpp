@@ -6,6 +6,7 @@
 #include "io/read_file.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
+#include "run/state_checkpoint.hpp"
 #include "run/text.hpp"
 
 namespace pd {
@@ -88,7 +89,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
                 " changed since it was written)");
   const auto directed = static_cast<std::size_t>(p.directed_bonds());
   if (checkpoint.nodes != n || checkpoint.directed_bonds != directed || checkpoint.broken_flags.size() != directed ||
-      checkpoint.node_critical_stretch.size() != model.node_critical_stretch.size() ||
+      !fits_checkpointed_state(checkpoint.state_arrays, model, n, directed) ||
       checkpoint.integrator != integrator.name() ||
       (model.contact.pairs && checkpoint.contact_rebuilds > 0 && checkpoint.contact_u_build[0].size() != n))
     throw Error(where + "the checkpoint does not fit this model (" + std::to_string(checkpoint.nodes) + " nodes, " +
@@ -107,9 +108,7 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
   if (p.decomposed) restore_piece(p, checkpoint.state, s);
   else s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
   if (!p.whole_bonds) std::vector<std::uint8_t>().swap(model.bonds.broken);  // the rows are in the piece now
-  model.node_critical_stretch = std::move(checkpoint.node_critical_stretch);  // LAMMPS's α rule (empty otherwise)
-  if (p.decomposed && !model.node_critical_stretch.empty())  // the piece's owned nodes and ghosts, global order
-    p.decomposed->piece().model.node_critical_stretch = to_local(p.decomposed->piece(), model.node_critical_stretch);
+  restore_checkpointed_state(std::move(checkpoint.state_arrays), model, p.decomposed ? &p.decomposed->piece() : nullptr);
   if (model.contact.pairs && p.decomposed) {
     // The piece's record of the last build; its first force evaluation searches again at that
     // displacement on every rank (forces/contact_on_piece), the list the serial restore finds.
@@ -206,7 +205,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, 
   k.integrator_state = std::move(integrator_state);
   k.state = whole;
   k.broken_flags = model.bonds.broken;
-  k.node_critical_stretch = model.node_critical_stretch;
+  k.state_arrays = checkpointed_state(model);
   // The operator's list: the whole model's, or on a decomposed run the piece's record, whose
   // displacement at the last build the caller gathered in global node order (contact_u_build).
   const NeighbourList& list = p.op->model().contact_list;

@@ -13,6 +13,7 @@
 #include "jacobian_check.hpp"
 #include "lattice.hpp"
 #include "materials/pmb/pmb.hpp"
+#include "pmb_s0.hpp"
 
 namespace {
 
@@ -54,18 +55,18 @@ bool broken(const pd::Model& m, std::size_t i, std::size_t j) {
 TEST(PmbLammps, CriticalStretchPerNodeIsS00MinusAlphaTimesTheSmallestStretch) {
   pd::Model m = chain(4, kAlpha);
   // At rest every s0_i is s00 (LAMMPS's set-up pass at zero stretch).
-  ASSERT_EQ(m.node_critical_stretch.size(), 4u);
-  for (double s0 : m.node_critical_stretch) EXPECT_EQ(s0, kS00);
+  ASSERT_EQ(pdtest::s0_of(m).size(), 4u);
+  for (double s0 : pdtest::s0_of(m)) EXPECT_EQ(s0, kS00);
   // Stretches 0.01 (0–1), 0.02 (1–2), −0.005 (2–3): compression raises s0 (LAMMPS peri/pmb).
   const pd::Vec3Array u = displacement_x({0.0, 0.01, 0.03, 0.025});
   pd::Vec3Array f = pd::make_vec3(4);
   m.bond_model->break_bonds_and_add_force(m, u, f, nullptr, false);
   const double s01 = ((1.0 + 0.01) - 0.0 - 1.0) / 1.0;  // the stretch of 0–1 as the kernel rounds it
-  EXPECT_NEAR(m.node_critical_stretch[0], kS00 - kAlpha * 0.01, 1e-15);   // 0.0475
-  EXPECT_NEAR(m.node_critical_stretch[1], kS00 - kAlpha * 0.01, 1e-15);   // min(0.01, 0.02)
-  EXPECT_NEAR(m.node_critical_stretch[2], kS00 + kAlpha * 0.005, 1e-15);  // min(0.02, −0.005): 0.05125
-  EXPECT_NEAR(m.node_critical_stretch[3], kS00 + kAlpha * 0.005, 1e-15);
-  EXPECT_EQ(m.node_critical_stretch[0], kS00 - kAlpha * s01);  // exactly LAMMPS's s00 − α·s
+  EXPECT_NEAR(pdtest::s0_of(m)[0], kS00 - kAlpha * 0.01, 1e-15);   // 0.0475
+  EXPECT_NEAR(pdtest::s0_of(m)[1], kS00 - kAlpha * 0.01, 1e-15);   // min(0.01, 0.02)
+  EXPECT_NEAR(pdtest::s0_of(m)[2], kS00 + kAlpha * 0.005, 1e-15);  // min(0.02, −0.005): 0.05125
+  EXPECT_NEAR(pdtest::s0_of(m)[3], kS00 + kAlpha * 0.005, 1e-15);
+  EXPECT_EQ(pdtest::s0_of(m)[0], kS00 - kAlpha * s01);  // exactly LAMMPS's s00 − α·s
   for (int k = 0; k < 6; ++k) EXPECT_EQ(m.bonds.broken[static_cast<std::size_t>(k)], 0);
 }
 
@@ -86,7 +87,7 @@ TEST(PmbLammps, ABondBreaksOverTheSmallerCriticalStretchOfItsEndsFromThePrevious
   EXPECT_FALSE(broken(m, 3, 2));
   // Without α (s0 fixed at s00) the same state breaks 2–3 and keeps 0–1.
   pd::Model fixed = chain(4, 0.0);
-  EXPECT_TRUE(fixed.node_critical_stretch.empty());
+  EXPECT_TRUE(pdtest::s0_of(fixed).empty());
   fixed.bond_model->break_bonds_and_add_force(fixed, displacement_x({0.0, 0.048, 0.068, 0.119}), f, nullptr, false);
   EXPECT_FALSE(broken(fixed, 0, 1));
   EXPECT_TRUE(broken(fixed, 2, 3));

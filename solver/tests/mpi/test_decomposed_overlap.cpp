@@ -31,6 +31,7 @@
 #include "materials/pmb/pmb.hpp"
 #include "operator/force_operator.hpp"
 #include "parallel/mpi_decomposed.hpp"
+#include "pmb_s0.hpp"
 
 namespace {
 
@@ -230,6 +231,10 @@ class WatchedDecomposed : public pd::Decomposed {
   std::vector<double> gather(const std::vector<double>& v, int width) const override { return d_.gather(v, width); }
   void broadcast(std::vector<double>& v) const override { d_.broadcast(v); }
   void gather_broken(const pd::BondList& l, pd::BondList& g) const override { d_.gather_broken(l, g); }
+  std::vector<double> gather_bond_values(const pd::BondList& l, const std::vector<double>& v, int w,
+                                         const pd::BondList& g) const override {
+    return d_.gather_bond_values(l, v, w, g);
+  }
   void gather_broken_lines(const pd::BondList& l, pd::BondList& g) const override { d_.gather_broken_lines(l, g); }
   std::vector<double> per_rank(double v) const override { return d_.per_rank(v); }
   std::string broadcast(const std::string& b) const override { return d_.broadcast(b); }
@@ -277,7 +282,7 @@ std::vector<std::uint8_t> row_flags(const pd::Model& m, std::size_t l) {
 constexpr double kS0Poison = -1.0;
 void poison_ghost_s0(const pd::LocalPiece& p, pd::Model& m) {
   for (std::int32_t l : p.ghost_local)
-    if (!m.node_critical_stretch.empty()) m.node_critical_stretch[static_cast<std::size_t>(l)] = kS0Poison;
+    if (std::vector<double>* s0 = pd::node_critical_stretch(m)) (*s0)[static_cast<std::size_t>(l)] = kS0Poison;
 }
 
 class OverlapBreaking : public ::testing::TestWithParam<std::tuple<std::string, int>> {};  // kind, threads per rank
@@ -296,7 +301,7 @@ TEST_P(OverlapBreaking, EachPassSweepsInteriorRowsBeforeItsOneWaitAndBoundaryRow
   const pd::RowSplit& split = dec.row_split();
   const std::size_t n = p.size();
   const bool per_node_s0 = kind == "lammps";
-  ASSERT_EQ(model.node_critical_stretch.empty(), !per_node_s0);
+  ASSERT_EQ(pdtest::s0_of(model).empty(), !per_node_s0);
 
   // Two passes over stretches around s0 (≈ 4.4e-5 here: the wavy field's stretches reach about its
   // amplitude), so that some bonds break in each, in interior and boundary rows alike: break_bonds
@@ -308,7 +313,7 @@ TEST_P(OverlapBreaking, EachPassSweepsInteriorRowsBeforeItsOneWaitAndBoundaryRow
   serial.u = u1;
   const pd::BreakReport serial1 = serial_op.break_bonds(serial);
   const std::vector<std::uint8_t> serial_flags1 = global.bonds.broken;
-  const std::vector<double> serial_s01 = global.node_critical_stretch;
+  const std::vector<double> serial_s01 = pdtest::s0_of(global);
   serial.u = u2;
   const pd::BreakReport serial2 = serial_op.break_bonds_and_evaluate(serial, 0.0);
   ASSERT_GT(serial1.broken, 0);
@@ -356,7 +361,7 @@ TEST_P(OverlapBreaking, EachPassSweepsInteriorRowsBeforeItsOneWaitAndBoundaryRow
       const std::vector<std::uint8_t> mine = row_flags(model, li);
       ASSERT_EQ(static_cast<std::int64_t>(mine.size()), global.bonds.offsets[g + 1] - global.bonds.offsets[g]);
       for (std::size_t q = 0; q < mine.size(); ++q) differ += mine[q] != flags[static_cast<std::size_t>(global.bonds.offsets[g]) + q];
-      if (per_node_s0) differ += !same_bits(model.node_critical_stretch[li], s0[g]);
+      if (per_node_s0) differ += !same_bits(pdtest::s0_of(model)[li], s0[g]);
     }
     EXPECT_EQ(differ, 0);
   };
@@ -410,7 +415,7 @@ TEST_P(OverlapBreaking, EachPassSweepsInteriorRowsBeforeItsOneWaitAndBoundaryRow
   check_flags(interior_broke, boundary_broke);
   EXPECT_GT(dec.total(interior_broke), 0);
   if (dec.ranks() > 1) EXPECT_GT(dec.total(boundary_broke), 0);
-  expect_serial_flags_and_s0(global.bonds.broken, global.node_critical_stretch);
+  expect_serial_flags_and_s0(global.bonds.broken, pdtest::s0_of(global));
   EXPECT_EQ(report2.broken, serial2.broken);
   EXPECT_TRUE(same_bits(report2.energy, serial2.energy));
   // The force at the wait that precedes the force sweep (PMB: u's; LPS: P's, its first sweep gives

@@ -106,10 +106,10 @@ Outcome run_both(const pd::Model& global_in, const pd::Vec3Array& v0, int steps,
     const pd::StepReport& rs = serial_verlet.last_step();
     out.broken += rs.broken_now;
     std::vector<double> values = {op.kinetic_energy(local), op.strain_energy(local), local.external_work,
-                                  local.damping_work,       r.broken_energy_now,    local.contact_energy, local.indenter_energy, t, dt};
+                                  local.damping_work,       r.broken_energy_now,    pd::term_energy(local, "contact"), pd::term_energy(local, "indenters"), t, dt};
     std::vector<double> serial_values = {serial_op.kinetic_energy(serial), serial_op.strain_energy(serial),
                                          serial.external_work,             serial.damping_work,
-                                         rs.broken_energy_now,             serial.contact_energy, serial.indenter_energy, ts, dts};
+                                         rs.broken_energy_now,             pd::term_energy(serial, "contact"), pd::term_energy(serial, "indenters"), ts, dts};
     bool same = r.broken_now == rs.broken_now && r.iterations == rs.iterations && r.rejected == rs.rejected &&
                 local.indenter_force.size() == serial.indenter_force.size();
     out.iterations += rs.iterations;
@@ -150,8 +150,8 @@ Outcome run_both(const pd::Model& global_in, const pd::Vec3Array& v0, int steps,
     if (bad_steps > 3) break;
   }
   out.external_work = serial.external_work;
-  out.contact_energy = serial.contact_energy;
-  out.indenter_energy = serial.indenter_energy;
+  out.contact_energy = pd::term_energy(serial, "contact");
+  out.indenter_energy = pd::term_energy(serial, "indenters");
   out.indenter_force = serial.indenter_force;
   return out;
 }

@@ -91,13 +91,33 @@ std::int64_t break_bonds_and_add_pmb_force(Model& model, const Vec3Array& u, Vec
                                            double* energy_density = nullptr, double* broken_energy = nullptr,
                                            double* lost_per_node = nullptr, RowSubset rows = {});
 
+// LAMMPS's critical-stretch rule (validation.md F5), when some α > 0 (MaterialTable::node_rule):
+// s0_i = max_j (s0_ij − α_ij·s_ij) over i's intact bonds at the previous breaking pass (= s0 −
+// α·min_j s_ij for one block), +inf for a node without intact bonds; a bond breaks when
+// s > min(s0_i, s0_j). PMB's history: a per-node array it declares (core/state_arrays.hpp) under this
+// name, checkpointed, exchanged with ghosts (a bond reads its far end's s0), rolled back with the
+// broken flags, not written to frames (materials/pmb/pmb_state.cpp).
+constexpr const char* kNodeCriticalStretch = "node_critical_stretch";
+// s0_i per node, or null when the rule is off (no α > 0: nothing declared).
+std::vector<double>* node_critical_stretch(Model& model);
+const std::vector<double>* node_critical_stretch(const Model& model);
+// s0_i's declaration: per node, +inf before the set-up pass, checkpointed, with the ghosts, rolled back.
+StateDeclaration node_critical_stretch_declaration();
+// What PMB declares: s0_i when some α > 0, else nothing.
+std::vector<StateDeclaration> pmb_state_declarations(const Model& model);
+// s0_i of LAMMPS's rule at rest (every s_ij = 0): max_j s0_ij over i's intact bonds, +inf without
+// one — what LAMMPS's set-up force pass leaves before the first step (validation.md F5). A row of
+// `bonds` per node of `block` (an empty row, a ghost's: +inf).
+std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
+                                                  const BondList& bonds);
+
 // True when the model breaks bonds by LAMMPS peri/pmb's rules (Model::break_after_force, or a
 // per-node critical stretch: some α > 0); then break_bonds_lammps_rules is the breaking pass.
 bool uses_lammps_rules(const Model& model);
 
 // One breaking pass by LAMMPS peri/pmb's rules (validation.md F5), and, if f is not null, the force:
 // - a bond breaks when s > min(s0_i, s0_j), s0_i the per-node value left by the previous pass
-//   (Model::node_critical_stretch), or s > s0_ij when every α is 0; never with a no-fail end;
+//   (node_critical_stretch above), or s > s0_ij when every α is 0; never with a no-fail end;
 // - then s0_i ← max_j (s0_ij − α_ij·s_ij) over the bonds intact at the start of the pass
 //   (s0 − α·min_j s_ij for one block: Parks et al., LAMMPS pair peri/pmb);
 // - Model::break_after_force: f gets the force of every bond intact at the start of the pass (a
@@ -108,7 +128,7 @@ bool uses_lammps_rules(const Model& model);
 // decomposed run) gets each node's share instead, as break_bonds_and_add_pmb_force. Each row writes
 // only its own flags and s0: the same for any thread count. Returns the bonds broken now, each
 // counted once.
-// ghosts (a decomposed run): u's ghosts and, with per-node s0, node_critical_stretch's are still on
+// ghosts (a decomposed run): u's ghosts and, with per-node s0, the ghosts' s0 are still on
 // their way (one exchange, operator/force_operator): the pass sweeps the interior rows, waits, then
 // the boundary rows (parallel/row_split.hpp); the new s0 replace the old once both halves have
 // read them. The same bits as the pass over every row after the exchange.
@@ -153,6 +173,10 @@ class PmbModel : public BondModel {
                                                    bool want_energy, double* lost_per_node,
                                                    const GhostsInFlight& u_ghosts) const override;
   BreakReport break_bonds(Model& model, const Vec3Array& u, bool want_energy) const override;
+  std::vector<StateDeclaration> state_declarations(const Model& model) const override {
+    return pmb_state_declarations(model);
+  }
+  void initialise_state(Model& model) const override;
   StretchRatio stretch_ratio(const Model& model, const Vec3Array& u) const override { return pmb_stretch_ratio(model, u); }
   std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u) const override;
   std::vector<double> damage(const Model& model) const override { return bond_damage(model); }

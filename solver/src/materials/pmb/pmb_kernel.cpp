@@ -181,7 +181,7 @@ std::int64_t break_bonds_and_add_pmb_force(Model& m, const Vec3Array& u, Vec3Arr
   return newly;
 }
 
-bool uses_lammps_rules(const Model& m) { return m.break_after_force || !m.node_critical_stretch.empty(); }
+bool uses_lammps_rules(const Model& m) { return m.break_after_force || node_critical_stretch(m) != nullptr; }
 
 std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f, double* energy_density,
                                       double* broken_energy, double* lost_per_node, const GhostsInFlight* ghosts) {
@@ -197,9 +197,10 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
     return 0;
   }
   const auto n = static_cast<std::size_t>(a.nodes);
-  const bool node_rule = !m.node_critical_stretch.empty();
+  std::vector<double>* s0_now = node_critical_stretch(m);
+  const bool node_rule = s0_now != nullptr;
   const bool force_first = m.break_after_force;
-  const double* s0_node = node_rule ? m.node_critical_stretch.data() : nullptr;
+  const double* s0_node = node_rule ? s0_now->data() : nullptr;
   // A row not swept (a ghost's, on a decomposed run: its row is empty) keeps +inf, as a row without
   // intact bonds gets in the sweep (LAMMPS's DBL_MAX).
   std::vector<double> s0_next(node_rule ? n : 0, std::numeric_limits<double>::infinity());
@@ -266,7 +267,7 @@ std::int64_t break_bonds_lammps_rules(Model& m, const Vec3Array& u, Vec3Array* f
     return newly;
   };
   const std::int64_t newly = sweep(pass);
-  if (node_rule) m.node_critical_stretch.swap(s0_next);  // every row read the previous s0 above
+  if (node_rule) s0_now->swap(s0_next);  // every row read the previous s0 above
   if (broken_energy && !lost_per_node && newly > 0)
     *broken_energy += exact_sum(lost);  // exact, as update_broken_bonds
   return newly;
@@ -278,7 +279,8 @@ StretchRatio pmb_stretch_ratio(const Model& m, const Vec3Array& u) {
   const PmbArrays a = pmb_arrays(m, u);
   // The thresholds break_bonds compares with: LAMMPS's per-node s0 of the previous pass when its α
   // rule is on (break_bonds_lammps_rules), else the pair table's (break_row).
-  const double* s0_node = m.node_critical_stretch.empty() ? nullptr : m.node_critical_stretch.data();
+  const std::vector<double>* s0_now = node_critical_stretch(m);
+  const double* s0_node = s0_now ? s0_now->data() : nullptr;
   const double* s0_pair = m.material.critical_pair.data();
   const std::uint8_t* no_fail = m.no_fail.data();
   double largest = 0.0;
