@@ -396,7 +396,7 @@ void read_settings(const Checker& ck, const json& j, const SettingsSection& sect
 }
 
 // dt_initial, dt_min and dt_max of adaptive, quasi_static or implicit, against one another;
-// quasi_static takes a dt_initial outside [dt_min, dt_max] to the nearest end instead.
+// initial_too false: dt_initial is not checked (quasi_static lowers one above dt_max to it).
 void check_step_limits(const Checker& ck, const std::string& section, const std::optional<double>& dt_initial,
                        const std::optional<double>& dt_min, const std::optional<double>& dt_max, bool initial_too) {
   if (dt_min && dt_max && *dt_min > *dt_max) ck.fail(section + ".dt_min", "is larger than " + section + ".dt_max");

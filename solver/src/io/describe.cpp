@@ -1,5 +1,6 @@
 // pdsolve --describe: the case.json keys the reader accepts, described from the structs' own
-// defaults (core/case.hpp) and the registries' keys, checked against the reader's key lists.
+// defaults (core/case.hpp), the registries' keys and the settings sections' tables
+// (io/case_settings.cpp), checked against the reader's key lists.
 #include "io/describe.hpp"
 
 #include <limits>
@@ -90,8 +91,8 @@ json describe_case() {
   const InitialCondition ic;
   const IndenterSettings ind;
 
-  // Ranges and hand-checked choices as case_reader.cpp enforces them (time.max_steps and the other
-  // counts have no maximum but int64's); defaults from the structs.
+  // The keys outside the settings sections: ranges and hand-checked choices as case_reader.cpp
+  // enforces them; defaults from the structs.
   json keys = json::object();
   keys["format_version"] = required("integer", {{"choices", {kCaseFormatVersion}}});
   keys["case"] = defaulted("string", c.name);
