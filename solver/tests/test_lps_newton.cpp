@@ -41,7 +41,7 @@ pd::Case quasi_static_case(const std::string& solver) {
   c.file = "lps_bar.yaml";
   c.time.end = 1.0;
   c.quasi_static.residual_tol = 1e-10;
-  c.quasi_static.tol = 1e-8;
+  c.quasi_static.newton_tol = 1e-8;
   c.quasi_static.linear_solver = solver;
   return c;
 }

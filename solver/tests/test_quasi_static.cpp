@@ -36,7 +36,7 @@ pd::Case bar_case() {
   pd::Case c;
   c.time.end = 1.0;
   c.quasi_static.residual_tol = 1e-10;
-  c.quasi_static.tol = 1e-8;
+  c.quasi_static.newton_tol = 1e-8;
   return c;
 }
 

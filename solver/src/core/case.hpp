@@ -44,42 +44,48 @@ struct AdaptiveSettings {
   std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: derived from eq. 2.5
 };
 
-// quasi_static: time is a load parameter; each load step is solved for equilibrium by Newton
-// (integrators/quasi_static.hpp), its size set by eq. 2.8 from the iterations it took.
-struct QuasiStaticSettings {
-  double tol = 1e-6;           // TOL on ω_K = ‖Δu_K‖/‖u_K − u_n‖ (eq. 2.6 for Newton's corrections)
-  double residual_tol = 1e-8;  // equilibrium: ‖V f‖ over free components ≤ this × the load (reactions, body forces)
-  int kd = 5;                  // K_d: the Newton iterations the load step is aimed at
-  double p = 2.0;              // exponent of eq. 2.8
-  int max_iterations = 30;     // Newton iterations before the load step is cut
-  int max_breaking_rounds = 100;  // re-solves at one load while bonds keep breaking, then unstable
-  // A load step that overshoots the first bond failure is redone to it (integrators/quasi_static.hpp).
-  bool cut_to_first_failure = true;
-  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: end/100, end·1e-6, end/10
-  // The linear solve of each Newton iteration (integrators/quasi_static.hpp): "direct" (CHOLMOD),
+// Newton's settings, one block shared by quasi_static and implicit (and so by mixed, which runs
+// their load steps and steps): each section reads it with the same table (io/case_settings.cpp).
+struct NewtonSettings {
+  explicit NewtonSettings(int max_iterations) : max_iterations(max_iterations) {}
+  // TOL on ω_K = ‖Δu_K‖/‖u_K − u_n‖ (eq. 2.6 for Newton's corrections); the key is quasi_static.tol
+  // and implicit.newton_tol (implicit.tol is the step's error tolerance).
+  double newton_tol = 1e-6;
+  // Equilibrium: the residual over free components ≤ this × the load's scale (quasi_static: the
+  // reactions and body forces; implicit: ‖inertia‖ + ‖force‖).
+  double residual_tol = 1e-8;
+  int kd = 5;          // K_d: the Newton iterations a step is aimed at (eq. 2.8)
+  double p = 2.0;      // exponent of eq. 2.8
+  int max_iterations;  // Newton iterations before the step is cut (quasi_static 30, implicit 20)
+  // [s]; empty: quasi_static end/100, end·1e-6, end/10; implicit time.dt, 1e-6 × eq. 2.5, end/10.
+  std::optional<double> dt_initial, dt_min, dt_max;
+  // The linear solve of each Newton iteration (integrators/newton_krylov.hpp): "direct" (CHOLMOD),
   // "cg" (matrix-free preconditioned CG, an inexact Newton–Krylov iteration) or "auto" (cg when the
   // scene has no assembled tangent, contact, or when it is large; direct otherwise).
   std::string linear_solver = "auto";
+  int cg_max_iterations = 5000;  // CG iterations per Newton iteration before it takes the iterate it has
+};
+
+// quasi_static: time is a load parameter; each load step is solved for equilibrium by Newton
+// (integrators/quasi_static.hpp), its size set by eq. 2.8 from the iterations it took.
+struct QuasiStaticSettings : NewtonSettings {
+  QuasiStaticSettings() : NewtonSettings(30) {}
+  int max_breaking_rounds = 100;  // re-solves at one load while bonds keep breaking, then unstable
+  // A load step that overshoots the first bond failure is redone to it (integrators/quasi_static.hpp).
+  bool cut_to_first_failure = true;
   // CG's preconditioner (integrators/quasi_static.cpp, choose_preconditioner): "block_jacobi" (the
   // node blocks of K, matrix-free), "amg" (hypre's BoomerAMG on the assembled K: linalg/amg.hpp) or
   // "auto" (amg for large 3D models when it fits in memory, block_jacobi otherwise).
   std::string preconditioner = "auto";
-  int cg_max_iterations = 5000;  // CG iterations per Newton iteration before it takes the iterate it has
 };
 
 // implicit: dynamics by the generalized-α method solved by Newton (integrators/implicit.hpp), the
-// step set by a local error estimate and by eq. 2.8 from the Newton iterations.
-struct ImplicitSettings {
-  double rho_infinity = 1.0;   // ρ∞: spectral radius at infinite frequency (1: trapezoidal, no dissipation)
-  double tol = 1e-3;           // TOL on the local error estimate relative to the step's motion
-  double newton_tol = 1e-6;    // Newton: the last correction relative to the step's motion (eq. 2.6)
-  double residual_tol = 1e-8;  // Newton: ‖r‖ ≤ this × (‖inertia‖ + ‖force‖)
-  int kd = 5;                  // K_d: the Newton iterations a step is aimed at (eq. 2.8)
-  double p = 2.0;              // exponent of eq. 2.8
-  int max_iterations = 20;     // Newton iterations before the step is cut
-  std::optional<double> dt_initial, dt_min, dt_max;  // [s]; empty: time.dt, 1e-6 × eq. 2.5, end/10
-  std::string linear_solver = "auto";  // auto | direct (CHOLMOD) | cg (matrix-free, block-Jacobi)
-  int cg_max_iterations = 5000;        // CG iterations per Newton iteration before it takes the iterate it has
+// step set by a local error estimate and by eq. 2.8 from the Newton iterations; its linear solve
+// is block-Jacobi CG when cg.
+struct ImplicitSettings : NewtonSettings {
+  ImplicitSettings() : NewtonSettings(20) {}
+  double rho_infinity = 1.0;  // ρ∞: spectral radius at infinite frequency (1: trapezoidal, no dissipation)
+  double tol = 1e-3;          // TOL on the local error estimate relative to the step's motion
 };
 
 // mixed: quasi-static load steps while the body is in equilibrium, Verlet while a crack runs

@@ -534,7 +534,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     // Equilibrium: the residual below its tolerance and the last correction below TOL. Or the
     // correction below TOL and the residual no longer falling: it is at the round-off floor of the
     // stretches (about 1e-16/strain of the load), and no further iteration changes u.
-    if (k > 1 && omega <= settings_.tol && (residual <= settings_.residual_tol * load || residual >= 0.5 * previous))
+    if (k > 1 && omega <= settings_.newton_tol && (residual <= settings_.residual_tol * load || residual >= 0.5 * previous))
       return true;
     // The separated pieces carried rigidly by their grips are unstrained: when that already meets the
     // residual test, it is the equilibrium, and no tangent is needed (carry_rigidly).
@@ -669,7 +669,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     op_.evaluate(s, t1);
     ++report_.force_evaluations;
   }
-  return residual_norm(s) <= settings_.residual_tol * force_scale(s, t1) && omega <= settings_.tol;
+  return residual_norm(s) <= settings_.residual_tol * force_scale(s, t1) && omega <= settings_.newton_tol;
 }
 
 void QuasiStatic::remember_solver() {
@@ -883,7 +883,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       report_.broken_energy_now = broken_in_step.energy;
       t = t1;
       dt = h;
-      double next = std::min(zohdi_step_factor(settings_.tol, omega, std::max(iterations, 1), settings_.kd, settings_.p), 2.0) * h;
+      double next = std::min(zohdi_step_factor(settings_.newton_tol, omega, std::max(iterations, 1), settings_.kd, settings_.p), 2.0) * h;
       if (broke_total.broken > 0) next = std::min(next, h);  // a crack grows: no longer steps
       report_.next_dt = std::max(std::min(next, dt_max_), dt_min_);
       return;
@@ -986,7 +986,7 @@ std::string QuasiStatic::linear_algebra_summary() const {
 
 std::vector<std::string> QuasiStatic::describe(double) const {
   return {"quasi_static: Newton with line search to residual " + message_number(settings_.residual_tol) +
-          " × the load and correction TOL " + message_number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
+          " × the load and correction TOL " + message_number(settings_.newton_tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
           message_number(settings_.p) +
           (use_cg_ ? std::string("; linear solves by matrix-free CG with ") +
                          (use_amg_ ? "algebraic multigrid (hypre BoomerAMG, one V-cycle)" : "block-Jacobi") +

@@ -7,19 +7,17 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
-#include <limits>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <sstream>
-#include <tuple>
+#include <type_traits>
 #include <utility>
+#include <variant>
 
 #include "core/error.hpp"
 #include "core/partial_volume.hpp"
 #include "core/surface_correction.hpp"
 #include "forces/indenter.hpp"
-#include "integrators/integrator.hpp"
-#include "io/output.hpp"
+#include "io/case_settings.hpp"
 #include "materials/bond_model.hpp"
 
 namespace pd {
@@ -257,24 +255,6 @@ InitialCondition read_initial(const Checker& ck, const json& j, std::size_t k) {
   return ic;
 }
 
-ContactSettings read_contact(const Checker& ck, const json& j) {
-  ck.object(j, "contact");
-  ck.known_keys(j, "contact", case_keys().at("contact"));
-  ContactSettings s;
-  if (const json* e = ck.optional(j, "enabled")) {
-    s.enabled = ck.string(*e, "contact.enabled");
-    if (s.enabled != "auto" && s.enabled != "on" && s.enabled != "off")
-      ck.fail("contact.enabled", "unknown value '" + s.enabled + "'; known: auto, on, off");
-  }
-  if (const json* e = ck.optional(j, "self_contact")) {
-    if (!e->is_boolean()) ck.fail("contact.self_contact", "must be true or false, got " + show(*e));
-    s.self_contact = e->get<bool>();
-  }
-  if (const json* e = ck.optional(j, "skin"); e && !e->is_null()) s.skin = ck.positive(*e, "contact.skin");
-  if (const json* e = ck.optional(j, "stiffness_factor")) s.stiffness_factor = ck.positive(*e, "contact.stiffness_factor");
-  return s;
-}
-
 std::array<double, 3> read_vector(const Checker& ck, const json& j, const std::string& key) {
   const std::vector<double> v = ck.numbers(j, key);
   if (v.size() != 3) ck.fail(key, "must have 3 components, got " + std::to_string(v.size()));
@@ -331,129 +311,100 @@ IndenterSettings read_indenter(const Checker& ck, const json& j, std::size_t k) 
   return ind;
 }
 
-// <section>.linear_solver (auto | direct | cg) and <section>.cg_max_iterations of quasi_static and
-// implicit (integrators/newton_krylov.hpp).
-void read_linear_solver(const Checker& ck, const json& j, const std::string& section, std::string& choice,
-                        int& cg_max_iterations) {
-  if (const json* v = ck.optional(j, "linear_solver")) {
-    choice = ck.string(*v, section + ".linear_solver");
-    if (choice != "auto" && choice != "direct" && choice != "cg")
-      ck.fail(section + ".linear_solver", "unknown value '" + choice + "'; known: auto, direct, cg");
-  }
-  if (const json* v = ck.optional(j, "cg_max_iterations"))
-    cg_max_iterations = static_cast<int>(ck.integer(*v, section + ".cg_max_iterations", 1, 100000000));
+// The text of a bound in a message: 0, 0.5, 1 (not json's 0.0).
+std::string bound_text(double bound) {
+  std::ostringstream out;
+  out << bound;
+  return out.str();
 }
 
-// The quasi_static section (integrators/quasi_static.hpp).
-QuasiStaticSettings read_quasi_static(const Checker& ck, const json& j) {
-  ck.object(j, "quasi_static");
-  ck.known_keys(j, "quasi_static", case_keys().at("quasi_static"));
-  QuasiStaticSettings q;
-  for (auto [name, slot] : {std::pair<const char*, double*>{"tol", &q.tol}, {"residual_tol", &q.residual_tol}})
-    if (const json* v = ck.optional(j, name)) {
-      *slot = ck.positive(*v, std::string("quasi_static.") + name);
-      if (!(*slot < 1.0)) ck.fail(std::string("quasi_static.") + name, "must be below 1 (a relative error), got " + show(*v));
+// One value of a settings section, checked against its declaration (io/settings_table.hpp) and
+// stored in the field the declaration points to.
+void read_setting(const Checker& ck, const json& v, const Setting& s, const std::string& key) {
+  const std::string why = s.why.empty() ? std::string() : " (" + s.why + ")";
+  auto number = [&](const json& j) {
+    const double x = ck.number(j, key);
+    if (s.minimum && s.maximum) {
+      if (x < *s.minimum || x > *s.maximum)
+        ck.fail(key, "must be between " + bound_text(*s.minimum) + " and " + bound_text(*s.maximum) + why + ", got " + show(j));
+      return x;
     }
-  if (const json* v = ck.optional(j, "kd")) q.kd = static_cast<int>(ck.integer(*v, "quasi_static.kd", 1, 1000));
-  if (const json* v = ck.optional(j, "p")) q.p = ck.positive(*v, "quasi_static.p");
-  if (const json* v = ck.optional(j, "max_iterations"))
-    q.max_iterations = static_cast<int>(ck.integer(*v, "quasi_static.max_iterations", 1, 100000));
-  if (const json* v = ck.optional(j, "max_breaking_rounds"))
-    q.max_breaking_rounds = static_cast<int>(ck.integer(*v, "quasi_static.max_breaking_rounds", 1, 100000000));
-  if (const json* v = ck.optional(j, "cut_to_first_failure")) {
-    if (!v->is_boolean()) ck.fail("quasi_static.cut_to_first_failure", "must be true or false, got " + show(*v));
-    q.cut_to_first_failure = v->get<bool>();
-  }
-  for (auto [name, slot] : {std::pair<const char*, std::optional<double>*>{"dt_initial", &q.dt_initial},
-                            {"dt_min", &q.dt_min}, {"dt_max", &q.dt_max}})
-    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("quasi_static.") + name);
-  if (q.dt_min && q.dt_max && *q.dt_min > *q.dt_max) ck.fail("quasi_static.dt_min", "is larger than quasi_static.dt_max");
-  read_linear_solver(ck, j, "quasi_static", q.linear_solver, q.cg_max_iterations);
-  if (const json* v = ck.optional(j, "preconditioner")) {
-    q.preconditioner = ck.string(*v, "quasi_static.preconditioner");
-    if (q.preconditioner != "auto" && q.preconditioner != "block_jacobi" && q.preconditioner != "amg")
-      ck.fail("quasi_static.preconditioner", "unknown value '" + q.preconditioner + "'; known: auto, block_jacobi, amg");
-  }
-  return q;
+    if (s.above && !(x > *s.above)) ck.fail(key, "must be > " + bound_text(*s.above) + ", got " + show(j));
+    if (s.minimum && x < *s.minimum) ck.fail(key, "must be ≥ " + bound_text(*s.minimum) + ", got " + show(j));
+    if (s.below && !(x < *s.below)) ck.fail(key, "must be below " + bound_text(*s.below) + why + ", got " + show(j));
+    return x;
+  };
+  auto name = [&](const std::string& given, const std::string& where, const std::string& did_you_mean) {
+    if (std::find(s.choices.begin(), s.choices.end(), given) == s.choices.end())
+      ck.fail(where, "unknown " + s.noun + " '" + given + "'" + did_you_mean + "; known: " + joined(s.choices));
+  };
+  std::visit(
+      [&](auto field) {
+        using Field = decltype(field);
+        if constexpr (std::is_same_v<Field, double*> || std::is_same_v<Field, std::optional<double>*>) {
+          *field = number(v);
+        } else if constexpr (std::is_same_v<Field, int*>) {
+          *field = static_cast<int>(ck.integer(v, key, s.lowest, s.highest));
+        } else if constexpr (std::is_same_v<Field, std::int64_t*> || std::is_same_v<Field, std::optional<std::int64_t>*>) {
+          *field = ck.integer(v, key, s.lowest, s.highest);
+        } else if constexpr (std::is_same_v<Field, bool*>) {
+          if (!v.is_boolean()) ck.fail(key, "must be true or false, got " + show(v));
+          *field = v.get<bool>();
+        } else if constexpr (std::is_same_v<Field, std::string*>) {
+          *field = ck.string(v, key);
+          name(*field, key, "");
+        } else if constexpr (std::is_same_v<Field, std::vector<std::string>*>) {
+          std::vector<std::string>& list = *field;
+          list = ck.strings(v, key);
+          if (s.choices.empty()) return;
+          for (std::size_t k = 0; k < list.size(); ++k) {
+            name(list[k], key + "[" + std::to_string(k) + "]", closest(list[k], s.choices));
+            if (std::count(list.begin(), list.end(), list[k]) > 1) ck.fail(key, "'" + list[k] + "' is listed twice");
+          }
+        } else {  // RuleOrNumber: a number makes the rule "fixed"
+          static_assert(std::is_same_v<Field, RuleOrNumber>);
+          if (!v.is_string()) {
+            *field.rule = "fixed";
+            *field.number = number(v);
+            return;
+          }
+          *field.rule = v.get<std::string>();
+          if (std::find(s.choices.begin(), s.choices.end(), *field.rule) == s.choices.end())
+            ck.fail(key, "unknown " + s.noun + " '" + *field.rule + "'; known: " + joined(s.choices) + ", or a number [" +
+                             s.unit + "]");
+        }
+      },
+      s.field);
 }
 
-// The implicit section (integrators/implicit.hpp).
-ImplicitSettings read_implicit(const Checker& ck, const json& j) {
-  ck.object(j, "implicit");
-  ck.known_keys(j, "implicit", case_keys().at("implicit"));
-  ImplicitSettings m;
-  if (const json* v = ck.optional(j, "rho_infinity")) {
-    m.rho_infinity = ck.number(*v, "implicit.rho_infinity");
-    // Chung & Hulbert's family is unconditionally stable and second order for ρ∞ in [0, 1].
-    if (m.rho_infinity < 0.0 || m.rho_infinity > 1.0)
-      ck.fail("implicit.rho_infinity", "must be between 0 and 1 (1: no numerical dissipation), got " + show(*v));
+// A settings section (io/case_settings.cpp): an object of its keys only, each one absent (the
+// default), or null where its type is optional, or a value in its range.
+void read_settings(const Checker& ck, const json& j, const SettingsSection& section) {
+  ck.object(j, section.name);
+  std::vector<std::string> keys;
+  for (const Setting& s : section.settings) keys.push_back(s.key);
+  ck.known_keys(j, section.name, keys);
+  for (const Setting& s : section.settings) {
+    const std::string key = section.name + "." + s.key;
+    const json* v = s.required ? &ck.required(j, s.key, key) : ck.optional(j, s.key);
+    if (!v) continue;
+    const bool optional_type = std::holds_alternative<std::optional<double>*>(s.field) ||
+                               std::holds_alternative<std::optional<std::int64_t>*>(s.field);
+    if (v->is_null() && (optional_type || s.null_is_default)) continue;
+    read_setting(ck, *v, s, key);
   }
-  for (auto [name, slot] : {std::pair<const char*, double*>{"tol", &m.tol}, {"newton_tol", &m.newton_tol},
-                            {"residual_tol", &m.residual_tol}})
-    if (const json* v = ck.optional(j, name)) {
-      *slot = ck.positive(*v, std::string("implicit.") + name);
-      if (!(*slot < 1.0)) ck.fail(std::string("implicit.") + name, "must be below 1 (a relative error), got " + show(*v));
-    }
-  if (const json* v = ck.optional(j, "kd")) m.kd = static_cast<int>(ck.integer(*v, "implicit.kd", 1, 1000));
-  if (const json* v = ck.optional(j, "p")) m.p = ck.positive(*v, "implicit.p");
-  if (const json* v = ck.optional(j, "max_iterations"))
-    m.max_iterations = static_cast<int>(ck.integer(*v, "implicit.max_iterations", 1, 100000));
-  for (auto [name, slot] : {std::pair<const char*, std::optional<double>*>{"dt_initial", &m.dt_initial},
-                            {"dt_min", &m.dt_min}, {"dt_max", &m.dt_max}})
-    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("implicit.") + name);
-  if (m.dt_min && m.dt_max && *m.dt_min > *m.dt_max) ck.fail("implicit.dt_min", "is larger than implicit.dt_max");
-  if (m.dt_initial && m.dt_max && *m.dt_initial > *m.dt_max) ck.fail("implicit.dt_initial", "is larger than implicit.dt_max");
-  if (m.dt_initial && m.dt_min && *m.dt_initial < *m.dt_min) ck.fail("implicit.dt_initial", "is smaller than implicit.dt_min");
-  read_linear_solver(ck, j, "implicit", m.linear_solver, m.cg_max_iterations);
-  return m;
 }
 
-// The mixed section (integrators/mixed.hpp).
-MixedSettings read_mixed(const Checker& ck, const json& j) {
-  ck.object(j, "mixed");
-  ck.known_keys(j, "mixed", case_keys().at("mixed"));
-  MixedSettings m;
-  if (const json* v = ck.optional(j, "start")) {
-    m.start = ck.string(*v, "mixed.start");
-    if (m.start != "quasi_static" && m.start != "implicit")
-      ck.fail("mixed.start", "unknown value '" + m.start + "'; known: quasi_static, implicit");
-  }
-  if (const json* v = ck.optional(j, "unstable_rounds"))
-    m.unstable_rounds = static_cast<int>(ck.integer(*v, "mixed.unstable_rounds", 1, 100000000));
-  if (const json* v = ck.optional(j, "kinetic_fraction")) {
-    m.kinetic_fraction = ck.positive(*v, "mixed.kinetic_fraction");
-    if (!(m.kinetic_fraction < 1.0)) ck.fail("mixed.kinetic_fraction", "must be below 1 (a fraction of the strain energy), got " + show(*v));
-  }
-  if (const json* v = ck.optional(j, "arrest_steps")) m.arrest_steps = ck.integer(*v, "mixed.arrest_steps", 1, 1000000000);
-  return m;
-}
-
-// The adaptive section (integrators/adaptive.hpp): every value in the range the scheme needs.
-AdaptiveSettings read_adaptive(const Checker& ck, const json& j) {
-  ck.object(j, "adaptive");
-  ck.known_keys(j, "adaptive", case_keys().at("adaptive"));
-  AdaptiveSettings a;
-  if (const json* v = ck.optional(j, "tol")) {
-    a.tol = ck.positive(*v, "adaptive.tol");
-    if (!(a.tol < 1.0)) ck.fail("adaptive.tol", "must be below 1 (a relative error), got " + show(*v));
-  }
-  if (const json* v = ck.optional(j, "kd")) a.kd = static_cast<int>(ck.integer(*v, "adaptive.kd", 1, 1000));
-  if (const json* v = ck.optional(j, "p")) a.p = ck.positive(*v, "adaptive.p");
-  if (const json* v = ck.optional(j, "phi")) {
-    a.phi = ck.number(*v, "adaptive.phi");
-    // Newmark with β = γ = φ is unconditionally stable only for φ ≥ ½.
-    if (a.phi < 0.5 || a.phi > 1.0) ck.fail("adaptive.phi", "must be between 0.5 and 1, got " + show(*v));
-  }
-  for (auto [name, slot] : {std::pair{"dt_initial", &a.dt_initial}, std::pair{"dt_min", &a.dt_min},
-                            std::pair{"dt_max", &a.dt_max}})
-    if (const json* v = ck.optional(j, name); v && !v->is_null()) *slot = ck.positive(*v, std::string("adaptive.") + name);
-  if (a.dt_min && a.dt_max && *a.dt_min > *a.dt_max)
-    ck.fail("adaptive.dt_min", "is larger than adaptive.dt_max");
-  if (a.dt_initial && a.dt_max && *a.dt_initial > *a.dt_max)
-    ck.fail("adaptive.dt_initial", "is larger than adaptive.dt_max");
-  if (a.dt_initial && a.dt_min && *a.dt_initial < *a.dt_min)
-    ck.fail("adaptive.dt_initial", "is smaller than adaptive.dt_min");
-  return a;
+// dt_initial, dt_min and dt_max of adaptive, quasi_static or implicit, against one another;
+// initial_too false: dt_initial is not checked (quasi_static lowers one above dt_max to it).
+void check_step_limits(const Checker& ck, const std::string& section, const std::optional<double>& dt_initial,
+                       const std::optional<double>& dt_min, const std::optional<double>& dt_max, bool initial_too) {
+  if (dt_min && dt_max && *dt_min > *dt_max) ck.fail(section + ".dt_min", "is larger than " + section + ".dt_max");
+  if (!initial_too) return;
+  if (dt_initial && dt_max && *dt_initial > *dt_max)
+    ck.fail(section + ".dt_initial", "is larger than " + section + ".dt_max");
+  if (dt_initial && dt_min && *dt_initial < *dt_min)
+    ck.fail(section + ".dt_initial", "is smaller than " + section + ".dt_min");
 }
 
 // output_dir, which must stay inside the run folder (the directory of case.json): pdsolve writes
@@ -487,26 +438,22 @@ std::filesystem::path confined_output_dir(const Checker& ck, const std::filesyst
 }  // namespace
 
 const std::map<std::string, std::vector<std::string>>& case_keys() {
-  static const std::map<std::string, std::vector<std::string>> keys = {
-      {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
-            "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
-            "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output", "figures", "partial_volume", "surface_correction", "breaking_order", "contact",
-            "indenters", "cracks"}},
-      {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
-      {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
-      {"contact", {"enabled", "self_contact", "skin", "stiffness_factor"}},
-      {"cracks[]", {"from", "to"}},
-      {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
-      {"adaptive", {"tol", "kd", "p", "phi", "dt_initial", "dt_min", "dt_max"}},
-      {"quasi_static", {"tol", "residual_tol", "kd", "p", "max_iterations", "max_breaking_rounds", "cut_to_first_failure", "linear_solver", "preconditioner", "cg_max_iterations", "dt_initial", "dt_min",
-                        "dt_max"}},
-      {"implicit", {"rho_infinity", "tol", "newton_tol", "residual_tol", "kd", "p", "max_iterations", "dt_initial",
-                    "dt_min", "dt_max", "linear_solver", "cg_max_iterations"}},
-      {"mixed", {"start", "unstable_rounds", "kinetic_fraction", "arrest_steps"}},
-      {"time", {"end", "integrator", "dt", "safety_factor", "max_steps"}},
-      {"output", {"every_time", "every_steps", "history_every", "reactions", "restart_every_time",
-                  "restart_every_steps", "restart_every_wall", "precision", "compression", "fields", "gmsh", "parallel_frames"}},
-  };
+  static const std::map<std::string, std::vector<std::string>> keys = [] {
+    std::map<std::string, std::vector<std::string>> k = {
+        {"", {"format_version", "case", "title", "source", "nodes_file", "output_dir", "dimension", "analysis",
+              "thickness", "grid_spacing", "horizon", "blocks", "no_fail_sets", "node_sets", "boundary_conditions",
+              "initial_conditions", "damping", "time", "adaptive", "quasi_static", "implicit", "mixed", "output",
+              "figures", "partial_volume", "surface_correction", "breaking_order", "contact", "indenters", "cracks"}},
+        {"boundary_conditions[]", {"set", "kind", "component", "times", "values"}},
+        {"initial_conditions[]", {"set", "kind", "component", "value", "gradient"}},
+        {"cracks[]", {"from", "to"}},
+        {"indenters[]", {"name", "shape", "radius", "centre", "velocity", "normal", "axis", "stiffness"}},
+    };
+    Case c;  // the tables point into it; only their keys are taken
+    for (const SettingsSection& section : settings_sections(c))
+      for (const Setting& s : section.settings) k[section.name].push_back(s.key);
+    return k;
+  }();
   return keys;
 }
 
@@ -523,6 +470,14 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   ck.known_keys(root, "", case_keys().at(""));
   Case c;
   c.file = path;
+  // The settings sections (io/case_settings.cpp), each read at its place in the order of the checks.
+  const std::vector<SettingsSection> sections = settings_sections(c);
+  auto read_section = [&](const std::string& name) {
+    const SettingsSection& section =
+        *std::find_if(sections.begin(), sections.end(), [&](const SettingsSection& s) { return s.name == name; });
+    const json* j = section.required ? &ck.required(root, name, name) : ck.optional(root, name);
+    if (section.required || (j && !j->is_null())) read_settings(ck, *j, section);
+  };
   const std::int64_t version = ck.integer(ck.required(root, "format_version", "format_version"), "format_version", 0, 1 << 30);
   if (version != kCaseFormatVersion)
     ck.fail("format_version", "is " + std::to_string(version) + "; this solver reads version " +
@@ -597,7 +552,7 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   if (const json* j = ck.optional(root, "cracks"))
     for (std::size_t k = 0; k < ck.array(*j, "cracks").size(); ++k) c.cracks.push_back(read_crack(ck, (*j)[k], k));
   if (const json* j = ck.optional(root, "damping")) c.damping = ck.non_negative(*j, "damping");
-  if (const json* j = ck.optional(root, "contact"); j && !j->is_null()) c.contact = read_contact(ck, *j);
+  read_section("contact");
   if (const json* j = ck.optional(root, "indenters"))
     for (std::size_t k = 0; k < ck.array(*j, "indenters").size(); ++k) {
       c.indenters.push_back(read_indenter(ck, (*j)[k], k));
@@ -606,80 +561,22 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
           ck.fail("indenters[" + std::to_string(k) + "].name", "'" + c.indenters[k].name + "' is used twice");
     }
 
-  const json& time = ck.object(ck.required(root, "time", "time"), "time");
-  ck.known_keys(time, "time", case_keys().at("time"));
-  c.time.end = ck.positive(ck.required(time, "end", "time.end"), "time.end");
-  if (const json* j = ck.optional(time, "integrator")) {
-    c.time.integrator = ck.string(*j, "time.integrator");
-    if (!integrator_registry().contains(c.time.integrator))
-      ck.fail("time.integrator", integrator_registry().unknown_message(c.time.integrator));
-  }
-  if (const json* j = ck.optional(time, "dt")) {
-    if (j->is_string()) {
-      const std::string rule = j->get<std::string>();
-      if (rule != "stable" && rule != "exact")
-        ck.fail("time.dt", "unknown rule '" + rule + "'; known: stable, exact, or a number [s]");
-      c.time.dt_rule = rule;
-    } else {
-      c.time.dt_rule = "fixed";
-      c.time.dt_value = ck.positive(*j, "time.dt");
-    }
-  }
-  if (const json* j = ck.optional(time, "safety_factor")) c.time.safety_factor = ck.positive(*j, "time.safety_factor");
-  if (const json* j = ck.optional(time, "max_steps"))
-    c.time.max_steps = ck.integer(*j, "time.max_steps", 1, std::numeric_limits<std::int64_t>::max());
-
-  if (const json* j = ck.optional(root, "adaptive"); j && !j->is_null()) c.adaptive = read_adaptive(ck, *j);
-  if (const json* j = ck.optional(root, "quasi_static"); j && !j->is_null()) c.quasi_static = read_quasi_static(ck, *j);
-  if (const json* j = ck.optional(root, "implicit"); j && !j->is_null()) c.implicit = read_implicit(ck, *j);
-  if (const json* j = ck.optional(root, "mixed"); j && !j->is_null()) c.mixed = read_mixed(ck, *j);
+  read_section("time");
+  read_section("adaptive");
+  check_step_limits(ck, "adaptive", c.adaptive.dt_initial, c.adaptive.dt_min, c.adaptive.dt_max, true);
+  read_section("quasi_static");
+  check_step_limits(ck, "quasi_static", c.quasi_static.dt_initial, c.quasi_static.dt_min, c.quasi_static.dt_max, false);
+  read_section("implicit");
+  check_step_limits(ck, "implicit", c.implicit.dt_initial, c.implicit.dt_min, c.implicit.dt_max, true);
+  read_section("mixed");
   if (const json* j = ck.optional(root, "figures"); j && !j->is_null()) ck.object(*j, "figures");    // postprocess only
 
-  const json& output = ck.object(ck.required(root, "output", "output"), "output");
-  ck.known_keys(output, "output", case_keys().at("output"));
-  if (const json* j = ck.optional(output, "every_time"); j && !j->is_null())
-    c.output.every_time = ck.positive(*j, "output.every_time");
-  if (const json* j = ck.optional(output, "every_steps"); j && !j->is_null())
-    c.output.every_steps = ck.integer(*j, "output.every_steps", 1, std::numeric_limits<std::int64_t>::max());
+  read_section("output");
   if (c.output.every_time.has_value() == c.output.every_steps.has_value())
     ck.fail("output", "exactly one of every_time and every_steps must be set (not null)");
-  if (const json* j = ck.optional(output, "restart_every_time"); j && !j->is_null())
-    c.output.restart_every_time = ck.positive(*j, "output.restart_every_time");
-  if (const json* j = ck.optional(output, "restart_every_steps"); j && !j->is_null())
-    c.output.restart_every_steps =
-        ck.integer(*j, "output.restart_every_steps", 1, std::numeric_limits<std::int64_t>::max());
-  if (const json* j = ck.optional(output, "restart_every_wall"))
-    c.output.restart_every_wall = ck.non_negative(*j, "output.restart_every_wall");
-  if (const json* j = ck.optional(output, "history_every"))
-    c.output.history_every = ck.integer(*j, "output.history_every", 1, std::numeric_limits<std::int64_t>::max());
-  if (const json* j = ck.optional(output, "reactions")) {
-    c.output.reactions = ck.strings(*j, "output.reactions");
-    for (const auto& name : c.output.reactions)
-      if (std::find(c.node_sets.begin(), c.node_sets.end(), name) == c.node_sets.end())
-        ck.fail("output.reactions", "'" + name + "' is not in node_sets");
-  }
-  for (auto [name, slot, choices] :
-       {std::tuple{"precision", &c.output.precision, std::vector<std::string>{"float32", "float64"}},
-        std::tuple{"compression", &c.output.compression, std::vector<std::string>{"zlib", "none"}},
-        std::tuple{"gmsh", &c.output.gmsh, std::vector<std::string>{"all", "figures", "none"}},
-        std::tuple{"parallel_frames", &c.output.parallel_frames, std::vector<std::string>{"gathered", "pieces"}}}) {
-    const std::string key = std::string("output.") + name;
-    if (const json* j = ck.optional(output, name)) *slot = ck.string(*j, key);
-    if (std::find(choices.begin(), choices.end(), *slot) == choices.end())
-      ck.fail(key, "unknown value '" + *slot + "'; known: " + joined(choices));
-  }
-  if (const json* j = ck.optional(output, "fields")) {
-    c.output.fields = ck.strings(*j, "output.fields");
-    const std::vector<std::string>& known = frame_fields();
-    for (std::size_t k = 0; k < c.output.fields.size(); ++k) {
-      const std::string& name = c.output.fields[k];
-      if (std::find(known.begin(), known.end(), name) == known.end())
-        ck.fail("output.fields[" + std::to_string(k) + "]", "unknown field '" + name + "'" + closest(name, known) +
-                                                                 "; known: " + joined(known));
-      if (std::count(c.output.fields.begin(), c.output.fields.end(), name) > 1)
-        ck.fail("output.fields", "'" + name + "' is listed twice");
-    }
-  }
+  for (const auto& name : c.output.reactions)
+    if (std::find(c.node_sets.begin(), c.node_sets.end(), name) == c.node_sets.end())
+      ck.fail("output.reactions", "'" + name + "' is not in node_sets");
   return c;
 }
 

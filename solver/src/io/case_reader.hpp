@@ -18,8 +18,10 @@ inline constexpr const char* kDefaultOutputDir = ".";
 inline constexpr std::array<double, 3> kDefaultCylinderAxis{0.0, 0.0, 1.0};  // z: a disk in a 2D case
 
 // The keys parse_case accepts in each object of case.json, by where the object sits: "" (the top
-// level), "time", "adaptive", "output", "contact", "boundary_conditions[]", "initial_conditions[]",
-// "indenters[]", "cracks[]". The block keys are read_block's (io/describe.hpp describe_material_keys).
+// level), "boundary_conditions[]", "initial_conditions[]", "indenters[]", "cracks[]", and the
+// settings sections ("time", "adaptive", "quasi_static", "implicit", "mixed", "output",
+// "contact"), whose keys are their tables' (io/case_settings.cpp). The block keys are read_block's
+// (io/describe.hpp describe_material_keys).
 const std::map<std::string, std::vector<std::string>>& case_keys();
 
 Case read_case(const std::filesystem::path& path);

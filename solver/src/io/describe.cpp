@@ -1,10 +1,15 @@
 // pdsolve --describe: the case.json keys the reader accepts, described from the structs' own
-// defaults (core/case.hpp) and the registries' keys, checked against the reader's key lists.
+// defaults (core/case.hpp), the registries' keys and the settings sections' tables
+// (io/case_settings.cpp), checked against the reader's key lists.
 #include "io/describe.hpp"
 
+#include <limits>
 #include <optional>
 #include <set>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
 
 #include "core/case.hpp"
 #include "core/error.hpp"
@@ -14,6 +19,7 @@
 #include "forces/indenter.hpp"
 #include "integrators/integrator.hpp"
 #include "io/case_reader.hpp"
+#include "io/case_settings.hpp"
 #include "io/output.hpp"
 
 namespace pd {
@@ -41,20 +47,52 @@ json defaulted(const std::string& type, json value, json extra = json::object())
   return spec(type, std::move(extra));
 }
 
+// One key of a settings section (io/settings_table.hpp): its type from its field, its default from
+// the field's value in a fresh Case, its range and choices as the reader checks them.
+json describe_setting(const Setting& s) {
+  json extra = json::object();
+  if (s.above) extra["above"] = *s.above;
+  if (s.minimum) extra["minimum"] = *s.minimum;
+  if (s.below) extra["below"] = *s.below;
+  if (s.maximum) extra["maximum"] = *s.maximum;
+  if (!s.choices.empty()) extra["choices"] = s.choices;
+  if (!s.unit.empty()) extra["unit"] = s.unit;
+  if (!s.note.empty()) extra["note"] = s.note;
+  const auto integer_range = [&] {
+    extra["minimum"] = s.lowest;
+    if (s.highest != std::numeric_limits<std::int64_t>::max()) extra["maximum"] = s.highest;
+  };
+  const auto [type, value] = std::visit(
+      [&](auto field) -> std::pair<std::string, json> {
+        using Field = decltype(field);
+        if constexpr (std::is_same_v<Field, double*>) return {"number", *field};
+        if constexpr (std::is_same_v<Field, std::optional<double>*>) return {"number", value_or_null(*field)};
+        if constexpr (std::is_same_v<Field, int*> || std::is_same_v<Field, std::int64_t*>) {
+          integer_range();
+          return {"integer", *field};
+        }
+        if constexpr (std::is_same_v<Field, std::optional<std::int64_t>*>) {
+          integer_range();
+          return {"integer", value_or_null(*field)};
+        }
+        if constexpr (std::is_same_v<Field, bool*>) return {"boolean", *field};
+        if constexpr (std::is_same_v<Field, std::string*>) return {"string", *field};
+        if constexpr (std::is_same_v<Field, std::vector<std::string>*>) return {"strings", *field};
+        if constexpr (std::is_same_v<Field, RuleOrNumber>) return {"number_or_choice", *field.rule};
+      },
+      s.field);
+  return s.required ? required(type, extra) : defaulted(type, value, extra);
+}
+
 }  // namespace
 
 json describe_case() {
   const Case c;
-  const TimeSettings t;
-  const AdaptiveSettings a;
-  const OutputSettings o;
-  const ContactSettings k;
   const InitialCondition ic;
   const IndenterSettings ind;
-  const json positive = {{"above", 0.0}};
 
-  // Ranges and hand-checked choices as case_reader.cpp enforces them (time.max_steps and the other
-  // counts have no maximum but int64's); defaults from the structs.
+  // The keys outside the settings sections: ranges and hand-checked choices as case_reader.cpp
+  // enforces them; defaults from the structs.
   json keys = json::object();
   keys["format_version"] = required("integer", {{"choices", {kCaseFormatVersion}}});
   keys["case"] = defaulted("string", c.name);
@@ -94,12 +132,6 @@ json describe_case() {
   keys["cracks[].to"] = required("numbers", {{"length", 3}, {"unit", "m"}});
   keys["breaking_order"] = defaulted("string", c.breaking_order, {{"choices", {"thesis", "lammps"}}});
   keys["damping"] = defaulted("number", c.damping, {{"minimum", 0.0}, {"unit", "1/s"}});
-  keys["contact"] = defaulted("object", json::object());
-  keys["contact.enabled"] = defaulted("string", k.enabled, {{"choices", {"auto", "on", "off"}}});
-  keys["contact.self_contact"] = defaulted("boolean", k.self_contact);
-  keys["contact.skin"] = defaulted("number", k.skin,
-                                 {{"above", 0.0}, {"unit", "m"}, {"note", "absent or null: half the grid spacing"}});
-  keys["contact.stiffness_factor"] = defaulted("number", k.stiffness_factor, positive);
   keys["indenters"] = defaulted("list", json::array());
   keys["indenters[].name"] = required("string", {{"note", "[A-Za-z_][A-Za-z0-9_]*, unique"}});
   keys["indenters[].shape"] = required("string", {{"choices", indenter_shape_registry().keys()}});
@@ -112,77 +144,14 @@ json describe_case() {
   keys["indenters[].axis"] = defaulted("numbers", kDefaultCylinderAxis,
                                      {{"length", 3}, {"note", "cylinder only; made a unit vector"}});
   keys["indenters[].stiffness"] = required("number", {{"above", 0.0}, {"unit", "N/m⁵"}});
-  keys["time"] = required("object");
-  keys["time.end"] = required("number", {{"above", 0.0}, {"unit", "s"}});
-  keys["time.integrator"] = defaulted("string", t.integrator, {{"choices", integrator_registry().keys()}});
-  keys["time.dt"] = defaulted("number_or_choice", t.dt_rule,
-                            {{"choices", {"stable", "exact"}}, {"above", 0.0}, {"unit", "s"}});
-  keys["time.safety_factor"] = defaulted("number", t.safety_factor, positive);
-  keys["time.max_steps"] = defaulted("integer", t.max_steps, {{"minimum", 1}});
-  keys["adaptive"] = defaulted("object", json::object());
-  keys["adaptive.tol"] = defaulted("number", a.tol, {{"above", 0.0}, {"below", 1.0}});
-  keys["adaptive.kd"] = defaulted("integer", a.kd, {{"minimum", 1}, {"maximum", 1000}});
-  keys["adaptive.p"] = defaulted("number", a.p, positive);
-  keys["adaptive.phi"] = defaulted("number", a.phi, {{"minimum", 0.5}, {"maximum", 1.0}});
-  keys["adaptive.dt_initial"] = defaulted("number", value_or_null(a.dt_initial), {{"above", 0.0}, {"unit", "s"}});
-  keys["adaptive.dt_min"] = defaulted("number", value_or_null(a.dt_min), {{"above", 0.0}, {"unit", "s"}});
-  keys["adaptive.dt_max"] = defaulted("number", value_or_null(a.dt_max), {{"above", 0.0}, {"unit", "s"}});
-  const QuasiStaticSettings q{};
-  keys["quasi_static"] = defaulted("object", json::object());
-  keys["quasi_static.tol"] = defaulted("number", q.tol, {{"above", 0.0}, {"below", 1.0}});
-  keys["quasi_static.residual_tol"] = defaulted("number", q.residual_tol, {{"above", 0.0}, {"below", 1.0}});
-  keys["quasi_static.kd"] = defaulted("integer", q.kd, {{"minimum", 1}, {"maximum", 1000}});
-  keys["quasi_static.p"] = defaulted("number", q.p, positive);
-  keys["quasi_static.max_iterations"] = defaulted("integer", q.max_iterations, {{"minimum", 1}, {"maximum", 100000}});
-  keys["quasi_static.max_breaking_rounds"] =
-      defaulted("integer", q.max_breaking_rounds, {{"minimum", 1}, {"maximum", 100000000}});
-  keys["quasi_static.cut_to_first_failure"] = defaulted("boolean", q.cut_to_first_failure);
-  keys["quasi_static.linear_solver"] = defaulted("string", q.linear_solver, {{"choices", {"auto", "direct", "cg"}}});
-  keys["quasi_static.preconditioner"] =
-      defaulted("string", q.preconditioner, {{"choices", {"auto", "block_jacobi", "amg"}}});
-  keys["quasi_static.cg_max_iterations"] =
-      defaulted("integer", q.cg_max_iterations, {{"minimum", 1}, {"maximum", 100000000}});
-  keys["quasi_static.dt_initial"] = defaulted("number", value_or_null(q.dt_initial), {{"above", 0.0}, {"unit", "s"}});
-  keys["quasi_static.dt_min"] = defaulted("number", value_or_null(q.dt_min), {{"above", 0.0}, {"unit", "s"}});
-  keys["quasi_static.dt_max"] = defaulted("number", value_or_null(q.dt_max), {{"above", 0.0}, {"unit", "s"}});
-  const ImplicitSettings im{};
-  keys["implicit"] = defaulted("object", json::object());
-  keys["implicit.rho_infinity"] = defaulted("number", im.rho_infinity, {{"minimum", 0.0}, {"maximum", 1.0}});
-  keys["implicit.tol"] = defaulted("number", im.tol, {{"above", 0.0}, {"below", 1.0}});
-  keys["implicit.newton_tol"] = defaulted("number", im.newton_tol, {{"above", 0.0}, {"below", 1.0}});
-  keys["implicit.residual_tol"] = defaulted("number", im.residual_tol, {{"above", 0.0}, {"below", 1.0}});
-  keys["implicit.kd"] = defaulted("integer", im.kd, {{"minimum", 1}, {"maximum", 1000}});
-  keys["implicit.p"] = defaulted("number", im.p, positive);
-  keys["implicit.max_iterations"] = defaulted("integer", im.max_iterations, {{"minimum", 1}, {"maximum", 100000}});
-  keys["implicit.dt_initial"] = defaulted("number", value_or_null(im.dt_initial), {{"above", 0.0}, {"unit", "s"}});
-  keys["implicit.dt_min"] = defaulted("number", value_or_null(im.dt_min), {{"above", 0.0}, {"unit", "s"}});
-  keys["implicit.dt_max"] = defaulted("number", value_or_null(im.dt_max), {{"above", 0.0}, {"unit", "s"}});
-  keys["implicit.linear_solver"] = defaulted("string", im.linear_solver, {{"choices", {"auto", "direct", "cg"}}});
-  keys["implicit.cg_max_iterations"] =
-      defaulted("integer", im.cg_max_iterations, {{"minimum", 1}, {"maximum", 100000000}});
-  const MixedSettings mx{};
-  keys["mixed"] = defaulted("object", json::object());
-  keys["mixed.start"] = defaulted("string", mx.start, {{"choices", {"quasi_static", "implicit"}}});
-  keys["mixed.unstable_rounds"] = defaulted("integer", mx.unstable_rounds, {{"minimum", 1}, {"maximum", 100000000}});
-  keys["mixed.kinetic_fraction"] = defaulted("number", mx.kinetic_fraction, {{"above", 0.0}, {"below", 1.0}});
-  keys["mixed.arrest_steps"] = defaulted("integer", mx.arrest_steps, {{"minimum", 1}, {"maximum", 1000000000}});
-  keys["output"] = required("object", {{"note", "exactly one of every_time and every_steps"}});
-  keys["output.every_time"] = defaulted("number", value_or_null(o.every_time), {{"above", 0.0}, {"unit", "s"}});
-  keys["output.every_steps"] = defaulted("integer", value_or_null(o.every_steps), {{"minimum", 1}});
-  keys["output.history_every"] = defaulted("integer", o.history_every, {{"minimum", 1}});
-  keys["output.reactions"] = defaulted("strings", o.reactions, {{"note", "each one of node_sets"}});
-  keys["output.restart_every_time"] = defaulted("number", value_or_null(o.restart_every_time),
-                                              {{"above", 0.0}, {"unit", "s"}});
-  keys["output.restart_every_steps"] = defaulted("integer", value_or_null(o.restart_every_steps), {{"minimum", 1}});
-  keys["output.restart_every_wall"] = defaulted("number", o.restart_every_wall,
-                                              {{"minimum", 0.0}, {"unit", "s"}, {"note", "wall time; 0: none"}});
-  keys["output.precision"] = defaulted("string", o.precision, {{"choices", {"float32", "float64"}}});
-  keys["output.compression"] = defaulted("string", o.compression, {{"choices", {"zlib", "none"}}});
-  keys["output.fields"] = defaulted("strings", o.fields, {{"choices", frame_fields()}});
-  keys["output.gmsh"] = defaulted("string", o.gmsh, {{"choices", {"all", "figures", "none"}},
-                                                     {"note", "postprocess only: checked to be one of the choices"}});
-  keys["output.parallel_frames"] = defaulted("string", o.parallel_frames, {{"choices", {"gathered", "pieces"}},
-                                                                           {"note", "several MPI ranks only"}});
+  // The settings sections, from their tables (io/case_settings.cpp).
+  Case defaults;
+  for (const SettingsSection& section : settings_sections(defaults)) {
+    json extra = json::object();
+    if (!section.note.empty()) extra["note"] = section.note;
+    keys[section.name] = section.required ? required("object", extra) : defaulted("object", json::object(), extra);
+    for (const Setting& setting : section.settings) keys[section.name + "." + setting.key] = describe_setting(setting);
+  }
   keys["figures"] = defaulted("object", json::object(), {{"note", "postprocess only: checked to be an object"}});
 
   // Every key the reader accepts is described, and nothing else (blocks: id, name + the material's).
