@@ -253,6 +253,11 @@ figures: | $(DEPS)
 # the default wait policy a thread that reaches a barrier first spins, on the core the other test's
 # thread needs; PASSIVE makes it sleep (no result changes: the tests compare bits across thread
 # counts, not across wait policies). The mpi_ranks tests set it already (solver/CMakeLists.txt).
+# Measured side by side on 7 Dec 2026 with the machine's load average at 25-36 (not a quiet machine):
+# `ctest -j2` of the Release tree with PASSIVE ran its 295 tests in 18 min, 35 CPU s (mpi_ranks_2
+# and _3, passive before, timed out at that load); without it, 4 tests in 20 min
+# (Mixed.StartedImplicitReturnsToImplicitWhenTheCrackArrests: 693 s against 5 s). Quietly the gap is
+# far smaller, and not yet measured.
 # Tests marked slow (tests/conftest.py) run in `make validate`, not here.
 test: $(SOLVER) | $(DEPS)
 	$(ALL_SOLVER_TARGETS)
