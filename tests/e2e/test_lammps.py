@@ -33,9 +33,12 @@ import yaml
 from e2e_support import PY, ROOT, SOLVER, new_case_folder  # noqa: E402
 
 LMP = shutil.which("lmp")
-pytestmark = pytest.mark.skipif(
+# slow: a comparison with another code, run by make validate. In make test the gtests PmbLammps.*
+# hold LAMMPS's α rule and breaking order, test_mpi_lammps_rule.py their keys end to end (1-3 ranks),
+# the Contact gtests the short-range force.
+pytestmark = [pytest.mark.skipif(
     LMP is None, reason="LAMMPS is not installed (no `lmp` on PATH): Debian's `lammps` package; "
-    "`sh pipeline/install-deps.sh` (run by make test) installs it")
+    "`sh pipeline/install-deps.sh` (run by make test) installs it"), pytest.mark.slow]
 
 DX = 1.0e-3                      # lattice constant a [m]
 NX, NY, NZ = 16, 5, 5            # nodes per axis: LAMMPS's atoms at k·a, k = 0 … N − 1

@@ -22,8 +22,11 @@ import yaml
 from e2e_support import ROOT, SOLVER, new_case_folder, prepare_stages  # noqa: E402
 
 MPIEXEC = shutil.which("mpiexec")
-# The CI runs as root, which OpenMPI refuses unless told that it is meant.
-MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+# The CI runs as root, which OpenMPI refuses unless told that it is meant. OMP_WAIT_POLICY=PASSIVE
+# as for the ctest mpi_ranks tests: 2 ranks × 2 threads (np2t2) or 3 ranks on 2 cores, and a thread
+# waiting at a barrier would spin on the core a rank needs (no bit changes with the wait policy).
+MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMP_WAIT_POLICY="PASSIVE")
 
 
 def built_with_mpi():

@@ -53,6 +53,8 @@ def test_energy_balance_with_breakage_converges_with_dt(runs):
     assert full / half > 3.0
 
 
+# make validate's branching-lps is this run at the case's δ = 1 mm, judged by the same checks.
+@pytest.mark.slow
 def test_c7_criteria_with_lps(tmp_path):
     """cases/branching/lps.yaml (LPS, glass's ν = 0.22) at δ = 2 mm: the same C7 criteria, with the
     Rayleigh speed of ν = 0.22 (3156 m/s, plane stress) as the bound on the tip speed."""
