@@ -2,14 +2,14 @@
 the exact limit, and the adaptive step of thesis §2.2 over a sweep of TOL for φ = 1 and φ = ½ (at the
 default Δt_max = eq. 2.5, and for φ = ½ also with Δt_max = 4 × eq. 2.5, so that the controller alone
 sets the step), on an elastic wave in a strip and on a plate with a hole pulled to fracture; each
-against a Verlet run at 1/16 of the default step, 0.05 × eq. 2.5 (validation.md §4). A benchmark,
+against a Verlet run at 1/16 of the default step, 0.05 × eq. 2.5 (docs/theory.md T18). A benchmark,
 not a test: it asserts nothing. docs/accuracy.md reads the numbers.
 
 Errors: the wave, the relative L2 norm of the displacement over the 11 saved frames,
 sqrt(Σ_frames Σ_nodes |u − u_ref|² / Σ_frames Σ_nodes |u_ref|²); the fracture, the relative L2 norm
 of the difference of the final damage fields. Cost: the solver's own time-loop wall time (run.log's
 `done:` line, frame output included, set-up excluded), the minimum over --repeat runs of any run
-shorter than 2 s (validation.md §4: the minimum of repeated runs), and the force evaluations
+shorter than 2 s (docs/theory.md T18: the minimum of repeated runs), and the force evaluations
 (rejected adaptive attempts included), which do not depend on the machine.
 
 A third problem, quasi-static tension with fracture (bench/tension.py, issue 13): a notched strip
@@ -302,7 +302,7 @@ def measure(args, chosen):
         directory = os.path.join(args.out, problem_name)
         os.makedirs(directory, exist_ok=True)
         problem = make(directory)
-        # Reference: Verlet at 1/16 of the default step, 0.8/16 = 0.05 × eq. 2.5 (validation.md §4).
+        # Reference: Verlet at 1/16 of the default step, 0.8/16 = 0.05 × eq. 2.5 (docs/theory.md T18).
         ref_case = write_case(directory, problem, "reference",
                               {"integrator": "verlet", "dt": "stable", "safety_factor": 0.05}, None)
         ref = run(args.solver, ref_case, args.threads)

@@ -30,7 +30,7 @@ DX = 1e-3
 HORIZON = 3.0002 * DX
 YOUNG, DENSITY, FRACTURE_ENERGY = 72e9, 2440.0, 4.0
 BULK = YOUNG / (3.0 * (1.0 - 2.0 * 0.25))                          # k = E/(3(1−2ν)), ν = 1/4
-MICROMODULUS = micromodulus("3d", YOUNG, HORIZON, None)            # c = 18k/(πδ⁴) (validation.md F1)
+MICROMODULUS = micromodulus("3d", YOUNG, HORIZON, None)            # c = 18k/(πδ⁴) (docs/theory.md T2)
 CRITICAL_STRETCH = math.sqrt(5.0 * FRACTURE_ENERGY / (9.0 * BULK * HORIZON))  # s0 = √(5G0/(9kδ))
 SHEAR = YOUNG / (2.0 * (1.0 + 0.25))                               # G = E/(2(1+ν)): peri/lps
 

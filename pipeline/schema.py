@@ -150,7 +150,7 @@ CASE = {
         origin=Key("numbers", "lattice: a point [x, y(, z)] the lattice passes through, nodes at "
                    "origin + k·dx (as LAMMPS's lattice puts atoms at k·a); default: cell centres of the "
                    "mesh's bounding box", default=None, unit="m"),
-        partial_volume=Key("choice", "share ν of a neighbour's volume inside the horizon (validation.md F3): "
+        partial_volume=Key("choice", "share ν of a neighbour's volume inside the horizon (docs/theory.md T5): "
                            "none (full volumes), lammps (ν = (δ − |ξ|)/dx + ½ for δ − dx/2 ≤ |ξ| ≤ δ), "
                            "hhb (family |ξ| − dx/2 ≤ δ, ν = (δ − |ξ| + dx/2)/dx on the outer shell)",
                            default="none", choices=("none", "lammps", "hhb")),
@@ -188,7 +188,7 @@ CASE = {
                    "correction); 0 for none", default=0.0, unit="1/s", minimum=0.0),
     "contact": section(
         "short-range repulsion between nodes closer than d = min(0.9|ξ|, 1.35dx) (bonded pairs) or "
-        "1.35dx (others), force (c_s/δ)(d − r)V_j (thesis §1.1.3; validation.md F4)",
+        "1.35dx (others), force (c_s/δ)(d − r)V_j (thesis §1.1.3; docs/theory.md T8)",
         enabled=Key("choice", "auto: on when the case has more than one block (or self_contact); on; off",
                     default="auto", choices=("auto", "on", "off")),
         self_contact=Key("boolean", "also between nodes of the same block (fragments hitting each other)",

@@ -32,14 +32,14 @@ MIN_HORIZON_RATIO = 2.0   # horizon / spacing below which a warning says the mod
 LOW_DENSITY = 50.0
 LOW_MODULUS = 1.0e5
 # partial_volume rule → (family extension beyond δ in units of dx, shell weight ν on the outer
-# shell), as solver/src/core/partial_volume.cpp registers them (validation.md F3).
+# shell), as solver/src/core/partial_volume.cpp registers them (docs/theory.md T5).
 PARTIAL_VOLUME = {"none": (0.0, False), "lammps": (0.0, True), "hhb": (0.5, True)}
-# Contact distance 2r_s = 1.35·dx (solver/src/core/work_plan.cpp plan_contact; validation.md F4).
+# Contact distance 2r_s = 1.35·dx (solver/src/core/work_plan.cpp plan_contact; docs/theory.md T8).
 CONTACT_DISTANCE = 1.35
 
 
 def micromodulus(analysis: str, youngs_modulus: float, horizon: float, thickness: float | None) -> float:
-    """c of validation.md F1 (thesis eq. 1.11), as solver/src/core/material.cpp computes it."""
+    """c of docs/theory.md T2 (thesis eq. 1.11), as solver/src/core/material.cpp computes it."""
     if analysis == "3d":
         return 12.0 * youngs_modulus / (math.pi * horizon ** 4)
     if analysis == "plane_stress":
@@ -98,7 +98,7 @@ def stable_time_step(points: np.ndarray, volume: np.ndarray, block: np.ndarray, 
                      dx: float | None = None, partial_volume: str = "none", contact: float | None = None,
                      sample: int | None = SAMPLE, lps: tuple | None = None,
                      surface: np.ndarray | tuple | None = None) -> tuple[float, int]:
-    """min over nodes of √(2ρ_i / Σ_j V_j ν_ij c_ij/|ξ_ij|) (thesis eq. 2.5; validation.md F2) and the
+    """min over nodes of √(2ρ_i / Σ_j V_j ν_ij c_ij/|ξ_ij|) (thesis eq. 2.5; docs/theory.md T10) and the
     node where it is reached, as solver/src/core/model.cpp stable_time_step computes it: ν of the
     `partial_volume` rule (needs the grid spacing dx unless "none"), and with contact (c_s/c given
     as `contact`, see contact_stiffness_factor) a spring V_j c_s c_ij/δ for every bond with

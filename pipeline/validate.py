@@ -423,7 +423,7 @@ def _check_integrator_settings(case: dict, checker: _Checker):
 
 
 def _check_pmb_pairs(name: str, m: dict, checker: _Checker):
-    """PMB's constants come from one pair: E with G0 (validation.md F1) or c with s0 as given
+    """PMB's constants come from one pair: E with G0 (docs/theory.md T2) or c with s0 as given
     (a LAMMPS pair_coeff), never a mix; α only for a material that can break."""
     pairs = "give youngs_modulus (and fracture_energy) or micromodulus (and critical_stretch), not a mix"
     where = ("materials", name)

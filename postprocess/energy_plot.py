@@ -1,6 +1,6 @@
 """energy.png: the energy terms of history.csv against time, and the balance that should stay constant.
 
-The balance is every stored and dissipated energy minus the work put in (validation.md C4):
+The balance is every stored and dissipated energy minus the work put in (docs/theory.md C4):
     kinetic + strain + contact + indenter + broken bonds + damping work − external work,
 each term where history.csv has its column (formats.md §4). Without breaking, its drift is the
 integrator's error; with breaking, broken_bond_energy is the energy the broken bonds took with them,

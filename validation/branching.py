@@ -1,6 +1,6 @@
-"""Checks of cases/branching (validation.md C7, Bobaru & Zhang 2015): the crack-tip speed stays
+"""Checks of cases/branching (docs/theory.md C7, Bobaru & Zhang 2015): the crack-tip speed stays
 below the Rayleigh speed, the crack branches before the right edge, and the branches are
-symmetric about the notch line; also the energy balance with broken bonds (validation.md C4)."""
+symmetric about the notch line; also the energy balance with broken bonds (docs/theory.md C4)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,7 +9,7 @@ from postprocess import crack_tip
 
 from .common import Check, Run
 
-RAYLEIGH = 3058.0          # m/s, plane stress ν = 1/3, E = 72 GPa, ρ = 2440 (validation.md C7 [D]); rayleigh_speed()
+RAYLEIGH = 3058.0          # m/s, plane stress ν = 1/3, E = 72 GPa, ρ = 2440 (docs/theory.md C7 [D]); rayleigh_speed()
 DAMAGED = crack_tip.DAMAGED  # damage above which a node belongs to the crack (the normal output's too)
 SPEED_WINDOW = 2.0e-6      # s: tip speed over windows this long (a lattice crack advances in jumps)
 SYMMETRY_MIN = 0.95        # share of crack nodes whose mirror image is a crack node too

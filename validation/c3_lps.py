@@ -1,4 +1,4 @@
-"""validation.md C3 for LPS in 3D (issue 14): a 108 × 21 × 21 lattice bar in static tension, ν = 0.2,
+"""docs/theory.md C3 for LPS in 3D (issue 14): a 108 × 21 × 21 lattice bar in static tension, ν = 0.2,
 0.3, 0.45, hhb partial volumes, m = 4, with the energy surface correction and without it. The
 interior (2δ from every lateral face, the middle third of the length) must have the axial strain
 σ/E and the lateral strain −νσ/E within 2 % with the correction; the uncorrected errors are reported.
@@ -21,7 +21,7 @@ from .common import Check
 from .runner import ROOT
 
 TEST = "LpsTension.BarMeetsC3In3dWithItsInteriorTwoHorizonsFromEveryFace"
-TOLERANCE = 2.0  # %, validation.md C3 with a surface correction
+TOLERANCE = 2.0  # %, docs/theory.md C3 with a surface correction
 ROW = re.compile(r"\[ c3 lps   \] (corrected|uncorrected)\s+3d\s+nu=(\S+) .* cg=\s*(\d+)(.*?): "
                  r"axial ([+-]\d+\.\d+) %, lateral ([+-]\d+\.\d+) %")
 

@@ -1,12 +1,12 @@
 """Checks of cases/drum: a square membrane pre-tensioned by a uniform strain ε0 and struck, without
 damping. Its fundamental frequency must match the membrane's f = (√2/(2L))·√(T/(ρh)),
-T = E·ε0·h/(1 − ν) with plane-stress PMB's ν = 1/3; its energy KE + U must not drift (validation.md
+T = E·ε0·h/(1 − ν) with plane-stress PMB's ν = 1/3; its energy KE + U must not drift (docs/theory.md
 C4 without breakage); the clamping frame must hold the pre-strained edge where it was put.
 
 The out-of-plane restoring force is geometric: each pre-stretched bond pulls along its current
 direction, so a deflection w gives it a z-component c·ε0·V·(w_j − w_i)/|y_ij|, a nonlocal Laplacian
 whose continuum limit is exactly T∇²w/h (its lattice sum differs from the integral by the factor
-of validation.md C1, 1.025 at δ = 3.015 dx, and the nonlocal clamp moves the edge by ~dx).
+of docs/theory.md C1, 1.025 at δ = 3.015 dx, and the nonlocal clamp moves the edge by ~dx).
 The frequency is measured on the modal coordinate q(t) = Σ w_i φ_i / Σ φ_i², φ = sin(πx/L)·sin(πy/L)
 over the free span: the projection removes the other (odd, odd) modes the uniform blow excites."""
 from __future__ import annotations

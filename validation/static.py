@@ -1,4 +1,4 @@
-"""Static tension (validation.md C3): a 100 × 40 mm plane-stress plate held in x along its left end
+"""Static tension (docs/theory.md C3): a 100 × 40 mm plane-stress plate held in x along its left end
 row and pulled by σ = 1 MPa (a body force σ/dx on its right end row), brought to equilibrium by
 velocity damping (dynamic relaxation). The interior strains are fitted over the middle of the plate,
 2δ away from every edge: ε_xx against σ/E and ε_yy against −ν·σ/E (plane-stress PMB: ν = 1/3),
@@ -26,7 +26,7 @@ FINITE_PLATE = 0.02        # added to the lattice-sum deviation for the continuu
 
 
 def lattice_tensor(dx: float, delta: float, h: float, E: float, partial_volume: str) -> tuple[float, float, float]:
-    """(C11, C22, C12) [Pa] of the square lattice with the solver's volume weights (validation.md F3)."""
+    """(C11, C22, C12) [Pa] of the square lattice with the solver's volume weights (docs/theory.md T5)."""
     n = int(np.ceil(delta / dx)) + 2
     i, j = np.meshgrid(np.arange(-n, n + 1), np.arange(-n, n + 1), indexing="ij")
     x, y = i.ravel() * dx, j.ravel() * dx

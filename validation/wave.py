@@ -1,4 +1,4 @@
-"""Wave speed in the 1D chain of validation.md C2, run as one row of lattice nodes (validation/models/
+"""Wave speed in the 1D chain of docs/theory.md C2, run as one row of lattice nodes (validation/models/
 wave.yaml: bar.geo with H = dx, so every bond lies along x; a chain node has the 2D plane-stress
 micromodulus c and volume V = dx²h).
 
@@ -37,7 +37,7 @@ def chain_omega_squared(k: float, *, model: str, E: float, rho: float, h: float,
     """ω_s(k)² of the semi-discrete chain (one row of a plane-stress lattice, bonds j = 1..M = ⌊δ/Δx⌋
     on each side, V = Δx²h, ω = 1, full volumes), exact in space and continuous in time.
 
-    pmb (validation.md C2): ρω² = Σ_{j≤M} 2cV(1 − cos kjΔx)/(jΔx), c = 9E/(πhδ³).
+    pmb (docs/theory.md C2): ρω² = Σ_{j≤M} 2cV(1 − cos kjΔx)/(jΔx), c = 9E/(πhδ³).
 
     lps: the linearised LPS (materials/lps/lps.hpp) on the chain. With e_j = n_j·(u_j − u_i) and
     W_i = (κ/2)θ_i² + (α/(2m)) Σ_j ω(e_j − θ_i|ξ_j|/d)²V (Silling et al. 2007, eq. 92; Mitchell's
@@ -54,7 +54,7 @@ def chain_omega_squared(k: float, *, model: str, E: float, rho: float, h: float,
     r = np.arange(1, int(np.floor(delta / dx + 1e-9)) + 1) * dx
     V = dx * dx * h
     if model != "lps":
-        c = 9.0 * E / (np.pi * h * delta ** 3)      # plane stress, validation.md F1
+        c = 9.0 * E / (np.pi * h * delta ** 3)      # plane stress, docs/theory.md T2
         return float(np.sum(2 * c * V * (1 - np.cos(k * r)) / r) / rho)
     kappa, alpha, d = E / (2 * (1 - nu)), 8.0 * E / (2 * (1 + nu)), 2.0
     m = 2 * np.sum(r * r * V)
@@ -71,7 +71,7 @@ class Chain:
         self.rho, self.E = block["density"], block["youngs_modulus"]
         self.model, self.nu = block.get("model", "pmb"), block.get("poisson_ratio")
         self.h, self.dx, self.delta = run.case["thickness"], run.dx, run.horizon
-        self.c = 9.0 * self.E / (np.pi * self.h * self.delta ** 3)      # plane stress, validation.md F1
+        self.c = 9.0 * self.E / (np.pi * self.h * self.delta ** 3)      # plane stress, docs/theory.md T2
         self.V = self.dx ** 2 * self.h
         self.j = np.arange(1, int(np.floor(self.delta / self.dx + 1e-9)) + 1)
         self.dt = float(np.median(np.diff(run.history["time"])[1:] / np.diff(run.history["step"])[1:]))
@@ -291,7 +291,7 @@ def figure(result: dict, path: str):
             label=f"measured: {s['measured']:.3f} m/s ({s['measured'] / s['discrete'] - 1:+.1e} vs discrete)")
     ax.set_xlabel("kδ")
     ax.set_ylabel("phase speed / c0")
-    ax.set_title("wave: dispersion of the 1D chain (validation.md C2)")
+    ax.set_title("wave: dispersion of the 1D chain (docs/theory.md C2)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     ax = axes[1, 0]

@@ -7,7 +7,7 @@ validation/wave.py (one row of a plane-stress lattice, m = 3, ν = 0.3), the PMB
    Mitchell's form) with velocity Verlet's phase sin(ωΔt/2) = ω_s(k)Δt/2, within 0.1 %.
 Energy without breaking is not re-measured here: solver/tests/materials/test_lps.cpp
 (VerletFreeVibrationConservesEnergyToSecondOrder, a free vibrating plate, ν = 0.3) checks that KE + U
-does not drift and that its oscillation falls 4.3× when Δt halves (validation.md C4). On this chain a
+does not drift and that its oscillation falls 4.3× when Δt halves (docs/theory.md C4). On this chain a
 travelling pulse is a poor C4 probe: KE and U barely exchange, and the spread of KE + U fell 19× (not
 4×) from safety factor 0.8 to 0.4 (2.9·10⁻⁸ → 1.6·10⁻⁹ of KE + U).
 """

@@ -1,4 +1,4 @@
-// branching.geo: the dynamic crack-branching plate of Bobaru & Zhang (2015) (validation.md C7):
+// branching.geo: the dynamic crack-branching plate of Bobaru & Zhang (2015) (docs/theory.md C7):
 // a 100 mm × 40 mm soda-lime glass plate with a 50 mm notch along its mid-line from the left
 // edge (the notch is a pre-crack in branching.yaml, not a hole in the geometry), pulled by a
 // traction on its top and bottom edges. Values below are defaults; branching.yaml overrides them.

@@ -16,7 +16,7 @@ import peridyn
 from postprocess.plotting import new_figure, save_figure
 
 OUT = sys.argv[1] if len(sys.argv) > 1 else "out/study"
-ENERGIES = (2.0, 3.8, 8.0)  # J/m²; 3.8 is soda-lime glass (validation.md C7)
+ENERGIES = (2.0, 3.8, 8.0)  # J/m²; 3.8 is soda-lime glass (docs/theory.md C7)
 
 base = peridyn.load("cases/branching/branching.yaml")
 base["discretization.dx"] = 6.666666666666667e-4   # δ/3 with δ = 2 mm

@@ -3,7 +3,7 @@
 // is not: for the "axis" shear ε_xx = −ε_yy the deviatoric energy (α/2) Σ ω (e^d)² V_j is the
 // continuum's times r_A = Σ ω|ξ|² (n_x² − n_y²)² V / (c_d m), c_d = 4/15 (3D) or 1/2 (2D), the
 // isotropic mean of (n_x² − n_y²)² on the sphere or circle. So the bulk's C11 − C12 = 2 μ r_A, and a
-// bar's uniaxial stress along x has the compliances below (validation.md C3; the static tension of
+// bar's uniaxial stress along x has the compliances below (docs/theory.md C3; the static tension of
 // test_lps.cpp and test_lps_tension.cpp measure them).
 #pragma once
 #include <algorithm>

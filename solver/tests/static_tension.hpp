@@ -1,4 +1,4 @@
-// Test helper: the linear static tension of a lattice bar or plate (validation.md C3), solved by
+// Test helper: the linear static tension of a lattice bar or plate (docs/theory.md C3), solved by
 // conjugate gradients on the matrix-free J(0)·x of the material (the implicit integrators' path),
 // and the strains read back from it: of the interior (least squares away from every face) and of
 // the whole cross-section (the bar's apparent stiffness, surface layers included).
@@ -28,7 +28,7 @@ struct Tension {
 // u_z (and u_z everywhere in 2D) held where needed against rigid motion; σ [Pa] on its right face as
 // the body force σ/dx on the last layer (each node carries σ dx² of the load), or spread over the
 // last `load_layers` layers as σ/(load_layers dx) (a traction carried by a layer of about δ, as the
-// body-force loading of validation.md C7, rather than by the one row of surface nodes whose families
+// body-force loading of docs/theory.md C7, rather than by the one row of surface nodes whose families
 // are the most truncated). Fits over the middle third in x: interior = nodes whose y (and z) index
 // lies in [inner, n − 1 − inner].
 inline Tension static_tension(const pd::Model& m, int nx, int ny, int nz, double dx, double sigma, int inner,

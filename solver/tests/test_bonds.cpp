@@ -52,7 +52,7 @@ TEST(Bonds, EachBondStoredFromBothEndsWithTheSameLength) {
     ASSERT_NE(it, length.end());
     EXPECT_EQ(it->second, r);  // bitwise
   }
-  // Bulk node: 122 partners at m = 3 (validation.md C1).
+  // Bulk node: 122 partners at m = 3 (docs/theory.md C1).
   const std::size_t bulk = pdtest::node_index(3, 3, 3, 8, 7);
   EXPECT_EQ(b.offsets[bulk + 1] - b.offsets[bulk], 122);
 }
@@ -79,11 +79,11 @@ TEST(Bonds, StableTimeStepIsThesisEq25) {
   const pd::Model m = pd::build_model(c, nodes);
   const double cm = m.material.block[0].micromodulus;
   EXPECT_DOUBLE_EQ(pd::stable_time_step(m), std::sqrt(2.0 * 2000.0 / (1e-6 * cm / 0.01)));
-  EXPECT_DOUBLE_EQ(cm, 12.0 * 1e9 / (3.14159265358979323846 * std::pow(0.015, 4)));  // validation.md F1
+  EXPECT_DOUBLE_EQ(cm, 12.0 * 1e9 / (3.14159265358979323846 * std::pow(0.015, 4)));  // docs/theory.md T2
 }
 
 TEST(Material, CriticalStretchMatchesPeridynamicsJl) {
-  // validation.md F1 unit test: E = 1, ν = 0.25, δ = 2, Gc = 1 → εc = 0.6454972243679028 (3D).
+  // docs/theory.md T2 unit test: E = 1, ν = 0.25, δ = 2, Gc = 1 → εc = 0.6454972243679028 (3D).
   pd::BlockMaterial b;
   b.parameters["youngs_modulus"] = 1.0;
   b.parameters["fracture_energy"] = 1.0;

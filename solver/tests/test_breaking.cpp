@@ -59,9 +59,9 @@ TEST(Breaking, BondPastCriticalStretchBreaksAndCarriesNoForce) {
   EXPECT_EQ(pd::update_broken_bonds(m, stretched(m, 2 * s0)), 0);
 }
 
-// The energy a bond takes with it (history.csv broken_bond_energy, validation.md C4): the PMB bond
+// The energy a bond takes with it (history.csv broken_bond_energy, docs/theory.md C4): the PMB bond
 // energy w = ½ c s² |ξ| ν V_i V_j at the critical stretch s0 at which it broke, from the closed forms
-// of validation.md F1 (3D: c = 12E/(πδ⁴), s0 = √(5G0/(9Kδ)), K = E/(3(1 − 2·¼))), whatever stretch
+// of docs/theory.md T2 (3D: c = 12E/(πδ⁴), s0 = √(5G0/(9Kδ)), K = E/(3(1 − 2·¼))), whatever stretch
 // past s0 the step that broke it reached. Before issue 16 it was taken at that stretch: 2.25 × here.
 TEST(Breaking, ABrokenBondTakesItsEnergyAtTheCriticalStretch) {
   const double dx = 1e-3, delta = 1.5 * dx, E = 1e9, G0 = 10.0;

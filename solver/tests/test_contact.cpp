@@ -1,7 +1,7 @@
 // Contact and impact: two bodies bounce with momentum conserved to round-off and without
 // interpenetration; the Verlet list with skin gives bitwise the forces of a fresh search at every
 // step; an indenter's reaction follows K·h²; a single body builds no contact list; the partial-
-// volume rules reproduce validation.md C1's R_W factors.
+// volume rules reproduce docs/theory.md C1's R_W factors.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -262,7 +262,7 @@ TEST(Indenter, CylinderPushesANodeRadiallyOut) {
 }
 
 TEST(PartialVolume, RulesReproduceTheC1FactorsAtMEquals3) {
-  // validation.md C1(b): W = 4.5K·s̄²·R_W at a bulk node under isotropic stretch, with
+  // docs/theory.md C1(b): W = 4.5K·s̄²·R_W at a bulk node under isotropic stretch, with
   // R_W = Σ V_j ν_j |ξ_j|/(πδ⁴) = 1.120850 (full volumes) and 0.900206 (LAMMPS ν) for δ = 3dx.
   const int n = 9;
   const double E = 1e9, K = E / 1.5;  // 3D PMB: Poisson ratio 1/4

@@ -1,5 +1,5 @@
 // Time integration: momentum is conserved to round-off in a free body, energy error is bounded
-// and second order (validation.md C4), damping removes energy it accounts for, and the results
+// and second order (docs/theory.md C4), damping removes energy it accounts for, and the results
 // are bitwise the same with 1 and 2 threads.
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -83,7 +83,7 @@ TEST(Dynamics, MomentumConservedInAFreeBodyWithBreaking) {
 }
 
 TEST(Dynamics, EnergyErrorIsBoundedAndSecondOrder) {
-  // No breaking, no damping: KE + U is conserved up to an O(Δt²) oscillation (validation.md C4).
+  // No breaking, no damping: KE + U is conserved up to an O(Δt²) oscillation (docs/theory.md C4).
   double error[2];
   const double dt0 = 0.8 * pd::stable_time_step(free_body(-1.0));
   for (int r = 0; r < 2; ++r) {

@@ -1,4 +1,4 @@
-// Discrete patch tests on a bulk lattice node (validation.md C1): affine motion gives zero force,
+// Discrete patch tests on a bulk lattice node (docs/theory.md C1): affine motion gives zero force,
 // an isotropic stretch gives W = 4.5·K·s̄²·R_W (3D) or 1.5·E·s̄²·R (plane stress), u_x = a·x²
 // gives the Navier force 3.6·K·a times the lattice factor.
 #include <gtest/gtest.h>
@@ -91,7 +91,7 @@ TEST(PatchTest, AffineDisplacementGivesZeroForcePlaneStress) { expect_affine_for
 TEST(PatchTest, IsotropicStretchEnergy3D) {
   const Lattice l = bulk_lattice(3, "3d");
   const std::size_t n = l.model.nodes.size();
-  EXPECT_EQ(l.model.bonds.offsets[l.centre + 1] - l.model.bonds.offsets[l.centre], 122);  // validation.md C1
+  EXPECT_EQ(l.model.bonds.offsets[l.centre + 1] - l.model.bonds.offsets[l.centre], 122);  // docs/theory.md C1
   const double s_bar = 1e-3;
   pd::Vec3Array u = pd::make_vec3(n);
   for (std::size_t d = 0; d < 3; ++d)
@@ -102,7 +102,7 @@ TEST(PatchTest, IsotropicStretchEnergy3D) {
   // W = ¼ c s̄² Σ V_j |ξ_j| = 4.5 K s̄² R_W, R_W = Σ V_j |ξ_j| / (π δ⁴), with no linearisation error.
   const double E = 2.0e9, K = 2.0 * E / 3.0;  // ν = 1/4
   const double R_W = family_sum(l, length_term) / (kPi * std::pow(l.delta, 4));
-  EXPECT_NEAR(R_W, 1.120850, 1e-6);  // validation.md C1 (m = 3, full volumes)
+  EXPECT_NEAR(R_W, 1.120850, 1e-6);  // docs/theory.md C1 (m = 3, full volumes)
   EXPECT_NEAR(W / (4.5 * K * s_bar * s_bar * R_W), 1.0, 1e-9);
 
   // The kernel's own energy output agrees.
@@ -127,7 +127,7 @@ TEST(PatchTest, IsotropicStretchEnergyPlaneStressAndStrain) {
     // Continuum: ¼ c s̄² h ∫|ξ|dA = ¼ c s̄² h · 2πδ³/3; discrete factor R = Σ V_j|ξ_j| / (h·2πδ³/3).
     const double h = 2e-3;
     const double R = family_sum(l, length_term) / (h * 2.0 * kPi * std::pow(l.delta, 3) / 3.0);
-    EXPECT_NEAR(R, 1.0409, 5e-5) << analysis;  // validation.md C1: plane stress FA, m = 3
+    EXPECT_NEAR(R, 1.0409, 5e-5) << analysis;  // docs/theory.md C1: plane stress FA, m = 3
     const double continuum = (analysis == "plane_stress" ? 1.5 : 1.6) * E * s_bar * s_bar;  // PDMATLAB2D
     EXPECT_NEAR(W / (continuum * R), 1.0, 1e-9) << analysis;
   }
@@ -135,7 +135,7 @@ TEST(PatchTest, IsotropicStretchEnergyPlaneStressAndStrain) {
 
 TEST(PatchTest, QuadraticDisplacementGivesNavierForce3D) {
   // u_x = a·x² (origin shifted to the centre node): linearised PMB force c·a·Σ V ξ_x⁴/|ξ|³, whose
-  // continuum value is 3.6·K·a (validation.md C1c), times the FA lattice factor at m = 3.
+  // continuum value is 3.6·K·a (docs/theory.md C1c), times the FA lattice factor at m = 3.
   const Lattice l = bulk_lattice(3, "3d");
   const std::size_t n = l.model.nodes.size();
   const double a = 1e-3 / l.dx;  // small: the nonlinear part is O(a·δ) relative
@@ -149,7 +149,7 @@ TEST(PatchTest, QuadraticDisplacementGivesNavierForce3D) {
   const double linear = c * a * family_sum(l, navier_term);
   EXPECT_NEAR(f[0] / linear, 1.0, 1e-2);
   const double K = 2.0 * 2.0e9 / 3.0;
-  // validation.md C1c quotes 1.0563; the lattice sum Σ ξ_x⁴/|ξ|³ / (πδ⁴/5) at m = 3 is 1.0564121…
-  // (checked independently), so the quoted value is off by one in the last digit.
+  // docs/theory.md C1c: the lattice sum Σ ξ_x⁴/|ξ|³ / (πδ⁴/5) at m = 3 is 1.0564121… (checked
+  // independently; an earlier quote, 1.0563, was off by one in the last digit).
   EXPECT_NEAR(linear / (3.6 * K * a), 1.0564121, 1e-6);
 }

@@ -133,7 +133,7 @@ TEST(QuasiStatic, PulledBarReachesEquilibriumEqualToOneDirectSolve) {
               error / scale);
   // The middle of the bar stretches uniformly: the strain between two interior cross-sections
   // (x = 4dx and 7dx, on the axis) is within 20 % of the mean strain (PMB's surface effect and the
-  // stiffer clamped ends make it differ, validation.md C3).
+  // stiffer clamped ends make it differ, docs/theory.md C3).
   const std::size_t a = pdtest::node_index(4, 1, 1, kNx, kNy), b = pdtest::node_index(7, 1, 1, kNx, kNy);
   const double interior = (s.u[0][b] - s.u[0][a]) / (3 * kDx);
   EXPECT_NEAR(interior / strain, 1.0, 0.2);

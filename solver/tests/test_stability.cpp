@@ -1,6 +1,6 @@
 // The true stability limit (core/stability): the linearised operator is the tangent of the force
 // kernel; Lanczos finds the largest eigenvalue of infinite (periodic) lattices as a Bloch-wave
-// analysis does, and the ratio to eq. 2.5 is validation.md F2's 1.97 (3D, m = 3) and 1.17 (1D);
+// analysis does, and the ratio to eq. 2.5 is docs/theory.md T10's 1.97 (3D, m = 3) and 1.17 (1D);
 // velocity Verlet is stable just below 2/ω_max and blows up above it; energy error is second order.
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -160,7 +160,7 @@ TEST(Stability, PeriodicCubicLatticeIs197TimesEquation25) {
   ASSERT_TRUE(r.converged);
   EXPECT_NEAR(r.lambda_max / bloch_max(p, n, 3), 1.0, 1e-8);
   const double ratio = (2.0 / std::sqrt(r.lambda_max)) / equation_25(p);
-  EXPECT_NEAR(ratio, 1.97, 0.005);  // validation.md F2 (1.9698 for the infinite lattice)
+  EXPECT_NEAR(ratio, 1.97, 0.005);  // docs/theory.md T10 (1.9698 for the infinite lattice)
   std::printf("periodic cubic lattice, m = 3: exact/eq. 2.5 = %.5f (%d Lanczos iterations)\n", ratio, r.iterations);
 }
 
@@ -171,7 +171,7 @@ TEST(Stability, PeriodicChainIs117TimesEquation25) {
   ASSERT_TRUE(r.converged);
   EXPECT_NEAR(r.lambda_max / bloch_max(p, n, 1), 1.0, 1e-8);
   const double ratio = (2.0 / std::sqrt(r.lambda_max)) / equation_25(p);
-  EXPECT_NEAR(ratio, 1.1726, 0.001);  // validation.md F2: 1.17
+  EXPECT_NEAR(ratio, 1.1726, 0.001);  // docs/theory.md T10: 1.17
 }
 
 TEST(Stability, VerletIsStableJustBelowTheExactLimitAndBlowsUpJustAbove) {
@@ -208,7 +208,7 @@ TEST(Stability, VerletIsStableJustBelowTheExactLimitAndBlowsUpJustAbove) {
 
 TEST(Stability, VerletFreeVibrationEnergyDriftAndSecondOrderOscillation) {
   const OneThread one_thread;
-  // validation.md C4 over 10⁴ steps of a smooth free vibration at 0.8 × eq. 2.5: the mean of KE + U
+  // docs/theory.md C4 over 10⁴ steps of a smooth free vibration at 0.8 × eq. 2.5: the mean of KE + U
   // does not drift by 1e-3 (it oscillates by about 1.5% at this step, the O(Δt²) error of the
   // lowest modes), and halving Δt cuts that oscillation about 4× (second order).
   pd::Model m = free_plate(12);

@@ -84,7 +84,7 @@ def test_energy_is_dissipated_and_balanced(membrane_run):
     # mechanical energy falls: by 4 ms it is below exp(-α·t) ≈ 0.30 of the start.
     assert history["external_work"][-1] == 0.0
     assert mechanical[-1] < 0.35 * mechanical[0]
-    # Energy balance (validation.md C4): KE + U + damping work is conserved to the
+    # Energy balance (docs/theory.md C4): KE + U + damping work is conserved to the
     # integration error of velocity Verlet.
     balance = mechanical + history["damping_work"] - history["external_work"]
     assert np.abs(balance - balance[0]).max() < 1e-3 * balance[0]

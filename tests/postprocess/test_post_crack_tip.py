@@ -179,7 +179,7 @@ def test_validation_branching_uses_the_shared_tracker():
 
 
 def fracture_case():
-    return CaseSettings(name="branching", dimension=2, title="Crack branching in soda-lime glass (validation.md C7)",
+    return CaseSettings(name="branching", dimension=2, title="Crack branching in soda-lime glass (docs/theory.md C7)",
                         cracks=[([0.0, NOTCH_Y, 0.0], [NOTCH_TIP, NOTCH_Y, 0.0])])
 
 

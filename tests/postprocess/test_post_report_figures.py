@@ -41,7 +41,7 @@ def keep(monkeypatch):
 
 
 def case(**kwargs):
-    return CaseSettings(name="branching", dimension=2, title="Crack branching in soda-lime glass (validation.md C7)",
+    return CaseSettings(name="branching", dimension=2, title="Crack branching in soda-lime glass (docs/theory.md C7)",
                         **kwargs)
 
 

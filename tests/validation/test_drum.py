@@ -42,7 +42,7 @@ def test_pre_strain_energy_is_the_lattice_sum(out):
     pairs = cKDTree(run.x[:, :2]).query_pairs(run.horizon, output_type="ndarray")
     length = np.linalg.norm(run.x[pairs[:, 0], :2] - run.x[pairs[:, 1], :2], axis=1)
     h, E = run.case["thickness"], run.case["blocks"][0]["youngs_modulus"]
-    c = 9.0 * E / (np.pi * h * run.horizon ** 3)           # plane stress (validation.md F1)
+    c = 9.0 * E / (np.pi * h * run.horizon ** 3)           # plane stress (docs/theory.md T2)
     # each pair once: ½·c·s²·|ξ|·V_i·V_j (= ¼ summed over both ends), s = ε0 for every bond
     expected = 0.5 * c * eps ** 2 * np.sum(length * volume[pairs[:, 0]] * volume[pairs[:, 1]])
     assert run.history["strain_energy"][0] == pytest.approx(expected, rel=1e-9)
@@ -53,7 +53,7 @@ def test_pre_strain_energy_is_the_lattice_sum(out):
 
 
 def test_energy_error_falls_4x_when_dt_halves(tmp_path_factory):
-    # validation.md C4 without breakage: velocity Verlet's energy error is O(Δt²), bounded, no drift.
+    # docs/theory.md C4 without breakage: velocity Verlet's energy error is O(Δt²), bounded, no drift.
     # Coarse drum (dx = 2 mm), 2 periods; measured 2.30e-5, 5.74e-6 (and 1.43e-6 at 0.2) of KE(0).
     dx = 2.0e-3
     errors = []

@@ -1,4 +1,4 @@
-"""Fast static tension (validation/static.py, validation.md C3) on a coarser plate (dx = 2 mm,
+"""Fast static tension (validation/static.py, docs/theory.md C3) on a coarser plate (dx = 2 mm,
 m = 3): the interior strains at equilibrium against the lattice-sum prediction and against σ/E,
 −νσ/E, with and without partial volumes; and the lattice tensor's own limits."""
 import numpy as np
@@ -12,7 +12,7 @@ def test_lattice_tensor_limits():
     c11, c22, c12 = static.lattice_tensor(1.0, 40.015, 1.0, 1.0, "none")
     assert c11 == pytest.approx(9 / 8, rel=5e-3) and c12 == pytest.approx(3 / 8, rel=5e-3)
     assert c11 == pytest.approx(c22, rel=1e-12)
-    # C1's 2D plane-stress factor R_W at δ = 3dx + ε (validation.md: 1.0409)
+    # C1's 2D plane-stress factor R_W at δ = 3dx + ε (docs/theory.md C1: 1.0409)
     assert static.lattice_factor("none", 3.0 + 1e-9) == pytest.approx(1.0409, abs=1e-4)
 
 

@@ -1,4 +1,4 @@
-"""Fast wave checks (validation/wave.py, validation.md C2) on the 1D chain (one row of lattice
+"""Fast wave checks (validation/wave.py, docs/theory.md C2) on the 1D chain (one row of lattice
 nodes): a driven sinusoid's phase speed matches the discrete dispersion relation with velocity
 Verlet's phase to 0.1 % (a shorter bar than `make validate`: 1 m), and a Gaussian pulse follows
 d'Alembert's transport with an error that falls about 4× when δ halves at m = 3."""

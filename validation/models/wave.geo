@@ -1,5 +1,5 @@
 // bar.geo: a rectangle Lx × H for the validation-only runs of validation/ (wave speed, static
-// tension). With H = dx the lattice holds a single row of nodes: the 1D chain of validation.md C2.
+// tension). With H = dx the lattice holds a single row of nodes: the 1D chain of docs/theory.md C2.
 DefineConstant[
   Lx = {0.1,   Name "Parameters/length [m]"},
   H  = {0.001, Name "Parameters/height [m]"},

@@ -21,7 +21,7 @@ inline double bond_length(const Vec3Array& x, std::size_t i, std::size_t j) {
   return std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
 }
 
-// ν(|ξ|), the share of V_j inside the horizon (validation.md F3): every rule we have is
+// ν(|ξ|), the share of V_j inside the horizon (docs/theory.md T5): every rule we have is
 // ν = clamp((outer − |ξ|)/dx, 0, 1) — LAMMPS's (δ − |ξ|)/dx + ½ and HHB's (δ − |ξ| + dx/2)/dx
 // both have outer = δ + dx/2; full volumes have outer = +∞, so ν = 1. Two numbers instead of
 // eight bytes per bond (core/partial_volume sets them).

@@ -129,7 +129,7 @@ struct CrackSegment {
   std::array<double, 3> from{}, to{};  // [m]
 };
 
-// contact: short-range forces between nodes (validation.md F4).
+// contact: short-range forces between nodes (docs/theory.md T8).
 struct ContactSettings {
   std::string enabled = "auto";   // auto | on | off
   bool self_contact = false;      // also between nodes of the same block (fragments)
@@ -158,7 +158,7 @@ struct Case {
   double thickness = 0.0;  // h [m], 2D only
   double grid_spacing = 0.0;
   double horizon = 0.0;
-  std::string partial_volume = "none";  // validation.md F3: none | lammps | hhb
+  std::string partial_volume = "none";  // docs/theory.md T5: none | lammps | hhb
   // none | energy | volume (Le & Bobaru 2018, core/surface_correction): energy, per-bond factors
   // from the energy of a uniaxial stress along each axis on each node's family against the
   // continuum's; volume, from the family volumes.

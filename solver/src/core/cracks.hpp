@@ -1,6 +1,6 @@
 // Pre-cracks (notches): bonds whose reference segment crosses a crack segment start broken, the
 // usual way to put a sharp notch into a peridynamic body (Bobaru & Zhang 2015, the crack-branching
-// set-up of validation.md C7; PDMATLAB2D CrackBranching.m cuts the bonds the same way).
+// set-up of docs/theory.md C7; PDMATLAB2D CrackBranching.m cuts the bonds the same way).
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -36,7 +36,7 @@ struct BlockMaterial {
 struct PairConstants {
   double micromodulus = 0.0;      // c [N/m⁶] (3D) so that c·s·V_j is a force density
   double critical_stretch = 0.0;  // s0; +inf for an unbreakable block
-  // α of LAMMPS's critical-stretch rule s0_i = s0 − α·min_j s_ij (validation.md F5; Parks et al.
+  // α of LAMMPS's critical-stretch rule s0_i = s0 − α·min_j s_ij (docs/theory.md T4; Parks et al.
   // 2008, the PERI package); 0: s0 stays fixed (the thesis).
   double critical_stretch_alpha = 0.0;
 };

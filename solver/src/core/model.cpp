@@ -68,7 +68,7 @@ Model build_model_without_bonds(const Case& c, Nodes nodes) {
     for (std::size_t i = 0; i < n; ++i) m.no_fail[i] |= set->member[i];
   }
   m.conditions = make_conditions(c, nodes);
-  // A partial-volume rule may widen the family (HHB) and weights each bond by ν (validation.md F3).
+  // A partial-volume rule may widen the family (HHB) and weights each bond by ν (docs/theory.md T5).
   const PartialVolumeRule& rule = partial_volume_registry().get(c.partial_volume);
   const double cutoff = bond_search_cutoff(c);
   apply_partial_volume(rule, c.horizon, c.grid_spacing, m.bonds);
@@ -112,7 +112,7 @@ double node_stiffness(const Model& m, std::size_t i) {
     const double length = bond_length(m.nodes.x, i, j);
     sum += m.bond_model->bond_stiffness(m, i, j, length) * m.bonds.factor(static_cast<std::size_t>(k));
     // With contact, a node pressed into a surface meets about as many contact partners as it has
-    // bonds shorter than 2r_s, each a spring c_s·V_j/δ (validation.md F2: the contact stiffness
+    // bonds shorter than 2r_s, each a spring c_s·V_j/δ (docs/theory.md T10: the contact stiffness
     // 15c needs extra margin in impacts).
     if (m.contact.pairs && length <= m.contact.distance) {
       const double micromodulus = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])];

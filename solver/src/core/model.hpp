@@ -41,7 +41,7 @@ struct Model {
   // bonds.broken; empty for a law without history.
   StateArrays state_arrays;
   Conditions conditions;
-  // Short-range contact (validation.md F4) and rigid indenters: what the scene needs is decided
+  // Short-range contact (docs/theory.md T8) and rigid indenters: what the scene needs is decided
   // once from the case (core/work_plan); contact.pairs is false when nothing can touch.
   ContactParameters contact;
   std::vector<IndenterSettings> indenters;
@@ -67,7 +67,7 @@ void declare_state(Model& model, bool at_rest = true);
 // Broken bonds, each counted once (both stored copies of a bond break together).
 std::int64_t broken_bond_count(const Model& model);
 
-// Stable step of the explicit scheme, thesis eq. 2.5 (validation.md F2):
+// Stable step of the explicit scheme, thesis eq. 2.5 (docs/theory.md T10):
 // Δt = min_i √(2ρ_i / Σ_p V_p C_ip), C_ip = c_ip/|ξ_p| for PMB, without safety factor; +inf if no node has a bond.
 // ν_p (partial volume) multiplies V_p; with contact, every bond shorter than 2r_s adds a contact
 // spring V_p·c_s/δ to the sum.

@@ -31,7 +31,7 @@ struct ContactPairs {
   std::size_t directed() const { return neighbour.size(); }
 };
 
-// d_ij of validation.md F4 (LAMMPS pair peri/pmb, Silling's EMU): 0.9|ξ| keeps a bonded pair from
+// d_ij of docs/theory.md T8 (LAMMPS pair peri/pmb, Silling's EMU): 0.9|ξ| keeps a bonded pair from
 // repelling at its rest length; 2r_s = 1.35·dx for any other pair.
 inline double contact_distance(double reference_length, bool bonded, double two_rs) {
   return bonded ? std::min(0.9 * reference_length, two_rs) : two_rs;

@@ -1,13 +1,13 @@
-// The partial-volume rules of validation.md F3 and their registry.
+// The partial-volume rules of docs/theory.md T5 and their registry.
 #include "core/partial_volume.hpp"
 
 namespace pd {
 
 // none: full volumes (FA), every neighbour within δ counts wholly.
 // lammps: LAMMPS peri/pmb, ν = (δ − |ξ|)/dx + ½ on [δ − dx/2, δ], else 1, so ν = ½ at |ξ| = δ
-//   (validation.md F3/F5; LAMMPS pair_peri_pmb documentation).
+//   (docs/theory.md T5/T4; LAMMPS pair_peri_pmb documentation).
 // hhb: PA-HHB, the family is |ξ| − dx/2 ≤ δ; on the outer shell the weight is (δ − |ξ| + dx/2)/dx
-//   (validation.md F3), i.e. the part of the node's cell, of width dx, that lies inside δ.
+//   (docs/theory.md T5), i.e. the part of the node's cell, of width dx, that lies inside δ.
 // lammps and hhb share ν = clamp((δ + dx/2 − |ξ|)/dx, 0, 1) and differ only in the family.
 VolumeWeight PartialVolumeRule::weight(double horizon, double dx) const {
   VolumeWeight w;

@@ -1,4 +1,4 @@
-// Partial-volume rules (validation.md F3): the share ν of a neighbour's volume V_j that lies
+// Partial-volume rules (docs/theory.md T5): the share ν of a neighbour's volume V_j that lies
 // inside the horizon, applied to every bond so that results can be compared with other codes.
 #pragma once
 #include <string>

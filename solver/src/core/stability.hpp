@@ -19,7 +19,7 @@ namespace pd {
 // cannot raise ω_max, Cauchy interlacing), so the limit is never optimistic on their account.
 //
 // period[d] > 0 makes axis d periodic for the bond direction (minimum image of x_j − x_i): only
-// the tests use it, to reproduce the infinite lattice of validation.md F2 with a hand-made bond list.
+// the tests use it, to reproduce the infinite lattice of docs/theory.md T10 with a hand-made bond list.
 struct LanczosReport {
   double lambda_max = 0.0;  // ω_max² [1/s²]
   int iterations = 0;       // operator applications (each costs about one force evaluation)

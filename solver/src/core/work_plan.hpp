@@ -11,7 +11,7 @@ namespace pd {
 
 // contact.enabled: off → no pairs; on → pairs; auto → pairs when the node file holds more than one
 // block or self_contact is set. Between different blocks always, inside a block only with
-// self_contact. Contact distance 2r_s = 1.35·(r_i + r_j) with r = dx/2 (validation.md F4).
+// self_contact. Contact distance 2r_s = 1.35·(r_i + r_j) with r = dx/2 (docs/theory.md T8).
 ContactParameters plan_contact(const Case& c, const std::vector<std::int32_t>& block_index, double bond_cutoff);
 
 class ForceOperator;

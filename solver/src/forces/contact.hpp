@@ -1,4 +1,4 @@
-// The short-range contact force (thesis §1.1.3, eq. 1.13; validation.md F4): a repulsion between
+// The short-range contact force (thesis §1.1.3, eq. 1.13; docs/theory.md T8): a repulsion between
 // any two nodes closer than d_ij in their current positions, bonded or not, along the line
 // joining them. Form of Silling's EMU code as LAMMPS pair peri/pmb implements it:
 //   f_i += −(c_s/δ)·(d_ij − |y_j − y_i|)·V_j·(y_j − y_i)/|y_j − y_i|   when |y_j − y_i| < d_ij,

@@ -18,7 +18,7 @@ namespace pd {
 
 void AdaptiveStep::configure(const Case& c, double dt_exact_known) {
   settings_ = c.adaptive;
-  // Default Δt_max: eq. 2.5 (validation.md §3: keep Δt ≤ Δt_SA), and below the step where the
+  // Default Δt_max: eq. 2.5 (docs/theory.md T12: keep Δt ≤ Δt_SA), and below the step where the
   // fixed-point iteration stops contracting, φΔtω_max < 1, i.e. Δt < Δt_exact/(2φ) (adaptive.hpp).
   // Above that limit every few steps diverge and are redone at half the step: with φ = 1 on the
   // membrane (Δt_exact/2 = 0.84 × eq. 2.5) the default eq. 2.5 cost a rejection on every other

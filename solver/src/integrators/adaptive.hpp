@@ -1,5 +1,5 @@
 // The mixed explicit–implicit adaptive step of thesis §2.2 (Zohdi's staggered fixed-point
-// iteration with step-size control, eqs. 2.6–2.8; validation.md §3).
+// iteration with step-size control, eqs. 2.6–2.8; docs/theory.md T12).
 //
 // The step n → n+1 is the θ-method with θ = φ on (u, v), solved by fixed-point iteration K = 1, 2, …:
 //   v^{n+1,K} = v^n + Δt/ρ·[φ f(u^{n+1,K−1}) + (1−φ) f(u^n)]        (damping: see below)
@@ -10,7 +10,7 @@
 // force by φ while keeping the thesis's Δt² in u would be first order in u for every φ: its Taylor
 // coefficient of the acceleration must be ½, and it is 1.) In Newmark terms β = φ², γ = φ, so every
 // φ in [½, 1] is unconditionally stable once the iteration has converged. The iteration contracts
-// only while φ²·Δt²·ω_max² < 1 (validation.md §3): Δt < Δt_exact/(2φ), where Δt_exact = 2/ω_max is
+// only while φ²·Δt²·ω_max² < 1 (docs/theory.md T12): Δt < Δt_exact/(2φ), where Δt_exact = 2/ω_max is
 // the Verlet limit; the controller finds this by itself.
 //
 // Error and control (eqs. 2.6–2.8): ω_K = Σ_i‖u_i^{K} − u_i^{K−1}‖ / Σ_i‖u_i^{K} − u_i^n‖, Z_K = ω_K/TOL,

@@ -1,4 +1,4 @@
-// The one reduction over nodes (design.md "next shape"): every sum over nodes that the operator
+// The one reduction over nodes (docs/theory.md T17): every sum over nodes that the operator
 // reports (energies, powers, norms) goes through here, so its bits never depend on threads or
 // ranks. The terms are summed exactly (core/exact_sum.hpp) and rounded once: serially (d == null)
 // over all nodes, decomposed over each rank's owned nodes and then across the ranks

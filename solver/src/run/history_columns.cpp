@@ -37,7 +37,7 @@ HistoryColumns::HistoryColumns(const Model& model, const Case& c, const Integrat
   add(energies, [](const HistoryInputs& in, std::vector<double>& out) {
     for (std::size_t k = 0; k < term_energy_names().size(); ++k)
       out.push_back(k < in.state.term_energies.size() ? in.state.term_energies[k] : 0.0);
-    out.push_back(in.broken_energy);  // validation.md C4 with breaking
+    out.push_back(in.broken_energy);  // docs/theory.md C4 with breaking
   });
   // The operator's list (contact_list; on a decomposed run the piece's: every rank builds together).
   const NeighbourList* list = contact_list ? contact_list : &model.contact_list;

@@ -179,7 +179,7 @@ LoopEnd TimeLoop::run() {
 std::optional<Failure> TimeLoop::advance() {
   const NextStep next = schedule.next_step(loop);
   double h = next.h;
-  // E + D + B − W before the step (validation.md C4), for a quasi-static load step's ledger in
+  // E + D + B − W before the step (docs/theory.md C4), for a quasi-static load step's ledger in
   // watch(); without the kinetic energy when the last step was a load step too (see there).
   const bool after_load_step = integrator.step_mode().value_or(0) == 1;
   const double held_before = state.plus_term_energies((after_load_step ? 0.0 : energies.kinetic) + energies.strain) +

@@ -2,7 +2,7 @@
 // no force, θ exact on the discrete family, the continuum strain energy with the discrete m), its
 // force as the gradient of its energy, its linearisation (J·x against a central difference,
 // symmetry, rigid motions, the reference stiffness), bitwise results for any thread count, its
-// stable step against the exact limit of an infinite lattice, and static tension (validation.md C3).
+// stable step against the exact limit of an infinite lattice, and static tension (docs/theory.md C3).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -102,7 +102,7 @@ TEST(Lps, CriticalStretchIsCabanaPdsAndPmbsForTheirInfluenceFunctions) {
   b.model = "lps";
   b.parameters = {{"youngs_modulus", 1.0}, {"poisson_ratio", 0.25}, {"fracture_energy", 1.0}};
   const double delta = 2.0, k3 = 2.0 / 3.0;  // K = E/(3(1−2ν))
-  b.choices["influence"] = "inverse_length";  // ω = 1/|ξ|: PMB's s0 (validation.md F1: 0.6454972243679028)
+  b.choices["influence"] = "inverse_length";  // ω = 1/|ξ|: PMB's s0 (docs/theory.md T2: 0.6454972243679028)
   EXPECT_NEAR(pd::lps_constants(b, "3d", delta, 0.0).critical_stretch, 0.6454972243679028, 1e-13);
   EXPECT_NEAR(pd::lps_constants(b, "3d", delta, 0.0).micromodulus, 18.0 * k3 / (kPi * 16.0), 1e-15);
   // 2D with ν = 1/4: plane strain is PMB's √(5πG0/(12Eδ)); plane stress with ν = 1/3 √(4πG0/(9Eδ)).
@@ -410,7 +410,7 @@ TEST(Lps, StableStepOfTheModelIsItsBondStiffnessSum) {
 }
 
 TEST(Lps, StaticTensionGivesTheLatticesPoissonRatio) {
-  // validation.md C3 in 3D with ν = 0.3: a 36 × 15 × 15 bar (dx = 1 mm, δ = 3.015 dx), u_x = 0 on its
+  // docs/theory.md C3 in 3D with ν = 0.3: a 36 × 15 × 15 bar (dx = 1 mm, δ = 3.015 dx), u_x = 0 on its
   // left face (and three components more against rigid motion), σ = 1 MPa as the body force σ/dx on
   // its right face. The linearised problem −J(0) u = b is solved by conjugate gradients with the
   // matrix-free J·x (the implicit integrators' path for a state-based law). Interior strains are
@@ -438,7 +438,7 @@ TEST(Lps, StaticTensionGivesTheLatticesPoissonRatio) {
   // The apparent Poisson ratio is the lattice's to 2 % (measured 0.3345 against 0.3293: the cubic
   // family's shear anisotropy at m = 3, not the continuum's 0.3); the axial strain lies between the
   // continuum's σ/E and the lattice's (measured 1.054 σ/E: a 15-node cross-section is stiffened by its
-  // surface layers, the C1 factor of validation.md C3).
+  // surface layers, the C1 factor of docs/theory.md C3).
   EXPECT_NEAR(-eyy / exx, -lattice_yy / lattice_xx, 0.02 * (-lattice_yy / lattice_xx));
   EXPECT_GT(exx, sigma / kE);
   EXPECT_LT(exx, lattice_xx);
@@ -576,7 +576,7 @@ TEST(Lps, Avx2RowsAreBitwiseThePortableRows) {
 }
 
 TEST(Lps, VerletFreeVibrationConservesEnergyToSecondOrder) {
-  // validation.md C4 with LPS: a free 12 × 12 plane-stress plate (ν = 0.3) vibrating in its lowest
+  // docs/theory.md C4 with LPS: a free 12 × 12 plane-stress plate (ν = 0.3) vibrating in its lowest
   // modes under velocity Verlet at 0.8 × the stable step: KE + U does not drift, and halving Δt
   // cuts its oscillation about 4× (second order) — the force is the gradient of U.
   const pdtest::OneThread one_thread;
@@ -667,7 +667,7 @@ TEST(Lps, PlaneWavesOnTheInfiniteLatticeFollowTheDiscreteDispersionRelation) {
   // longitudinal and transverse: it returns ω²·u to 1e-12, and the shorter wave is slower. The
   // printed long-wave speeds differ from the continuum's √((K + 4μ/3)/ρ), √(μ/ρ) (3D) and
   // √((κ + μ)/ρ), √(μ/ρ) (plane stress) by the lattice's anisotropy at m = 3 (the discrete family's
-  // fourth moments are not isotropic, as for PMB in validation.md C1/C3): measured −3.9 % and +5.0 %
+  // fourth moments are not isotropic, as for PMB in docs/theory.md C1/C3): measured −3.9 % and +5.0 %
   // (3D), +0.01 % and −2.2 % (plane stress) at kδ = 0.53.
   struct Setup {
     int dimension;

@@ -1,4 +1,4 @@
-// Static tension of LPS (validation.md C3; issue 14, "Tests and validation"): the interior axial
+// Static tension of LPS (docs/theory.md C3; issue 14, "Tests and validation"): the interior axial
 // strain against σ/E' and the lateral one against −ν'σ/E' (E' = E, ν' = ν in 3D and plane stress;
 // E/(1 − ν²), ν/(1 − ν) in plane strain), with the energy surface correction and without it, for
 // ν = 0.2, 0.3, 0.45 (3D, plane strain) and 0.3 (plane stress). The static problem is solved by
@@ -374,7 +374,7 @@ TEST(LpsTension, MeasureProfile) {
   std::printf("[ c3 lps   ] gaps across y (lateral %%):%s\n", line.c_str());
 }
 
-// validation.md C3 in 3D for LPS, the bar measured as C3 defines it (`make validate`, validation/
+// docs/theory.md C3 in 3D for LPS, the bar measured as C3 defines it (`make validate`, validation/
 // c3_lps.py; PD_LPS_TENSION_VALIDATE=1, else skipped: six solves of 47 628 nodes, 1–2 min each on
 // one thread). The bar of BarInterior… (36 × 13²) cannot show C3's lateral strain: its "interior"
 // (the middle 3 × 3 rows) is 5 spacings = 1.25δ from the faces, inside the surface layer, whose

@@ -65,7 +65,7 @@ TEST(Pmb, ConstantsAreThoseOfValidationF1) {
   pd::BlockMaterial b;
   b.parameters["youngs_modulus"] = 1.0;
   b.parameters["fracture_energy"] = 1.0;
-  // validation.md F1: E = 1, δ = 2, G0 = 1 → s0 = 0.6454972243679028 (3D), c = 18K/(πδ⁴), K = 2E/3
+  // docs/theory.md T2: E = 1, δ = 2, G0 = 1 → s0 = 0.6454972243679028 (3D), c = 18K/(πδ⁴), K = 2E/3
   const pd::PairConstants k = pd::pmb_constants(b, "3d", 2.0, 0.0);
   EXPECT_NEAR(k.critical_stretch, 0.6454972243679028, 1e-15);
   EXPECT_DOUBLE_EQ(k.micromodulus, 18.0 * (2.0 / 3.0) / (3.14159265358979323846 * 16.0));

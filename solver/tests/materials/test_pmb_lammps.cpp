@@ -1,4 +1,4 @@
-// LAMMPS-compatible PMB (docs/lammps.md; validation.md F5): the per-node critical stretch
+// LAMMPS-compatible PMB (docs/lammps.md; docs/theory.md T4): the per-node critical stretch
 // s0_i = s00 − α·min_j s_ij on a chain computed by hand, the breaking order in which a bond over
 // its critical stretch still carries its force in the step it breaks, c and s0 given directly, and
 // the case reader's errors for a mix of the two parameter pairs.
@@ -148,7 +148,7 @@ TEST(PmbLammps, WhileNothingBreaksTheLammpsOrderIsBitwiseTheThesisOrder) {
 }
 
 TEST(PmbLammps, MicromodulusAndCriticalStretchGivenDirectlyAreTheYoungsModulusRoute) {
-  // E and G0 → (c, s0) by validation.md F1; the same c and s0 given directly give the same table,
+  // E and G0 → (c, s0) by docs/theory.md T2; the same c and s0 given directly give the same table,
   // the same forces and the same broken bonds.
   pd::Case by_e = pdtest::lattice_case(3, "3d", 1e-3, 3.015e-3, 7.2e10, 2440.0, 4.0);
   pd::Model a = pd::build_model(by_e, pdtest::cubic_lattice(6, 5, 4, 1e-3, 3));

@@ -3,7 +3,7 @@
 // g per bond for both copies), the apparent stiffness of a thin bar and a plate in tension (within
 // 2 % of E with it; the error without it printed and asserted larger), the force as the gradient of
 // the corrected energy, J·x against a difference of the force, bitwise results for 1 and 2 threads,
-// and the static tension of validation.md C3 for LPS (interior strains against σ/E and −νσ/E).
+// and the static tension of docs/theory.md C3 for LPS (interior strains against σ/E and −νσ/E).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -73,7 +73,7 @@ double lateral_ratio(const Config& s) {
 }  // namespace
 
 // A measurement table (not a test): PD_SURFACE_MEASURE=1 prints the static tension of every
-// configuration of validation.md C3 with and without the correction and partial volumes.
+// configuration of docs/theory.md C3 with and without the correction and partial volumes.
 TEST(SurfaceCorrection, MeasureStaticTension) {
   if (!std::getenv("PD_SURFACE_MEASURE")) GTEST_SKIP() << "set PD_SURFACE_MEASURE=1 to print the table";
   const double sigma = 1e6;
@@ -425,7 +425,7 @@ TEST(SurfaceCorrection, PlateInTensionHasTheStiffnessOfTheLpsMaterial) {
 }
 
 TEST(SurfaceCorrection, StaticTensionOfLpsInteriorStrains) {
-  // validation.md C3 for LPS, on the thick bar of MeasureStaticTension (36 × 15 × 15, or a 36 × 21
+  // docs/theory.md C3 for LPS, on the thick bar of MeasureStaticTension (36 × 15 × 15, or a 36 × 21
   // plate): interior ε_xx against σ/E' and −ε_yy/ε_xx against ν' (E' = E, ν' = ν; plane strain
   // E/(1 − ν²), ν/(1 − ν)). The full table (3 analyses × ν × partial volumes × correction) is in the
   // report of issue 14; here three rows, each checked against its measured value and against the

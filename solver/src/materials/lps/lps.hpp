@@ -80,7 +80,7 @@ LpsModuli lps_moduli(double youngs_modulus, double poisson_ratio, const std::str
 // (lps_constants.cpp): 3D s0 = √(4 G0 I4 / (9 K I5)), 2D s0 = √(π G0 I3 / (4 κ I4)),
 // I_k = ∫₀^δ ω(r) r^k dr. This is CabanaPD's LPS critical stretch (√(8G0/(15Kδ)) for ω = 1,
 // √(5G0/(9Kδ)) for ω = 1/|ξ|, PMB's) for any ω and in 2D. c: the bond-based micromodulus of the
-// same κ, 18K/(πδ⁴) (3D) or 12κ/(πhδ³) (2D), used by contact (validation.md F4) and run.log.
+// same κ, 18K/(πδ⁴) (3D) or 12κ/(πhδ³) (2D), used by contact (docs/theory.md T8) and run.log.
 PairConstants lps_constants(const BlockMaterial& block, const std::string& analysis, double horizon, double thickness);
 
 class LpsModel : public BondModel {

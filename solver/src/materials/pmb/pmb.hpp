@@ -22,7 +22,7 @@ struct PmbArrays {
   const std::int64_t* offsets;
   const std::int32_t* neighbour;
   const std::uint8_t* broken;
-  VolumeWeight volume_weight;  // ν(|ξ|) (validation.md F3; 1 for full volumes)
+  VolumeWeight volume_weight;  // ν(|ξ|) (docs/theory.md T5; 1 for full volumes)
   const double* x[3];          // reference positions; |ξ| is recomputed from them (core/bonds.hpp)
   const double* u[3];          // displacements
   const double* volume;
@@ -53,7 +53,7 @@ struct PmbBreaking {
 // (thesis eqs. 1.9, 1.10, 2.1). Each node writes only its own f_i: parallel over nodes,
 // schedule static, bitwise the same for any thread count. Accumulates; never clears f.
 // If w is not null, also stores the strain-energy density W_i = Σ_j ¼ c s² |ξ| ν_j V_j of every node
-// (validation.md C4; overwritten, not accumulated): a few flops per bond, so the energy needs no
+// (docs/theory.md C4; overwritten, not accumulated): a few flops per bond, so the energy needs no
 // second pass over the bonds.
 // If breaking is not null, every intact bond whose stretch exceeds s0 of its block pair (and with
 // no end in a no-fail set) first breaks for good, as update_broken_bonds would break it on the same
@@ -78,7 +78,7 @@ void add_pmb_force(const Model& model, const Vec3Array& u, Vec3Array& f, double*
 // same stretch and break in the same call: symmetric and deterministic without a reverse index.
 // Returns the number of bonds broken now, each counted once. If energy is not null, adds to it the
 // energy the broken bonds held at the moment they broke, Σ ½ c s² |ξ| ν V_i V_j over the bonds
-// broken now (each once; the strain energy loses exactly this, validation.md C4 with breaking),
+// broken now (each once; the strain energy loses exactly this, docs/theory.md C4 with breaking),
 // summed per node and then serially, so the value does not depend on the thread count.
 std::int64_t update_broken_bonds(Model& model, const Vec3Array& u, double* energy = nullptr);
 
@@ -91,7 +91,7 @@ std::int64_t break_bonds_and_add_pmb_force(Model& model, const Vec3Array& u, Vec
                                            double* energy_density = nullptr, double* broken_energy = nullptr,
                                            double* lost_per_node = nullptr, RowSubset rows = {});
 
-// LAMMPS's critical-stretch rule (validation.md F5), when some α > 0 (MaterialTable::node_rule):
+// LAMMPS's critical-stretch rule (docs/theory.md T4), when some α > 0 (MaterialTable::node_rule):
 // s0_i = max_j (s0_ij − α_ij·s_ij) over i's intact bonds at the previous breaking pass (= s0 −
 // α·min_j s_ij for one block), +inf for a node without intact bonds; a bond breaks when
 // s > min(s0_i, s0_j). PMB's history: a per-node array it declares (core/state_arrays.hpp) under this
@@ -106,7 +106,7 @@ StateDeclaration node_critical_stretch_declaration();
 // What PMB declares: s0_i when some α > 0, else nothing.
 std::vector<StateDeclaration> pmb_state_declarations(const Model& model);
 // s0_i of LAMMPS's rule at rest (every s_ij = 0): max_j s0_ij over i's intact bonds, +inf without
-// one — what LAMMPS's set-up force pass leaves before the first step (validation.md F5). A row of
+// one — what LAMMPS's set-up force pass leaves before the first step (docs/theory.md T4). A row of
 // `bonds` per node of `block` (an empty row, a ghost's: +inf).
 std::vector<double> initial_node_critical_stretch(const MaterialTable& table, const std::vector<std::int32_t>& block,
                                                   const BondList& bonds);
@@ -115,7 +115,7 @@ std::vector<double> initial_node_critical_stretch(const MaterialTable& table, co
 // per-node critical stretch: some α > 0); then break_bonds_lammps_rules is the breaking pass.
 bool uses_lammps_rules(const Model& model);
 
-// One breaking pass by LAMMPS peri/pmb's rules (validation.md F5), and, if f is not null, the force:
+// One breaking pass by LAMMPS peri/pmb's rules (docs/theory.md T4), and, if f is not null, the force:
 // - a bond breaks when s > min(s0_i, s0_j), s0_i the per-node value left by the previous pass
 //   (node_critical_stretch above), or s > s0_ij when every α is 0; never with a no-fail end;
 // - then s0_i ← max_j (s0_ij − α_ij·s_ij) over the bonds intact at the start of the pass
@@ -141,14 +141,14 @@ std::int64_t break_bonds_lammps_rules(Model& model, const Vec3Array& u, Vec3Arra
 // StretchRatio; the thesis rule's pair s0, or LAMMPS's per-node s0 when its α rule is on). Reads only.
 StretchRatio pmb_stretch_ratio(const Model& model, const Vec3Array& u);
 
-// U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (validation.md C4) [J]. Per-node terms are
+// U = Σ_i Σ_j ¼ c s² |ξ| V_i V_j over intact bonds (docs/theory.md C4) [J]. Per-node terms are
 // summed serially in node order, so the value does not depend on the thread count.
 double strain_energy(const Model& model, const Vec3Array& u);
 // The same per node, divided by V_i: the strain-energy density W_i [J/m³].
 std::vector<double> strain_energy_density(const Model& model, const Vec3Array& u);
 
 
-// The constants of thesis eqs. 1.11–1.12 for one block (validation.md F1), by analysis; or c and
+// The constants of thesis eqs. 1.11–1.12 for one block (docs/theory.md T2), by analysis; or c and
 // s0 as the block gives them (micromodulus, critical_stretch: a LAMMPS pair_coeff); and its α.
 PairConstants pmb_constants(const BlockMaterial& block, const std::string& analysis, double horizon, double thickness);
 // One pair or the other (E with G0, or c with s0), never a mix; α only with a breakable material.

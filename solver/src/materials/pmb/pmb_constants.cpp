@@ -1,4 +1,4 @@
-// PMB's micromodulus c and critical stretch s0 per analysis: the F1 formulas of validation.md.
+// PMB's micromodulus c and critical stretch s0 per analysis: the formulas of docs/theory.md T2.
 #include <cmath>
 #include <limits>
 
@@ -16,7 +16,7 @@ using PmbFormula = PairConstants (*)(double youngs_modulus, std::optional<double
                                      double thickness);
 
 // Bond-based PMB fixes ν = 1/4 in 3D, so K = E/(3(1−2ν)) = 2E/3.
-// c = 18K/(πδ⁴) (thesis eq. 1.11), s0 = √(5G0/(9Kδ)) (Silling & Askari 2005; validation.md F1 —
+// c = 18K/(πδ⁴) (thesis eq. 1.11), s0 = √(5G0/(9Kδ)) (Silling & Askari 2005; docs/theory.md T2 —
 // thesis eq. 1.12 prints E where K belongs).
 PairConstants constants_3d(double e, std::optional<double> g0, double delta, double) {
   const double bulk = 2.0 * e / 3.0;
@@ -26,7 +26,7 @@ PairConstants constants_3d(double e, std::optional<double> g0, double delta, dou
   return out;
 }
 
-// ν = 1/3: c = 9E/(πhδ³), s0 = √(4πG0/(9Eδ)) (validation.md F1; Peridigm, PDMATLAB2D).
+// ν = 1/3: c = 9E/(πhδ³), s0 = √(4πG0/(9Eδ)) (docs/theory.md T2; Peridigm, PDMATLAB2D).
 PairConstants constants_plane_stress(double e, std::optional<double> g0, double delta, double h) {
   PairConstants out;
   out.micromodulus = 9.0 * e / (kPi * h * std::pow(delta, 3));
@@ -34,7 +34,7 @@ PairConstants constants_plane_stress(double e, std::optional<double> g0, double 
   return out;
 }
 
-// ν = 1/4: c = 48E/(5πhδ³), s0 = √(5πG0/(12Eδ)) (validation.md F1).
+// ν = 1/4: c = 48E/(5πhδ³), s0 = √(5πG0/(12Eδ)) (docs/theory.md T2).
 PairConstants constants_plane_strain(double e, std::optional<double> g0, double delta, double h) {
   PairConstants out;
   out.micromodulus = 48.0 * e / (5.0 * kPi * h * std::pow(delta, 3));
@@ -57,7 +57,7 @@ const Registry<PmbFormula>& pmb_formulas() {
 PairConstants pmb_constants(const BlockMaterial& block, const std::string& analysis, double horizon, double thickness) {
   PairConstants out;
   if (const std::optional<double> c = block.parameter("micromodulus")) {
-    // c and s0 as a LAMMPS pair_coeff gives them (validation.md F5): taken as they are.
+    // c and s0 as a LAMMPS pair_coeff gives them (docs/theory.md T4): taken as they are.
     out.micromodulus = *c;
     out.critical_stretch = block.parameter("critical_stretch").value_or(kInf);
   } else {

@@ -40,7 +40,7 @@ namespace {
 
 // The breaking criterion, in one place (every pass that breaks or asks whether a bond would break
 // calls these two): bond i→j is compared with s0 of its block pair, or by LAMMPS's α rule with
-// min(s0_i, s0_j) of the previous pass (s0_node not null, validation.md F5); it breaks when intact,
+// min(s0_i, s0_j) of the previous pass (s0_node not null, docs/theory.md T4); it breaks when intact,
 // over that threshold and with no end in a no-fail set.
 inline double critical_stretch_of(const double* s0_row, std::int32_t bj, const double* s0_node, std::int64_t i,
                                   std::int64_t j) {
@@ -51,7 +51,7 @@ inline bool bond_breaks(bool intact, double s, double s0, bool no_fail_end) {
 }
 
 // The energy a bond takes with it when it breaks: ½ c s0² |ξ| ν V_i V_j, the two ¼-shares that W_i
-// and W_j held (validation.md C4), at the critical stretch s0 it crossed, not at the stretch s > s0
+// and W_j held (docs/theory.md C4), at the critical stretch s0 it crossed, not at the stretch s > s0
 // it has after the step that broke it. A bond passes s0 somewhere inside that step; its post-step
 // stretch, which grows with the strain rate × Δt, counted energy the bond never stored (issue 16:
 // on the impact case the energy sum ended 4.5 % above the input).
@@ -319,7 +319,7 @@ std::vector<double> strain_energy_density(const Model& m, const Vec3Array& u) {
       const std::int64_t j = a.neighbour[k];
       const BondTerms b = bond_terms(a, xi, yi, j);
       // ¼ c s² |ξ| V_j: each bond is visited from both ends, so each end takes half of the
-      // bond's ½ c s² |ξ| V_i V_j (validation.md C4).
+      // bond's ½ c s² |ξ| V_i V_j (docs/theory.md C4).
       double e = 0.25 * c_row[a.block[j]] * b.s * b.s * b.length * a.volume[j] * a.volume_weight(b.length);
       if (a.factor) e *= a.factor[k];
       sum += e;

@@ -110,7 +110,7 @@ void PmbModel::apply_reference_stiffness(const Model& m, const std::array<double
       const double e0 = xi0 / len, e1 = xi1 / len, e2 = xi2 / len;
       const double inv_sqrt_mj = 1.0 / std::sqrt(m.density[j] * m.nodes.volume[j]);
       // bond stiffness k_ij = c ν V_i V_j/|ξ| (force per unit relative displacement along e; ν the
-      // partial-volume factor of validation.md F3, from |ξ|)
+      // partial-volume factor of docs/theory.md T5, from |ξ|)
       const double nu = m.bonds.volume_weight(len);
       const double kij = m.material.micromodulus_pair[bi * nb + static_cast<std::size_t>(m.block_index[j])] * nu *
                          m.nodes.volume[i] * m.nodes.volume[j] / len * m.bonds.factor(ku);  // g: surface correction
