@@ -165,9 +165,10 @@ pd-case-lock:
 else
 # The make this rule starts holds the lock as fd 9 (PD_LOCK_FD tells pdsolve so: it locks its output
 # folder itself, io/output_lock.hpp). PD_CASE_LOCK=1 in the environment of a make run by hand would
-# skip the lock: that make is refused unless fd 9 is the folder's lock and holds it.
+# skip the lock: that make is refused unless fd 9 is the folder's lock and holds it. (`flock -n 9`,
+# the descriptor form: with a command after it, `flock -n 9 true` locked a new file named "9".)
 ifneq ($(and $(PD_CASE_LOCK),$(LOCKED_GOALS),$(if $(DRY_RUN),,check)),)
-  ifneq ($(shell [ /proc/self/fd/9 -ef '$(OUT)/.lock' ] && flock -n 9 true && echo held),held)
+  ifneq ($(shell [ /proc/self/fd/9 -ef '$(OUT)/.lock' ] && flock -n 9 && echo held),held)
     $(error PD_CASE_LOCK is this Makefile's own (the make it starts under the lock of $(OUT)/); unset it)
   endif
 endif

@@ -50,6 +50,9 @@ def test_the_lock_is_free_again_when_make_ends(tree):
     result = make(tree, NAME, f"out/{NAME}/mesh-parameters.json")
     assert result.returncode == 0, result.stderr
     assert (out / ".lock").exists()
+    # The inner make's check that it holds the lock reads fd 9 and writes nothing: `flock -n 9 true`
+    # (a command after the number) locked, and so created, a file named "9" in the repository's root.
+    assert not (tree / "9").exists()
 
 
 def test_pd_case_lock_in_the_environment_does_not_skip_the_lock(tree):

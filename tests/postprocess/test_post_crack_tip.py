@@ -188,7 +188,7 @@ def drawn(monkeypatch):
     """crack_plot's figure, drawn and kept instead of saved: drawn["fig"] after plot_crack_path."""
     kept = {}
 
-    def spy(fig, path):
+    def spy(fig, path, dpi):
         fig.canvas.draw()
         kept["fig"] = fig
 

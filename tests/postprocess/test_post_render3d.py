@@ -24,7 +24,7 @@ def no_pvpython(monkeypatch):
 def test_matplotlib_draws_exactly_the_damaged_nodes(monkeypatch, tmp_path, no_pvpython):
     kept = {}
 
-    def spy(fig, path):
+    def spy(fig, path, dpi):
         fig.canvas.draw()
         kept["fig"] = fig
 

@@ -29,7 +29,8 @@ def keep(monkeypatch):
     """Figures drawn by the plotting modules, kept instead of saved: {file name: figure}."""
     kept = {}
 
-    def spy(fig, path):
+    def spy(fig, path, dpi):
+        assert dpi == 300, path   # figures.dpi's default reaches every figure
         fig.canvas.draw()
         kept[path.rsplit("/", 1)[-1]] = fig
 

@@ -13,12 +13,14 @@ def test_mixed_history_draws_each_mode_on_a_log_scale(tmp_path, monkeypatch):
     history = {"step": step, "time": np.cumsum(dt), "dt": dt, "iterations": np.where(mode == 1, 4, 1),
                "rejected": np.zeros_like(step), "mode": mode}
     saved = {}
-    monkeypatch.setattr(timestep_plot, "save_figure", lambda fig, path: saved.update(fig=fig, path=path))
+    monkeypatch.setattr(timestep_plot, "save_figure", lambda fig, path, dpi: saved.update(fig=fig, path=path, dpi=dpi))
 
     class Case:
         heading = "mixed"
+        dpi = 150
 
     timestep_plot.plot_timestep(history, Case(), str(tmp_path / "timestep.png"))
+    assert saved["dpi"] == 150   # the case's figures.dpi
     axes = saved["fig"].axes
     assert axes[1].get_yscale() == "log" and axes[0].get_yscale() == "log"
     labels = [t.get_text() for t in axes[1].get_legend().get_texts()]
