@@ -293,13 +293,15 @@ TEST(Checkpoint, RestartTimeEveryTimeWritesCheckpoints) {
 // output.restart_every_wall (issue 36, item 8): checkpoints by wall time, on by default, so that a
 // run killed with SIGKILL has one. They are written between steps and change no bit of the frames
 // and history rows; the last one before a run was cut off continues it bitwise. Each step here
-// sleeps 2 ms so that a 1 ns interval, held back only by the 3 % bound, gives several checkpoints.
+// sleeps 40 ms so that a 1 ns interval, held back only by the 3 % bound, gives several checkpoints:
+// the bound spaces them by 33 × a checkpoint's write time, and with fsync that took 5.5 ms on a
+// quiet machine and 37 ms under load, where 2 ms steps (a 0.1 s run) gave one checkpoint only.
 TEST(Checkpoint, WallClockCheckpointsChangeNoBitAndContinueBitwise) {
   const fs::path off = temp_dir("wall_off"), on = temp_dir("wall_on"), cut = temp_dir("wall_cut");
   write_case(off, "adaptive", false, R"(, "restart_every_wall": 0)");
   write_case(on, "adaptive", false, R"(, "restart_every_wall": 1e-9)");
   write_case(cut, "adaptive", false, R"(, "restart_every_wall": 1e-9)");
-  const auto slow = [](std::int64_t) { usleep(2000); };
+  const auto slow = [](std::int64_t) { usleep(40000); };
   ASSERT_EQ(run(off / "case.json", slow), pd::kOk);
   EXPECT_FALSE(fs::exists(off / "out" / "checkpoint.bin"));  // 0: none
 
