@@ -33,58 +33,43 @@ void Implicit::configure(const Case& c, double) {
   const double scale = std::isfinite(dt_sa) && dt_sa > 0.0 ? dt_sa : c.time.end;
   dt_max_ = settings_.dt_max.value_or(c.time.end / 10.0);
   dt_min_ = settings_.dt_min.value_or(std::min(1e-6 * scale, dt_max_));
-  choose_linear_solver(c);
+  // direct or cg, and why (for describe()): quasi_static's rule, over this scheme's dofs (z too in 2D).
+  linear_.choose(op_, c, "implicit", settings_.linear_solver, 3);
   if (dt_min_ > dt_max_)
     throw Error(c.file.string() + ": implicit.dt_min = " + message_number(dt_min_) + " s is above dt_max = " +
                 message_number(dt_max_) + " s; lower implicit.dt_min or raise implicit.dt_max");
-}
-
-// direct or cg, and why (for describe()): quasi_static's rule, over this scheme's dofs (z too in 2D).
-void Implicit::choose_linear_solver(const Case& c) {
-  const LinearSolverChoice choice = pd::choose_linear_solver(op_, c, "implicit", settings_.linear_solver, 3);
-  use_cg_ = choice.use_cg;
-  solver_reason_ = choice.reason;
 }
 
 std::string Implicit::keep_linear_solver(const std::string& recorded) {
   const std::string here = linear_solver();
   if (recorded == here) return {};
   if (std::string why = why_not_linear_solver(op_, recorded); !why.empty()) return why;
-  use_cg_ = recorded != "direct";
-  solver_reason_ = "as the checkpoint was written; this run alone would take " + here + ", " + solver_reason_;
+  linear_.keep_recorded(recorded != "direct", here);
   return {};
 }
 
 bool Implicit::solve_krylov(const State& s, double t1, double h, double floor) {
   const double c = mass_coefficient(h);
-  if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
-    // A law with neither form of diagonal block: the mass term alone preconditions.
-    block_first_.clear();
-    for (std::size_t k = 0; k <= dofs_.size(); ++k) block_first_.push_back(static_cast<std::int64_t>(k));
-    blocks_.assign(9 * dofs_.size(), 0.0);
-  }
+  // A law with neither form of diagonal block: 1×1 blocks of 0, the mass term alone preconditions.
+  linear_.stiffness_blocks(op_, s, t1, dofs_, 0.0);
   // K_eff's blocks: + c m on the diagonal (a node's dofs share its mass).
-  for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
-    for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a)
-      blocks_[9 * g + static_cast<std::size_t>(4 * a)] += c * mass_[static_cast<std::size_t>(block_first_[g] + a)];
-  preconditioner_.build(block_first_, blocks_);
+  linear_.each_block_diagonal([&](double& entry, std::size_t q) { entry += c * mass_[q]; });
+  linear_.build_block_jacobi();
   PcgSettings settings;
   settings.relative_tol = kCgTolerance;
   settings.absolute_tol = floor;
   settings.max_iterations = settings_.cg_max_iterations;
-  diagonal_.resize(dofs_.size());
-  for (std::size_t q = 0; q < dofs_.size(); ++q) diagonal_[q] = c * mass_[q];  // K_eff = K + c M
-  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, preconditioner_, r_, correction_,
-                                               settings, cg_x_, cg_y_);
-  cg_iterations_ += result.iterations;
-  ++cg_solves_;
+  std::vector<double>& diagonal = linear_.cg_diagonal();
+  diagonal.resize(dofs_.size());
+  for (std::size_t q = 0; q < dofs_.size(); ++q) diagonal[q] = c * mass_[q];  // K_eff = K + c M
+  const PcgResult result = linear_.solve_cg(op_, s, t1, dofs_, sums_, r_, correction_, settings);
   report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
   return result.converged() || result.status == PcgResult::kIndefinite || result.residual < result.initial_residual;
 }
 
 std::string Implicit::linear_algebra_summary() const {
-  if (!use_cg_) return {};  // the direct path's done: line stays as it was
-  return std::to_string(cg_solves_) + " CG solves with " + std::to_string(cg_iterations_) +
+  if (!linear_.uses_cg()) return {};  // the direct path's done: line stays as it was
+  return std::to_string(linear_.cg_solves()) + " CG solves with " + std::to_string(linear_.cg_iterations()) +
          " iterations (J·x products)";
 }
 
@@ -94,7 +79,7 @@ void Implicit::resume(const State& state) {
     const std::size_t d = dofs_.component[q];
     a_[d][i] = state.f[d][i] / op_.density()[i] - op_.damping() * state.v[d][i];
   }
-  have_factor_ = false;
+  linear_.forget_factor();
   proposal_ = 0.0;
 }
 
@@ -107,7 +92,7 @@ void Implicit::initialize(State& state, double t) {
   dofs_ = op_.free_dofs(3);
   sums_.setup(op_.decomposed(), dofs_);
   for (auto& terms : terms_) terms.assign(dofs_.size(), 0.0);
-  if (use_cg_) cg_x_ = make_vec3(n), cg_y_ = make_vec3(n);
+  if (linear_.uses_cg()) linear_.size_cg(n);
   const auto& volume = op_.model().nodes.volume;
   const auto& rho = op_.density();
   mass_.resize(dofs_.size());
@@ -124,8 +109,8 @@ void Implicit::initialize(State& state, double t) {
   r_.assign(dofs_.size(), 0.0);
   a_new_.assign(dofs_.size(), 0.0);
   v_new_.assign(dofs_.size(), 0.0);
-  have_factor_ = false;
-  factorisations_ = 0;
+  linear_.forget_factor();
+  linear_.set_factorisations(0);
   proposal_ = 0.0;
   last_error_ = 0.0;
   report_ = StepReport{};
@@ -136,23 +121,15 @@ double Implicit::mass_coefficient(double h) const {
 }
 
 bool Implicit::factorize_at(const State& s, double t1, double h, bool definite) {
-  SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, definite);
-  if (K.rows < 0)
-    throw StepFailed("implicit needs an assembled tangent, which this scene's material or contact does not have; "
-                     "use time.integrator: verlet");
-  // K_eff = K + m·c on the diagonal (implicit.hpp).
-  const double c = mass_coefficient(h);
-  for (std::int64_t r = 0; r < K.rows; ++r)
-    for (std::int64_t q = K.row_start[static_cast<std::size_t>(r)]; q < K.row_start[static_cast<std::size_t>(r) + 1]; ++q)
-      if (K.column[static_cast<std::size_t>(q)] == r) K.value[static_cast<std::size_t>(q)] += c * mass_[static_cast<std::size_t>(r)];
-  have_factor_ = factor_.factorize(K);
-  if (!have_factor_) return false;
-  ++factorisations_;
-  factor_u_ = s.u;
-  factor_t_ = t1;
-  factor_h_ = h;
-  factor_definite_ = definite;
-  return true;
+  FactorPoint at;
+  at.t = t1, at.dt = h, at.definite = definite;
+  return linear_.factorize(op_, s, dofs_, at, "implicit", [&](SparseMatrix& K) {
+    // K_eff = K + m·c on the diagonal (implicit.hpp).
+    const double c = mass_coefficient(h);
+    for (std::int64_t r = 0; r < K.rows; ++r)
+      for (std::int64_t q = K.row_start[static_cast<std::size_t>(r)]; q < K.row_start[static_cast<std::size_t>(r) + 1]; ++q)
+        if (K.column[static_cast<std::size_t>(q)] == r) K.value[static_cast<std::size_t>(q)] += c * mass_[static_cast<std::size_t>(r)];
+  });
 }
 
 double Implicit::residual(const State& start, const State& s, double h, double& scale) {
@@ -208,9 +185,9 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
     // fast; else assemble and factorise at the current iterate — once per step: a tangent made in
     // this step that no longer cuts the residual 4× is at the round-off floor, or the step is too
     // long for the nonlinearity (then the step is cut).
-    if (use_cg_) {
+    if (linear_.uses_cg()) {
       fresh = true;  // every iterate's own tangent (full Newton)
-    } else if (!have_factor_ || factor_h_ != h || (res > 0.25 * previous && !fresh)) {
+    } else if (!linear_.have_factor() || linear_.factor_point().dt != h || (res > 0.25 * previous && !fresh)) {
       fresh = true;
       // The definite variant (compressed bonds without their negative lateral stiffness) when the
       // full tangent plus the mass is not positive definite (large Δt under compression): modified
@@ -220,10 +197,10 @@ bool Implicit::solve_step(const State& start, State& s, double t1, double h, int
     previous = res;
     const double to_dofs = -1.0 / (1.0 - ga_.alpha_f);  // K_eff Δu = −r/(1 − α_f)
     for (double& value : r_) value *= to_dofs;
-    if (use_cg_) {
+    if (linear_.uses_cg()) {
       if (!solve_krylov(s, t1, h, -0.5 * to_dofs * settings_.residual_tol * scale)) return false;
     } else {
-      factor_.solve(r_, correction_);
+      linear_.solve(r_, correction_);
     }
     // Backtracking: the full correction unless it raises the residual (then ½, ¼, … up to 1/32).
     // The trial's force evaluation is the next iteration's.
@@ -320,7 +297,7 @@ void Implicit::step(State& state, double& t, double& dt) {
               const std::size_t d = dofs_.component[q];
               a_[d][i] += (s.f[d][i] - f_old[d][i]) / rho[i];
             }
-            have_factor_ = false;  // the tangent lost bonds
+            linear_.forget_factor();  // the tangent lost bonds
             report_.broken_now = broke.broken;
             report_.broken_energy_now = broke.energy;
           }
@@ -357,7 +334,7 @@ void Implicit::step(State& state, double& t, double& dt) {
                           message_number(omega) + "): raise implicit.max_iterations, or use time.integrator: verlet");
     }
     ++report_.rejected;
-    have_factor_ = have_factor_ && converged;  // a failed Newton may have left a useless factor
+    if (!converged) linear_.forget_factor();  // a failed Newton may have left a useless factor
     h = std::max(converged ? h * std::max(0.2, 0.9 * std::sqrt(settings_.tol / eta)) : 0.5 * h, dt_min_);
   }
 }
@@ -373,13 +350,15 @@ std::vector<char> Implicit::save_state() const {
       bytes.insert(bytes.end(), reinterpret_cast<const char*>(component.data()),
                    reinterpret_cast<const char*>(component.data() + component.size()));
   };
-  const std::uint8_t have = have_factor_ ? 1 : 0, definite = factor_definite_ ? 1 : 0;
-  put(have), put(definite), put(factor_t_), put(factor_h_), put(proposal_), put(last_error_), put(factorisations_);
+  const FactorPoint& at = linear_.factor_point();
+  const std::uint8_t have = linear_.have_factor() ? 1 : 0, definite = at.definite ? 1 : 0;
+  const int factorisations = linear_.factorisations();
+  put(have), put(definite), put(at.t), put(at.dt), put(proposal_), put(last_error_), put(factorisations);
   // A decomposed run saves the whole model's a_n in global node order (gathered on rank 0, the one
   // that writes), as a serial run does: the checkpoint restarts on any rank count.
   if (const Decomposed* d = op_.decomposed()) put_vec3(d->gather(a_));
   else put_vec3(a_);
-  if (have_factor_) put_vec3(factor_u_);
+  if (linear_.have_factor()) put_vec3(linear_.factor_u());
   return bytes;
 }
 
@@ -406,15 +385,15 @@ void Implicit::load_state(const std::vector<char>& bytes) {
   get(t), get(h), get(proposal_), get(last_error_), get(factorisations);
   get_vec3(a_);
   if (decomposed) a_ = to_local(decomposed->piece(), a_);
-  have_factor_ = false;
+  linear_.forget_factor();
   if (have) {
     State s(n);
     get_vec3(s.u);
     // Needs the bonds of the checkpoint (restored before load_state, run/start.cpp). A factor of a
     // run on one process is of no use to CG (a decomposed run resuming from it): dropped.
-    if (!use_cg_ && !factorize_at(s, t, h, definite)) throw std::runtime_error("the saved tangent could not be factorised again");
+    if (!linear_.uses_cg() && !factorize_at(s, t, h, definite)) throw std::runtime_error("the saved tangent could not be factorised again");
   }
-  factorisations_ = factorisations;
+  linear_.set_factorisations(factorisations);
 }
 
 std::vector<std::string> Implicit::describe(double) const {
@@ -425,9 +404,9 @@ std::vector<std::string> Implicit::describe(double) const {
           "implicit: Newton to correction " + message_number(settings_.newton_tol) + " and residual " +
               message_number(settings_.residual_tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
               message_number(settings_.p) +
-              (use_cg_ ? "; linear solves of tangent + mass/(βΔt²) by matrix-free CG with block-Jacobi (cg, "
+              (linear_.uses_cg() ? "; linear solves of tangent + mass/(βΔt²) by matrix-free CG with block-Jacobi (cg, "
                        : "; tangent + mass/(βΔt²) factorised by CHOLMOD (direct, ") +
-              solver_reason_ + "); steps dt_initial " +
+              linear_.reason() + "); steps dt_initial " +
               (settings_.dt_initial ? message_number(*settings_.dt_initial) + " s" : std::string("from time.dt")) +
               ", dt_min " + message_number(dt_min_) + " s, dt_max " + message_number(dt_max_) + " s"};
 }

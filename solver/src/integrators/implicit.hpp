@@ -69,9 +69,8 @@
 #include <memory>
 
 #include "integrators/integrator.hpp"
+#include "integrators/linear_solve.hpp"
 #include "integrators/newton_krylov.hpp"
-#include "linalg/cholesky.hpp"
-#include "linalg/pcg.hpp"
 #include "linalg/sparse_matrix.hpp"
 #include "parallel/dof_sums.hpp"
 
@@ -105,11 +104,11 @@ class Implicit : public Integrator {
 
   const ImplicitSettings& settings() const { return settings_; }
   const GeneralizedAlpha& parameters() const { return ga_; }
-  int factorisations() const { return factorisations_; }
-  bool uses_cg() const { return use_cg_; }
-  std::string linear_solver() const override { return linear_solver_name(use_cg_); }
+  int factorisations() const { return linear_.factorisations(); }
+  bool uses_cg() const { return linear_.uses_cg(); }
+  std::string linear_solver() const override { return linear_solver_name(linear_.uses_cg()); }
   std::string keep_linear_solver(const std::string& recorded) override;
-  std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
+  std::int64_t cg_iterations() const { return linear_.cg_iterations(); }  // since configure (not checkpointed)
   std::string linear_algebra_summary() const override;
   double dt_min() const { return dt_min_; }
   double dt_max() const { return dt_max_; }
@@ -144,12 +143,9 @@ class Implicit : public Integrator {
   double proposal_ = 0.0;     // the last proposal handed out, to recognise a shortened step
   double last_error_ = 0.0;
 
-  SparseCholesky factor_;
-  bool have_factor_ = false;
-  int factorisations_ = 0;
-  Vec3Array factor_u_;
-  double factor_t_ = 0.0, factor_h_ = 0.0;
-  bool factor_definite_ = false;
+  // The linear solver (direct or CG, and why), the factorisation in use with where it was assembled
+  // (u, t, Δt, definite or not: for save_state), and CG's block Jacobi (linear_solve.hpp).
+  LinearSolve linear_;
 
   State trial_;
   std::vector<double> r_, correction_, a_new_, v_new_;
@@ -157,19 +153,10 @@ class Implicit : public Integrator {
   // Sums over the dofs (every rank's on a decomposed run) and their per-dof terms.
   DofSums sums_;
   std::vector<double> terms_[3];
-  // The matrix-free path: the choice and why (configure), and K_eff Δu = rhs by PCG at (s, t1) into
-  // correction_; false when CG made no progress.
+  // The matrix-free path: K_eff Δu = rhs by PCG at (s, t1) into correction_; false when CG made no
+  // progress.
   static constexpr double kCgTolerance = 1e-6;
-  bool use_cg_ = false;
-  std::string solver_reason_;
-  void choose_linear_solver(const Case& c);
   bool solve_krylov(const State& s, double t1, double h, double floor);
-  BlockJacobi preconditioner_;
-  std::vector<std::int64_t> block_first_;
-  std::vector<double> blocks_, diagonal_;
-  Vec3Array cg_x_, cg_y_;
-  std::int64_t cg_iterations_ = 0;
-  int cg_solves_ = 0;
 };
 
 }  // namespace pd

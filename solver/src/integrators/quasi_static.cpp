@@ -54,10 +54,7 @@ void QuasiStatic::configure(const Case& c, double) {
 // factorisation serves the elastic range): auto keeps direct whatever the size there, unless a term
 // has no assembled form.
 void QuasiStatic::choose_linear_solver(const Case& c) {
-  const LinearSolverChoice choice = pd::choose_linear_solver(op_, c, "quasi_static", settings_.linear_solver,
-                                                             op_.model().nodes.dimension);
-  use_cg_ = choice.use_cg;
-  solver_reason_ = choice.reason;
+  linear_.choose(op_, c, "quasi_static", settings_.linear_solver, op_.model().nodes.dimension);
   // The preconditioner needs the whole model's free dofs and whether its tangent can be assembled.
   const Decomposed* decomposed = op_.decomposed();
   const auto local_free = static_cast<std::int64_t>(op_.free_dofs(op_.model().nodes.dimension).size());
@@ -98,7 +95,7 @@ void QuasiStatic::choose_preconditioner(const Case& c, std::size_t free, bool as
   const int dimension = op_.model().nodes.dimension;
   const std::string& choice = settings_.preconditioner;
   use_amg_ = false;
-  if (!use_cg_) {
+  if (!linear_.uses_cg()) {
     preconditioner_reason_.clear();
     return;
   }
@@ -169,17 +166,16 @@ std::string QuasiStatic::keep_linear_solver(const std::string& recorded) {
   } else if (std::string why = why_not_linear_solver(op_, recorded); !why.empty()) {
     return why;
   }
-  use_cg_ = recorded != "direct";
+  linear_.keep_recorded(recorded != "direct", here,
+                        preconditioner_reason_.empty() ? "" : ", preconditioner " + preconditioner_reason_);
   use_amg_ = amg;
-  solver_reason_ = "as the checkpoint was written; this run alone would take " + here + ", " + solver_reason_ +
-                   (preconditioner_reason_.empty() ? "" : ", preconditioner " + preconditioner_reason_);
-  preconditioner_reason_ = use_cg_ ? (amg ? "amg" : "block_jacobi") + std::string(": as the checkpoint was written") : "";
+  preconditioner_reason_ = linear_.uses_cg() ? (amg ? "amg" : "block_jacobi") + std::string(": as the checkpoint was written") : "";
   return {};
 }
 
 void QuasiStatic::set_up_amg(const State& s, double t1) {
   const auto start = std::chrono::steady_clock::now();
-  if (at_start_.active && !at_start_.amg_u_saved && at_start_.amg_ready) {  // the step's start's, for restore_solver
+  if (linear_.remembering() && !at_start_.amg_u_saved && at_start_.amg_ready) {  // the step's start's, for restore_solver
     at_start_.amg_u = amg_u_;
     at_start_.amg_u_saved = true;
   }
@@ -215,41 +211,30 @@ void QuasiStatic::initialize(State& state, double t) {
   skip_dof_.clear();
   carried_load_ = 0.0;
   started_cold_ = false;
-  if (use_cg_) {
-    cg_x_ = make_vec3(state.size());
-    cg_y_ = make_vec3(state.size());
-  }
+  if (linear_.uses_cg()) linear_.size_cg(state.size());
 }
 
 // Block-Jacobi of K's 3×3 node blocks at (s, t1), shifted after bonds have broken; returns the shift.
 double QuasiStatic::build_block_jacobi(const State& s, double t1) {
-  if (!op_.stiffness_diagonal_blocks(s, t1, dofs_, block_first_, blocks_)) {
-    // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG.
-    block_first_.clear();
-    for (std::size_t k = 0; k <= dofs_.size(); ++k) block_first_.push_back(static_cast<std::int64_t>(k));
-    blocks_.assign(9 * dofs_.size(), 0.0);
-    for (std::size_t k = 0; k < dofs_.size(); ++k) blocks_[9 * k] = 1.0;
-  }
+  // A law with neither bond_tangent_row nor jacobian_diagonal_blocks: unpreconditioned CG (1×1 blocks of 1).
+  linear_.stiffness_blocks(op_, s, t1, dofs_, 1.0);
   // After bonds have broken, the same shift of the diagonal as the direct path (see
   // solve_equilibrium): kDiagonalShift × the largest diagonal entry of K, here of its blocks.
   double shift = 0.0;
   if (broken_since_start_) {
     double largest = 0.0;
-    for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
-      for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a)
-        largest = std::max(largest, std::fabs(blocks_[9 * g + static_cast<std::size_t>(4 * a)]));
+    linear_.each_block_diagonal([&](double& entry, std::size_t) { largest = std::max(largest, std::fabs(entry)); });
     if (op_.decomposed()) largest = -op_.decomposed()->minimum(-largest);  // over every rank's blocks: exact
     shift = kDiagonalShift * largest;
-    for (std::size_t g = 0; g + 1 < block_first_.size(); ++g)
-      for (std::int64_t a = 0; a < block_first_[g + 1] - block_first_[g]; ++a) blocks_[9 * g + static_cast<std::size_t>(4 * a)] += shift;
+    linear_.each_block_diagonal([shift](double& entry, std::size_t) { entry += shift; });
   }
-  preconditioner_.build(block_first_, blocks_);
+  linear_.build_block_jacobi();
   return shift;
 }
 
 bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double floor) {
   double shift = 0.0;
-  const Preconditioner* M = &preconditioner_;
+  const Preconditioner* M = nullptr;  // block Jacobi
   if (use_amg_) {
     // AMG never reads block-Jacobi's 3×3 blocks: they are not assembled. After bonds have broken
     // the operator's shift is the one the hierarchy was set up with (kDiagonalShift × the largest
@@ -264,10 +249,8 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
   settings.relative_tol = eta;
   settings.absolute_tol = floor;
   settings.max_iterations = settings_.cg_max_iterations;
-  diagonal_.assign(dofs_.size(), shift);  // K + shift·I
-  const PcgResult result = solve_newton_system(op_, s, t1, dofs_, sums_, diagonal_, *M, rhs_, correction_,
-                                               settings, cg_x_, cg_y_);
-  cg_iterations_ += result.iterations;
+  linear_.cg_diagonal().assign(dofs_.size(), shift);  // K + shift·I
+  const PcgResult result = linear_.solve_cg(op_, s, t1, dofs_, sums_, rhs_, correction_, settings, M);
   if (use_amg_ && result.iterations > 0 && result.residual > 0.0 && result.residual < result.initial_residual) {
     // The rebuild rule (2) of quasi_static.hpp: iterations per tenfold reduction against the first
     // solve's after the set-up.
@@ -275,7 +258,6 @@ bool QuasiStatic::solve_krylov(const State& s, double t1, double eta, double flo
     if (amg_rate_ == 0.0) amg_rate_ = rate;
     else if (rate > kAmgRebuildGrowth * amg_rate_) amg_.clear();
   }
-  ++cg_solves_;
   report_.force_evaluations += result.iterations + 1;  // a matvec costs about one force evaluation
   if (result.status == PcgResult::kNotConverged && !(result.residual < result.initial_residual)) {
     cg_failure_ = result.message();
@@ -336,33 +318,11 @@ double QuasiStatic::shift_diagonal(SparseMatrix& K) const {
 }
 
 bool QuasiStatic::factorize_at(const State& s, double t1, bool definite, bool shifted) {
-  const auto start = std::chrono::steady_clock::now();
-  struct Timer {  // the wall time of assembling and factorising, however this returns
-    std::chrono::steady_clock::time_point start;
-    double& seconds;
-    ~Timer() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
-  } timer{start, factorise_seconds_};
-  bonds_out_.clear();  // a new factor has the bonds as they are
-  SparseMatrix K = op_.assemble_stiffness(s, t1, dofs_, definite);
-  if (K.rows < 0)
-    throw StepFailed("quasi_static needs an assembled tangent, which this scene's material or contact does not "
-                     "have; use time.integrator: verlet");
-  if (shifted) shift_diagonal(K);
-  if (at_start_.active && !at_start_.swapped && at_start_.have_factor) {
-    // The step's first new factorisation: into the spare, the start's factor kept for restore_solver.
-    if (!spare_factor_) spare_factor_ = std::make_unique<SparseCholesky>();
-    std::swap(factor_, spare_factor_);
-    std::swap(factor_u_, at_start_.factor_u);
-    at_start_.swapped = true;
-  }
-  have_factor_ = factor_->factorize(K);
-  if (!have_factor_) return ++refused_, false;
-  ++factorisations_;
-  factor_u_ = s.u;
-  factor_t_ = t1;
-  factor_definite_ = definite;
-  factor_shifted_ = shifted;
-  return true;
+  FactorPoint at;
+  at.t = t1, at.definite = definite, at.shifted = shifted;
+  return linear_.factorize(op_, s, dofs_, at, "quasi_static", [&](SparseMatrix& K) {
+    if (shifted) shift_diagonal(K);
+  });
 }
 
 void QuasiStatic::limit(int max_breaking_rounds, double dt_min, bool fail_on_steady_breaking) {
@@ -377,13 +337,15 @@ std::vector<char> QuasiStatic::save_state() const {
     const auto* p = reinterpret_cast<const char*>(&value);
     bytes.insert(bytes.end(), p, p + sizeof value);
   };
-  const std::uint8_t have = have_factor_ ? 1 : 0, definite = factor_definite_ ? 1 : 0, shifted = factor_shifted_ ? 1 : 0;
-  put(have), put(definite), put(shifted), put(factor_t_), put(factorisations_);
-  if (have_factor_)
-    for (const auto& component : factor_u_)
+  const FactorPoint& at = linear_.factor_point();
+  const std::uint8_t have = linear_.have_factor() ? 1 : 0, definite = at.definite ? 1 : 0, shifted = at.shifted ? 1 : 0;
+  const int factorisations = linear_.factorisations();
+  put(have), put(definite), put(shifted), put(at.t), put(factorisations);
+  if (linear_.have_factor())
+    for (const auto& component : linear_.factor_u())
       bytes.insert(bytes.end(), reinterpret_cast<const char*>(component.data()),
                    reinterpret_cast<const char*>(component.data() + component.size()));
-  if (use_cg_ && use_amg_) {  // where the hierarchy was set up (nothing added without amg: old checkpoints read)
+  if (uses_amg()) {  // where the hierarchy was set up (nothing added without amg: old checkpoints read)
     const std::uint8_t have_amg = amg_.ready() ? 1 : 0;
     put(have_amg), put(amg_t_), put(amg_rate_);
     if (have_amg)
@@ -410,8 +372,8 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   load_report(std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes)), 0);
   constexpr std::size_t amg_part = 1 + 2 * sizeof(double);
   // Whether the bytes hold the hierarchy's part: the writer's solver, if the restart said it.
-  const bool amg_saved = checkpoint_solver_.empty() ? use_cg_ && use_amg_ : checkpoint_solver_ == "cg amg";
-  const bool amg = use_cg_ && use_amg_;
+  const bool amg_saved = checkpoint_solver_.empty() ? uses_amg() : checkpoint_solver_ == "cg amg";
+  const bool amg = uses_amg();
   const bool have_amg = amg_saved && bytes.size() > kReportBytes + extra && bytes[kReportBytes + extra] != 0;
   const std::size_t amg_extra = amg_saved ? amg_part + (have_amg ? 3 * n * sizeof(double) : 0) : 0;
   const std::size_t known = kReportBytes + extra + amg_extra;
@@ -432,15 +394,14 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
   int factorisations = 0;
   std::memcpy(&t, at, sizeof t), at += sizeof t;
   std::memcpy(&factorisations, at, sizeof factorisations), at += sizeof factorisations;
-  have_factor_ = false;
-  bonds_out_.clear();
+  linear_.forget_factor();
   // The factorisation and the hierarchy were made with the hanging nodes' bonds masked, if there were
   // any: the same nodes now (a function of the broken flags, which have not changed since: breaking
   // forgets both), so the same masked K.
   broken_since_start_ = op_.any_broken();
   find_hanging();
   MaskedBonds masked(hanging_, op_.model().bonds, !skip_dof_.empty());
-  if (have && use_cg_) {
+  if (have && linear_.uses_cg()) {
     at += 3 * n * sizeof(double);  // a factor, of no use to CG
   } else if (have) {
     State s(n);
@@ -449,7 +410,7 @@ void QuasiStatic::load_state(const std::vector<char>& bytes) {
     if (!factorize_at(s, t, definite, shifted))
       throw std::runtime_error("the saved tangent could not be factorised again");
   }
-  factorisations_ = factorisations;
+  linear_.set_factorisations(factorisations);
   amg_.clear();
   if (amg_saved) {
     ++at;  // have_amg, read above
@@ -488,7 +449,7 @@ bool QuasiStatic::solve_equilibrium(State& s, double t1, const Vec3Array& u_star
   find_hanging();
   // Nodes left hanging by the bonds taken out: the factor has no masks for them (it was made without
   // any); a new one is made with them masked.
-  if (bonds_out_.active() && !skip_dof_.empty()) have_factor_ = false, bonds_out_.clear();
+  if (linear_.bonds_out().active() && !skip_dof_.empty()) linear_.forget_factor();
   if (skip_dof_.empty()) return newton(s, t1, u_start, iterations, omega);
   // A free fragment stays where the last state left it: not where the predictor would carry it (its
   // last mean velocity, extrapolated, would go on stretching it load step after load step).
@@ -549,8 +510,8 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     // on what it was measured on: a direct factorisation made in this step with the bonds as they
     // are (not one from an earlier step, nor one with bonds taken out, whose slow convergence a new
     // tangent cures: the 4× rule below), and a residual still above its tolerance.
-    if (factorisation_cap_ > 0 && !use_cg_ && have_factor_ && !bonds_out_.active() &&
-        factorisations_ > factorisations_at_step_ && std::isfinite(previous) &&
+    if (factorisation_cap_ > 0 && !linear_.uses_cg() && linear_.have_factor() && !linear_.bonds_out().active() &&
+        linear_.factorisations() > factorisations_at_step_ && std::isfinite(previous) &&
         residual > settings_.residual_tol * load && residual > stall_ratio_limit_ * previous) {
       stall_ratio_ = residual / previous;
       stalled_at_ = k - 1;  // the iteration whose correction gave this residual
@@ -558,10 +519,10 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     }
     // Reuse the factorisation while it keeps the residual falling fast; else assemble anew (also
     // when only ω is above TOL: an old factor then reduces ω only linearly).
-    if (!use_cg_ && (!have_factor_ || residual > 0.25 * previous)) {
+    if (!linear_.uses_cg() && (!linear_.have_factor() || residual > 0.25 * previous)) {
       // A tentative step that has used its factorisations fails here: Newton that needs yet another
       // tangent is still far from an equilibrium (try_once).
-      if (factorisation_cap_ > 0 && factorisations_ - factorisations_at_step_ >= factorisation_cap_) {
+      if (factorisation_cap_ > 0 && linear_.factorisations() - factorisations_at_step_ >= factorisation_cap_) {
         factorisation_cap_hit_ = true;
         return false;
       }
@@ -583,9 +544,9 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
         factorised = factorize_at(s, t1, true, true);
       }
       if (!factorised) {
-        have_factor_ = false;
+        linear_.forget_factor();
         if (!std::isfinite(previous) && !broken_since_start_) {  // nothing broken: the body is not held
-          throw StepFailed("the tangent stiffness is singular or indefinite (" + factor_->failure() +
+          throw StepFailed("the tangent stiffness is singular or indefinite (" + linear_.factor().failure() +
                            "): the body can move freely or a part of it has come loose; quasi_static needs "
                            "displacement conditions that hold every body in every direction, or use "
                            "time.integrator: verlet");
@@ -604,7 +565,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
     // for: it is placed after the solve; nor a free fragment's (it carries no load: it stays).
     for (std::size_t q = 0; q < skip_dof_.size(); ++q)
       if (skip_dof_[q]) rhs_[q] = 0.0;
-    if (use_cg_) {
+    if (linear_.uses_cg()) {
       // Eisenstat–Walker choice 2: η_k = γ (‖F_k‖/‖F_{k−1}‖)², γ = 0.9, kept ≥ γ η_{k−1}² when that is
       // above 0.1 (so that η does not fall too fast), ≤ kEtaMax; and no tighter than half the
       // equilibrium tolerance asks of this residual (Kelley 1995, eq. 6.20).
@@ -617,11 +578,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
       const double floor = 0.5 * settings_.residual_tol * load;
       if (!solve_krylov(s, t1, eta, floor)) return false;
     } else {
-      const auto solve_start = std::chrono::steady_clock::now();
-      factor_->solve(rhs_, correction_);
-      bonds_out_.apply(correction_);  // the bonds broken since the factorisation, taken out
-      solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
-      ++solves_;
+      linear_.solve(rhs_, correction_);  // with the bonds broken since the factorisation taken out
     }
     for (std::size_t q = 0; q < skip_dof_.size(); ++q)
       if (skip_dof_[q]) correction_[q] = 0.0;
@@ -673,12 +630,7 @@ bool QuasiStatic::newton(State& s, double t1, const Vec3Array& u_start, int& ite
 }
 
 void QuasiStatic::remember_solver() {
-  at_start_.active = true;
-  at_start_.have_factor = have_factor_;
-  at_start_.definite = factor_definite_;
-  at_start_.shifted = factor_shifted_;
-  at_start_.factor_t = factor_t_;
-  at_start_.swapped = false;
+  linear_.remember_factor();
   at_start_.amg_ready = amg_.ready();
   at_start_.amg_t = amg_t_;
   at_start_.amg_rate = amg_rate_;
@@ -694,17 +646,8 @@ void QuasiStatic::remember_solver() {
 // load_state).
 void QuasiStatic::restore_solver() {
   const std::size_t n = op_.size();
-  bonds_out_.clear();  // a cut trial breaks nothing; this is for safety: they belong to the other factor
-  if (at_start_.swapped) {
-    std::swap(factor_, spare_factor_);
-    std::swap(factor_u_, at_start_.factor_u);
-    at_start_.swapped = false;
-  }
-  have_factor_ = at_start_.have_factor;
-  factor_t_ = at_start_.factor_t;
-  factor_definite_ = at_start_.definite;
-  factor_shifted_ = at_start_.shifted;
-  if (use_cg_ && use_amg_ && (amg_setups_ != at_start_.amg_setups || amg_.ready() != at_start_.amg_ready)) {
+  linear_.restore_factor();
+  if (uses_amg() && (amg_setups_ != at_start_.amg_setups || amg_.ready() != at_start_.amg_ready)) {
     amg_.clear();
     if (at_start_.amg_ready) {
       find_hanging();
@@ -767,7 +710,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   factorisation_cap_ = try_once_factorisations_;
   stalled_at_ = 0;
   try_once_iterations_ = try_once_factorisations_ = 0;
-  factorisations_at_step_ = factorisations_;
+  factorisations_at_step_ = linear_.factorisations();
   // The carried pieces are for this step only; a step that fails and is halved redoes it from them.
   struct Drop {
     std::vector<std::int32_t>& carried;
@@ -785,9 +728,9 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
   // at dx × 2, in the step where the crack starts to grow).
   if (settings_.cut_to_first_failure && !broken_since_start_ && guess_from_velocity_) remember_solver();
   struct Off {  // the snapshot is for this step only, however it ends
-    bool& active;
-    ~Off() { active = false; }
-  } off{at_start_.active};
+    LinearSolve& linear;
+    ~Off() { linear.end_remembering(); }
+  } off{linear_};
   int cuts = 0;
   cut_to_ = 0.0;
   // Bonds broken by attempts that then failed: they stay broken (below), so the accepted step
@@ -827,11 +770,11 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
         cut_to = cut_step(state, s, h, start_ratio);
       if (cut_to > 0.0) break;
       // The flags before the round, for taking its bonds out of the factor (only when there is one).
-      const bool can_take_out = max_removed_columns_ > 0 && have_factor_ && !use_cg_ && bond_based_ && !op_.decomposed() && skip_dof_.empty();
+      const bool can_take_out = max_removed_columns_ > 0 && linear_.have_factor() && !linear_.uses_cg() && bond_based_ && !op_.decomposed() && skip_dof_.empty();
       if (can_take_out) broken_before_round_ = op_.model().bonds.broken;
       const BreakReport broke = op_.break_bonds(s);
       if (broke.broken == 0) break;
-      at_start_.active = false;  // no cut can follow (one needs no bond broken in the run)
+      linear_.end_remembering();  // no cut can follow (one needs no bond broken in the run)
       // Unstable crack growth, seen early (limit()): a re-solve that broke at least as many bonds
       // as the one before it. The energy released by the crack's advance at a fixed load is not
       // falling, so the rounds would not end (the plate's: 4, 4, 8 bonds; traction's: 4, 8, 12).
@@ -840,12 +783,12 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       broke_total += broke;
       // The tangent lost bonds: taken out of the factor, or a new factorisation at the re-solve.
       if (can_take_out) take_out_broken_bonds(broken_before_round_);
-      else have_factor_ = false, bonds_out_.clear();
+      else linear_.forget_factor();
       amg_.clear();          // and the hierarchy too (rule (1) of quasi_static.hpp)
       broken_since_start_ = true;
       if (++rounds >= settings_.max_breaking_rounds || not_slowing) {
-        have_factor_ = have_factor_ && !bonds_out_.active();  // the bonds taken out are this step's
-        bonds_out_.clear();
+        if (linear_.bonds_out().active()) linear_.forget_factor();  // the bonds taken out are this step's
+        linear_.bonds_out().clear();
         failure_reason_ = "bonds kept breaking through " + std::to_string(rounds) + " re-solves at one load (" +
                           std::to_string(broke_total.broken) + " bonds" +
                           (not_slowing ? ", the last re-solve " + std::to_string(broke.broken) + ", no fewer than the one before" : "") +
@@ -872,7 +815,7 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
       // s.f is already the force at the equilibrium with these bonds: solve_equilibrium returns true
       // only just after evaluating it, and a breaking round that broke nothing changed no bond.
       op_.update_work(s, t1, h);
-      if (bonds_out_.active()) have_factor_ = false, bonds_out_.clear();  // for one step only (see .hpp)
+      if (linear_.bonds_out().active()) linear_.forget_factor();  // for one step only (see .hpp)
       carried_load_ = std::max(carried_load_, load_scale(s, t1));
       started_cold_ = !guess_from_velocity_;
       state = std::move(s);
@@ -891,11 +834,10 @@ void QuasiStatic::step(State& state, double& t, double& dt) {
     // Not converged (or lost a factorisation to a failed pivot): redo the step from t, halved. The
     // bonds broken on the way stay broken (breaking is irreversible, as in the explicit scheme).
     broken_by_failed_attempts += broke_total;
-    have_factor_ = false;
-    bonds_out_.clear();
+    linear_.forget_factor();
     if (iteration_cap_ > 0) {
       const std::string spent =
-          stalled_at_ > 0 ? counted(factorisations_ - factorisations_at_step_, "factorisation") + " of the tangent: Newton "
+          stalled_at_ > 0 ? counted(linear_.factorisations() - factorisations_at_step_, "factorisation") + " of the tangent: Newton "
                             "iteration " + std::to_string(stalled_at_) + " of its solve took the residual down only ×" +
                             message_number(stall_ratio_) + ", a stall"
           : factorisation_cap_hit_ ? std::to_string(factorisation_cap_) + " factorisations of the tangent and " +
@@ -940,26 +882,28 @@ void QuasiStatic::take_out_broken_bonds(const std::vector<std::uint8_t>& broken_
   const auto start = std::chrono::steady_clock::now();
   // On any failure the factor is dropped (a new factorisation at the re-solve, as without this), so
   // the blocks are added in place.
-  const std::int64_t bonds = add_broken_bonds(op_.model(), broken_before, factor_u_, factor_definite_, dofs_, bonds_out_);
+  Woodbury& bonds_out = linear_.bonds_out();
+  const std::int64_t bonds = add_broken_bonds(op_.model(), broken_before, linear_.factor_u(), linear_.factor_point().definite,
+                                              dofs_, bonds_out);
   // W is dofs × columns doubles: at most kMaxRemovedBytes of it, whatever the cap in columns.
   const auto byte_cap = static_cast<int>(std::min<std::size_t>(kMaxRemovedBytes / (sizeof(double) * std::max<std::size_t>(dofs_.size(), 1)),
                                                                 static_cast<std::size_t>(max_removed_columns_)));
-  const bool fits = bonds >= 0 && bonds_out_.columns() <= byte_cap && bonds_out_.update(*factor_, dofs_.size());
+  const bool fits = bonds >= 0 && bonds_out.columns() <= byte_cap && bonds_out.update(linear_.factor(), dofs_.size());
   if (fits) {
     bonds_taken_out_ += bonds;
   } else {
-    have_factor_ = false;
-    bonds_out_.clear();
+    linear_.forget_factor();
   }
   bonds_out_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::string QuasiStatic::linear_algebra_summary() const {
   char buffer[160];
-  std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s", factorisations_,
-                factorise_seconds_, static_cast<long long>(solves_), solve_seconds_);
+  std::snprintf(buffer, sizeof buffer, "%d factorisations in %.3f s, %lld solves in %.3f s",
+                linear_.factorisations(), linear_.factorise_seconds(), static_cast<long long>(linear_.solves()),
+                linear_.solve_seconds());
   std::string cut_text;
-  if (!use_cg_ && analyses() > 0) {
+  if (!linear_.uses_cg() && analyses() > 0) {
     char analyses_text[96];
     std::snprintf(analyses_text, sizeof analyses_text, ", %d symbolic %s in %.3f s", analyses(),
                   analyses() == 1 ? "analysis" : "analyses", analysis_seconds());
@@ -972,10 +916,10 @@ std::string QuasiStatic::linear_algebra_summary() const {
                   static_cast<long long>(bonds_taken_out_), bonds_out_seconds_);
     cut_text += out_text;
   }
-  if (!use_cg_) return buffer + cut_text;
+  if (!linear_.uses_cg()) return buffer + cut_text;
   // On the matrix-free path every CG iteration is one J·x product, about one force evaluation.
-  std::string text = std::string(buffer) + ", " + std::to_string(cg_solves_) + " CG solves with " +
-                     std::to_string(cg_iterations_) + " iterations (J·x products)";
+  std::string text = std::string(buffer) + ", " + std::to_string(linear_.cg_solves()) + " CG solves with " +
+                     std::to_string(linear_.cg_iterations()) + " iterations (J·x products)";
   if (use_amg_) {
     std::snprintf(buffer, sizeof buffer, ", %d AMG set-ups in %.3f s (last: %d levels, operator complexity %.2f)",
                   amg_setups_, amg_seconds_, amg_.levels(), amg_.operator_complexity());
@@ -988,11 +932,11 @@ std::vector<std::string> QuasiStatic::describe(double) const {
   return {"quasi_static: Newton with line search to residual " + message_number(settings_.residual_tol) +
           " × the load and correction TOL " + message_number(settings_.tol) + ", Kd " + std::to_string(settings_.kd) + ", p " +
           message_number(settings_.p) +
-          (use_cg_ ? std::string("; linear solves by matrix-free CG with ") +
+          (linear_.uses_cg() ? std::string("; linear solves by matrix-free CG with ") +
                          (use_amg_ ? "algebraic multigrid (hypre BoomerAMG, one V-cycle)" : "block-Jacobi") +
                          ", Eisenstat-Walker forcing (cg, "
                    : std::string("; tangent factorised by CHOLMOD (direct, ")) +
-          solver_reason_ + ")" + (use_cg_ ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
+          linear_.reason() + ")" + (linear_.uses_cg() ? "; preconditioner " + preconditioner_reason_ : std::string()) + "; load steps dt_initial " + message_number(dt_initial_.value_or(0.0)) + " s, dt_min " + message_number(dt_min_) +
           " s, dt_max " + message_number(dt_max_) + " s" +
           (settings_.cut_to_first_failure ? "; a load step past the first bond failure is cut back to it" : "") +
           (bond_based_ ? "; once bonds have broken, nodes hanging by bonds on one line and one side are left out of "

@@ -81,11 +81,9 @@
 
 #include "integrators/hanging_nodes.hpp"
 #include "integrators/integrator.hpp"
-#include "linalg/amg.hpp"
-#include "linalg/cholesky.hpp"
-#include "linalg/pcg.hpp"
-#include "linalg/woodbury.hpp"
+#include "integrators/linear_solve.hpp"
 #include "integrators/newton_krylov.hpp"
+#include "linalg/amg.hpp"
 #include "linalg/sparse_matrix.hpp"
 #include "parallel/dof_sums.hpp"
 
@@ -111,21 +109,19 @@ class QuasiStatic : public Integrator {
   void load_state(const std::vector<char>& bytes) override;
 
   // Work of the whole run, for run.log and the tests.
-  int factorisations() const { return factorisations_; }
+  int factorisations() const { return linear_.factorisations(); }
   // Factorisations CHOLMOD refused (the tangent not positive definite), since configure.
-  int refused_factorisations() const { return refused_; }
+  int refused_factorisations() const { return linear_.refused(); }
   // CHOLMOD's symbolic analyses (orderings) behind the factorisations, and their wall time: one per
   // CHOLMOD object in use while the tangent's pattern stays (it keeps every bond, broken or not).
-  int analyses() const { return factor_->analyses() + (spare_factor_ ? spare_factor_->analyses() : 0); }
-  double analysis_seconds() const {
-    return factor_->analysis_seconds() + (spare_factor_ ? spare_factor_->analysis_seconds() : 0.0);
-  }
+  int analyses() const { return linear_.analyses(); }
+  double analysis_seconds() const { return linear_.analysis_seconds(); }
   // "N factorisations in X s, M solves in Y s" (wall time of assembling and factorising the tangent,
   // and of the solves with its factor; this process's only: a restarted run counts from the restart).
   std::string linear_algebra_summary() const override;
-  bool uses_cg() const { return use_cg_; }
-  bool uses_amg() const { return use_cg_ && use_amg_; }
-  std::string linear_solver() const override { return use_cg_ && use_amg_ ? "cg amg" : linear_solver_name(use_cg_); }
+  bool uses_cg() const { return linear_.uses_cg(); }
+  bool uses_amg() const { return linear_.uses_cg() && use_amg_; }
+  std::string linear_solver() const override { return uses_amg() ? "cg amg" : linear_solver_name(linear_.uses_cg()); }
   std::string keep_linear_solver(const std::string& recorded) override;
   int amg_setups() const { return amg_setups_; }  // since configure (not checkpointed)
   // Load steps cut to the first bond failure (see the head of this file), since configure (not checkpointed).
@@ -136,8 +132,8 @@ class QuasiStatic : public Integrator {
   // The largest overshoot of the ratio s/s0 a load step keeps without a cut, and the cut's targets
   // 1 ∓ kCutMargin/2 (the head of this file).
   static constexpr double kCutMargin = 1e-3;
-  std::int64_t cg_iterations() const { return cg_iterations_; }  // since configure (not checkpointed)
-  int cg_solves() const { return cg_solves_; }
+  std::int64_t cg_iterations() const { return linear_.cg_iterations(); }  // since configure (not checkpointed)
+  int cg_solves() const { return linear_.cg_solves(); }
   // Auto picks cg at or above this many free dofs in 3D (measured: see the .cpp).
   static constexpr std::size_t kCgFromDofs3d = pd::kCgFromDofs3d;
   // Auto picks amg (when CG is used, the tangent can be assembled and hypre is built in) from this
@@ -193,7 +189,7 @@ class QuasiStatic : public Integrator {
   // Whether the last step's equilibrium was the carried state itself (no correction, no tangent).
   bool accepted_as_carried() const { return accepted_carried_; }
   // Bonds broke outside this integrator (an explicit step): the factorisation no longer fits.
-  void forget_factorisation() { have_factor_ = false, amg_.clear(), bonds_out_.clear(); }
+  void forget_factorisation() { linear_.forget_factor(), amg_.clear(); }
   // Why the last step() threw StepFailed, in a few words for run.log.
   const std::string& failure_reason() const { return failure_reason_; }
   double dt_min() const { return dt_min_; }
@@ -256,24 +252,15 @@ class QuasiStatic : public Integrator {
   FreeDofs dofs_;
   DofSums sums_;  // the norms and CG's dot products over dofs_ (every rank's on a decomposed run)
   mutable std::vector<double> terms_, motion_terms_;  // per-dof terms of those sums
-  // The factorisation in use, and a spare CHOLMOD object that a cut trial factorises into so that
-  // the start's factor survives it (restore_solver swaps them back; each keeps its symbolic analysis).
-  std::unique_ptr<SparseCholesky> factor_ = std::make_unique<SparseCholesky>(), spare_factor_;
-  bool have_factor_ = false;
-  int factorisations_ = 0, refused_ = 0;
-  std::int64_t solves_ = 0;
-  double factorise_seconds_ = 0.0, solve_seconds_ = 0.0;  // wall time, for linear_algebra_summary()
-  // Where the factorisation in use was assembled (for save_state): u, t, and whether the definite
-  // variant and the diagonal shift were used.
-  Vec3Array factor_u_;
-  double factor_t_ = 0.0;
-  bool factor_definite_ = false, factor_shifted_ = false;
+  // The linear solver (direct or CG, and why), the factorisation in use with where it was assembled
+  // (for save_state: u, t, and whether the definite variant and the diagonal shift were used), and
+  // CG's block Jacobi (linear_solve.hpp). Its factor's spare object serves the cut (remember_solver).
+  LinearSolve linear_;
   bool factorize_at(const State& s, double t1, bool definite, bool shifted);
-  // The bonds broken since the factorisation in use, taken out of it (bonds_out_of_factor.hpp): every
-  // solve with the factor is corrected by them. For one load step only: a step that ends with
-  // bonds taken out drops its factor, so that what a checkpoint holds (factor_u_ with the bonds of
-  // the checkpoint) is what a restart factorises again, bit for bit.
-  Woodbury bonds_out_;
+  // The bonds broken since the factorisation in use are taken out of it (bonds_out_of_factor.hpp,
+  // LinearSolve::bonds_out): every solve with the factor is corrected by them. For one load step only:
+  // a step that ends with bonds taken out drops its factor, so that what a checkpoint holds (the
+  // factor's u with the bonds of the checkpoint) is what a restart factorises again, bit for bit.
   std::int64_t bonds_taken_out_ = 0;  // bonds so, since configure (run.log's summary)
   double bonds_out_seconds_ = 0.0;
   // At most this many columns (2 per bond in 2D, 3 in 3D) are taken out; a round that would pass it
@@ -291,17 +278,14 @@ class QuasiStatic : public Integrator {
   void take_out_broken_bonds(const std::vector<std::uint8_t>& broken_before);
   std::vector<std::uint8_t> broken_before_round_;  // scratch: the flags before a breaking round
   std::string failure_reason_;
-  // The matrix-free path: the choice and why (configure), the correction by PCG at (s, t1) for the
-  // forcing term eta; false when CG made no progress.
-  bool use_cg_ = false;
-  std::string solver_reason_;
+  // The matrix-free path: the correction by PCG at (s, t1) for the forcing term eta; false when CG
+  // made no progress.
   std::string checkpoint_solver_;  // the solver of the checkpoint a restart reads (keep_linear_solver), or ""
   static constexpr double kEtaMax = 0.1;
   bool solve_krylov(const State& s, double t1, double eta, double floor);
   double build_block_jacobi(const State& s, double t1);
   void choose_linear_solver(const Case& c);
   std::string cg_failure_;
-  BlockJacobi preconditioner_;
   // Algebraic multigrid (see the head of this file): the choice and why, the hierarchy, where it
   // was set up, and the first solve's iterations per tenfold reduction after it (0: none yet).
   void choose_preconditioner(const Case& c, std::size_t free, bool assembled);
@@ -314,23 +298,13 @@ class QuasiStatic : public Integrator {
   double amg_shift_ = 0.0;  // the diagonal shift of the K the hierarchy was set up on
   int amg_setups_ = 0;
   double amg_seconds_ = 0.0;
-  std::vector<std::int64_t> block_first_;
-  std::vector<double> blocks_, cg_rhs_, diagonal_;
-  Vec3Array cg_x_, cg_y_;
-  std::int64_t cg_iterations_ = 0;
-  int cg_solves_ = 0;
   State trial_;
   std::vector<double> rhs_, correction_;
   // The cut (see the head of this file): what the linear solver held at the start of the step, to
-  // be put back after a trial that is cut. The first factorisation of the step goes into the spare
-  // object (factorize_at swaps them, and u of the start's factor into factor_u), so the start's
-  // factor is kept as it is; an AMG hierarchy is set up again where it was (u copied by set_up_amg).
+  // be put back after a trial that is cut. The factor is kept by linear_ (remember_factor: the
+  // step's first factorisation goes into its spare object); an AMG hierarchy is set up again where
+  // it was (u copied by set_up_amg). Active while linear_.remembering().
   struct SolverAtStart {
-    bool active = false;
-    bool have_factor = false, definite = false, shifted = false;
-    double factor_t = 0.0;
-    bool swapped = false;  // factor_ is the spare now, and factor_u the start's factor's u
-    Vec3Array factor_u;
     bool amg_ready = false;
     double amg_t = 0.0, amg_rate = 0.0;
     int amg_setups = 0;
