@@ -28,7 +28,8 @@ from .inputs import check_case_inputs
 from .output_lock import FolderInUse, output_lock
 from .regular_file import open_regular
 from .resolve import check_set_names, resolve
-from .stability import check_discretized_case
+from .solver_physics import CaseQuery, SolverError
+from .stability import BOND_SLACK, check_discretized_case
 
 
 def cmd_check(args):
@@ -160,13 +161,13 @@ def missing_block_error(case: dict, mesh: str, err) -> CaseError:
     return CaseError("\n".join(messages))
 
 
-def run_cost(case: dict, resolved: dict, cloud) -> dict:
-    """The estimate of pipeline/cost.py for this case: bonds counted on a sample, eq. 2.5's step."""
+def run_cost(case: dict, resolved: dict, cloud, query: CaseQuery | None = None) -> dict:
+    """The estimate of pipeline/cost.py for this case: bonds counted on a sample, eq. 2.5's step
+    (the solver's: query, made here if not given, see solver_physics.CaseQuery)."""
     import numpy as np
     from scipy.spatial import cKDTree
 
     from .cost import estimate, mean_bonds
-    from .stability import BOND_SLACK, case_stable_time_step
 
     points = np.asarray(cloud.points)
     tree = cKDTree(points)
@@ -174,7 +175,7 @@ def run_cost(case: dict, resolved: dict, cloud) -> dict:
     implicit = time["integrator"] == "implicit" or (time["integrator"] == "mixed" and
                                                      case["mixed"]["start"] == "implicit")
     # eq. 2.5's step: Verlet's with its safety factor, and the scale of an implicit step's accuracy
-    dt_stable = case_stable_time_step(case, resolved, cloud, tree)[0] if isinstance(time["dt"], str) or implicit \
+    dt_stable = (query or CaseQuery(resolved, cloud)).stable_step()[0] if isinstance(time["dt"], str) or implicit \
         else None
     if isinstance(time["dt"], str):
         dt = dt_stable * float(time["safety_factor"])   # "exact" is larger: this is an upper bound
@@ -208,10 +209,12 @@ def cmd_preprocess(args):
         raise missing_block_error(case, args.mesh, err) from err
     resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
                        nodes_file="nodes.vtu")
-    # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.
-    for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud):
+    # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written: the
+    # step is pdsolve's, asked on a temporary copy of the cloud and case.json (solver_physics.py).
+    query = CaseQuery(resolved, cloud, named=os.path.join(args.out_dir, "case.json"))
+    for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud, query):
         print(f"warning: {warning}", file=sys.stderr)
-    plan = check_cost(case, run_cost(case, resolved, cloud), args.out_dir)  # stops a huge run unless FORCE=1
+    plan = check_cost(case, run_cost(case, resolved, cloud, query), args.out_dir)  # stops a huge run unless FORCE=1
     os.makedirs(args.out_dir, exist_ok=True)
     write_node_file(os.path.join(args.out_dir, "nodes.vtu"), cloud)
     write_atomically(os.path.join(args.out_dir, "case.json"), json.dumps(resolved, indent=1) + "\n")
@@ -263,6 +266,9 @@ def main(argv=None) -> int:
     except WriteError as err:  # a full disk: its own exit code, as in the solver
         print(f"error: {err}", file=sys.stderr)
         return DISK_FULL_EXIT
+    except SolverError as err:  # pdsolve missing or refusing: preprocess asks it for the stable step
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     except Exception as err:  # preprocess errors carry the file name in their message
         if type(err).__name__ == "PreprocessError":
             print(f"error: {err}", file=sys.stderr)
