@@ -224,11 +224,15 @@ class Case:
                 say(f"mesh: {mesh} → {target}")
                 stages.cmd_mesh(argparse.Namespace(case=yaml_path, geo=mesh, out=target))
             mesh = target
-        say(f"preprocess: {yaml_path} + {mesh} → {out_dir}/nodes.vtu, case.json")
-        stages.cmd_preprocess(argparse.Namespace(case=yaml_path, mesh=mesh, out_dir=out_dir))
+        # Before preprocess, which asks this solver for the stable step (pipeline/solver_physics.py).
         solver = solver or os.environ.get("PDSOLVE", os.path.join(ROOT, "build", "solver", "pdsolve"))
         if not os.path.isfile(solver):
             raise RunError(f"{solver}: the solver is not built; run `make solver` in {ROOT}")
+        say(f"preprocess: {yaml_path} + {mesh} → {out_dir}/nodes.vtu, case.json")
+        try:
+            stages.cmd_preprocess(argparse.Namespace(case=yaml_path, mesh=mesh, out_dir=out_dir, solver=solver))
+        except stages.SolverError as error:
+            raise RunError(str(error)) from None
         for stale in glob.glob(os.path.join(out_dir, "frames", "*.vtu")):
             os.unlink(stale)  # frames of an earlier, longer run would stay listed nowhere but on disk
         command = [solver, os.path.join(out_dir, "case.json")] + (["--threads", str(threads)] if threads else [])

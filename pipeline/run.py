@@ -211,7 +211,8 @@ def cmd_preprocess(args):
                        nodes_file="nodes.vtu")
     # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written: the
     # step is pdsolve's, asked on a temporary copy of the cloud and case.json (solver_physics.py).
-    query = CaseQuery(resolved, cloud, named=os.path.join(args.out_dir, "case.json"))
+    query = CaseQuery(resolved, cloud, named=os.path.join(args.out_dir, "case.json"),
+                      solver=getattr(args, "solver", None))  # peridyn's solver; else PDSOLVE or build/'s
     for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud, query):
         print(f"warning: {warning}", file=sys.stderr)
     plan = check_cost(case, run_cost(case, resolved, cloud, query), args.out_dir)  # stops a huge run unless FORCE=1

@@ -103,12 +103,12 @@ class CaseQuery:
     the step is needed (a horizon below the spacing), and the step check and the work plan share
     one answer."""
 
-    def __init__(self, resolved: dict, cloud, named: str | None = None):
-        self._resolved, self._cloud, self._named, self._answer = resolved, cloud, named, None
+    def __init__(self, resolved: dict, cloud, named: str | None = None, solver: str | None = None):
+        self._resolved, self._cloud, self._named, self._solver, self._answer = resolved, cloud, named, solver, None
 
     def answer(self) -> dict:
         if self._answer is None:
-            self._answer = physics_of_cloud(self._resolved, self._cloud, named=self._named)
+            self._answer = physics_of_cloud(self._resolved, self._cloud, named=self._named, solver=self._solver)
         return self._answer
 
     def stable_step(self) -> tuple[float, int]:

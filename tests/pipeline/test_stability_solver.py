@@ -86,7 +86,8 @@ def test_the_warning_quotes_the_solvers_step_and_node(tmp_path, pdsolve, monkeyp
 def test_a_missing_solver_is_a_clear_error_and_nothing_is_written(tmp_path, monkeypatch, capsys):
     case_dir = os.path.join(ROOT, "cases", "membrane")
     mesh = str(tmp_path / "mesh.msh")
-    assert driver.main(["mesh", os.path.join(case_dir, "membrane.yaml"), os.path.join(case_dir, "membrane.geo"), mesh]) == 0
+    yaml = os.path.join(case_dir, "membrane.yaml")
+    assert driver.main(["mesh", yaml, os.path.join(case_dir, "membrane.geo"), mesh]) == 0
     missing = str(tmp_path / "no" / "pdsolve")
     monkeypatch.setenv("PDSOLVE", missing)
     case, resolved, cloud = plate(tmp_path, "")
@@ -97,6 +98,6 @@ def test_a_missing_solver_is_a_clear_error_and_nothing_is_written(tmp_path, monk
     # The stage: exit 2 with that message, and no case.json or nodes.vtu.
     out = tmp_path / "out"
     capsys.readouterr()
-    assert driver.main(["preprocess", os.path.join(case_dir, "membrane.yaml"), mesh, str(out)]) == 2
+    assert driver.main(["preprocess", yaml, mesh, str(out)]) == 2
     assert f"error: the solver {missing} is missing" in capsys.readouterr().err
     assert not os.path.exists(out / "case.json") and not os.path.exists(out / "nodes.vtu")
