@@ -222,7 +222,10 @@ $(OUT)/mesh-parameters.json: $(YAML) $(PRE_SOURCES) | $(DEPS)
 $(OUT)/mesh.msh: $(CASEDIR)/$(case).geo $(OUT)/mesh-parameters.json | $(DEPS)
 	$(PY) -m pipeline.run mesh '$(YAML)' '$<' '$@'
 
-$(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS)
+# preprocess asks the solver for the stable step of its checks and work plan (pdsolve --physics,
+# pipeline/solver_physics.py): the solver is built first, and handed over as PDSOLVE.
+$(OUT)/nodes.vtu $(OUT)/case.json: export PDSOLVE := $(abspath $(SOLVER))
+$(OUT)/nodes.vtu $(OUT)/case.json &: $(YAML) $(MESH) $(PRE_SOURCES) | $(DEPS) $(SOLVER)
 	$(PY) -m pipeline.run preprocess '$<' '$(MESH)' '$(OUT)'
 
 # A stamp, not history.csv, marks a finished solve: an interrupted run keeps its files (Ctrl-C and

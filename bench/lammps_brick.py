@@ -13,7 +13,6 @@ the same loop; pd_speed has no contact on this brick. That is the work each code
 this problem, and it is what a user switching codes would see.
 """
 import argparse
-import math
 import os
 import re
 import shutil
@@ -23,31 +22,42 @@ import tempfile
 
 import numpy as np
 
-from pipeline.stability import micromodulus, stable_time_step  # the solver's formulas (tested equal)
+from pipeline.solver_physics import physics_of_cloud  # pdsolve --physics: the solver's own numbers
+from preprocess.cloud import NodeCloud
 
 # The material of pd_speed (solver/bench/speed.cpp): E = 72 GPa, ν = 1/4, ρ = 2440 kg/m³, G0 = 4 J/m².
 DX = 1e-3
 HORIZON = 3.0002 * DX
 YOUNG, DENSITY, FRACTURE_ENERGY = 72e9, 2440.0, 4.0
 BULK = YOUNG / (3.0 * (1.0 - 2.0 * 0.25))                          # k = E/(3(1−2ν)), ν = 1/4
-MICROMODULUS = micromodulus("3d", YOUNG, HORIZON, None)            # c = 18k/(πδ⁴) (docs/theory.md T2)
-CRITICAL_STRETCH = math.sqrt(5.0 * FRACTURE_ENERGY / (9.0 * BULK * HORIZON))  # s0 = √(5G0/(9kδ))
 SHEAR = YOUNG / (2.0 * (1.0 + 0.25))                               # G = E/(2(1+ν)): peri/lps
 
 
-def lattice_stable_time_step():
-    """Thesis eq. 2.5 on the brick's lattice, as pipeline/stability.py computes it for any cloud: its
-    minimum is at an interior node, so a 9³ lattice (an interior node with its whole family) gives
-    the brick's. 0.8 of it is the step pd_speed takes (0.8 · stable_time_step of the model)."""
+def lattice_physics():
+    """pdsolve --physics on a 9³ piece of the brick's lattice with its material: PMB's c = 18k/(πδ⁴)
+    (docs/theory.md T2) and s0 = √(5G0/(9kδ)) from E and G0, and thesis eq. 2.5's step, whose minimum
+    is at an interior node, so that the piece (an interior node with its whole family) gives the
+    brick's. 0.8 of the step is the one pd_speed takes (0.8 · stable_time_step of the model).
+    Returns (c, s0, the step × 0.8)."""
     side = 2 * (int(HORIZON / DX) + 1) + 1
     k, j, i = np.meshgrid(np.arange(side), np.arange(side), np.arange(side), indexing="ij")
     points = np.column_stack([i.ravel(), j.ravel(), k.ravel()]).astype(float) * DX
-    dt, _ = stable_time_step(points, np.full(len(points), DX ** 3), np.ones(len(points), np.int64),
-                             np.array([DENSITY]), np.array([[MICROMODULUS]]), HORIZON)
-    return dt
+    n = len(points)
+    cloud = NodeCloud(points=points, volume=np.full(n, DX ** 3), block=np.ones(n, np.int32),
+                      sets={"brick": np.ones(n, bool)}, grid_spacing=DX, dimension=3)
+    case = {"format_version": 1, "case": "lammps_brick", "dimension": 3, "analysis": "3d", "thickness": None,
+            "grid_spacing": DX, "horizon": HORIZON,
+            "blocks": [{"id": 1, "name": "brick", "model": "pmb", "density": DENSITY, "youngs_modulus": YOUNG,
+                        "fracture_energy": FRACTURE_ENERGY}],
+            "no_fail_sets": [], "node_sets": ["brick"], "boundary_conditions": [], "initial_conditions": [],
+            "damping": 0.0, "time": {"integrator": "verlet", "dt": "stable", "safety_factor": 0.8, "end": 1e-6},
+            "output": {"every_time": 1e-6, "every_steps": None, "history_every": 1}}
+    answer = physics_of_cloud(case, cloud)
+    (block,) = answer["blocks"]
+    return block["micromodulus"], block["critical_stretch"], answer["safety_factor"] * answer["stable"]
 
 
-TIME_STEP = 0.8 * lattice_stable_time_step()
+MICROMODULUS, CRITICAL_STRETCH, TIME_STEP = lattice_physics()
 
 
 def lammps_input(side, steps, model="pmb"):

@@ -18,11 +18,11 @@ prepare: the runs are
   - the runs of `make bench-accuracy` (bench/accuracy.py of --repo, run there, not copied): the
     wave and the fracture problem, each with its reference (Verlet at 0.05 × eq. 2.5) and every
     scheme of accuracy.schemes() (the full set by default, `--accuracy quick` for its --quick set,
-    `none` for no such runs). Run name: accuracy-<problem>-<scheme>-<parameter>. One difference
-    from bench-accuracy: the Δt_max = 4 × eq. 2.5 of the "dtmax4" runs takes eq. 2.5 from the
-    pre-processor's pipeline.stability instead of the solver's run.log, so that prepare needs no
-    solver; it may differ from the solver's value in the last bits, which does not matter here,
-    since every solver gets the same stored number.
+    `none` for no such runs). Run name: accuracy-<problem>-<scheme>-<parameter>. The Δt_max =
+    4 × eq. 2.5 of the "dtmax4" runs takes eq. 2.5 from `pdsolve --physics` on the problem
+    (pipeline/solver_physics.py: $PDSOLVE, else --repo's build/solver/pdsolve, which the
+    preprocess of the cases needs anyway) instead of a run's run.log, as bench-accuracy does; the
+    number is stored in the run's case.json, so every solver compared gets the same one.
   Each run gets its folder <runs>/<run>/ holding case.json and the node file it names (copied in as
   nodes.vtu, the only file a case.json refers to); the copy of case.json has nodes_file
   "nodes.vtu" and output_dir "output", so that a run writes <runs>/<run>/output/ and nothing
@@ -145,10 +145,8 @@ def stage(repo: str, args: list[str]) -> bool:
 # writes each problem's cases under the scratch folder and prints where, as JSON.
 ACCURACY_INPUTS = r"""
 import json, os, sys
-import numpy as np
 from bench import accuracy
-from pipeline.stability import micromodulus, stable_time_step
-from preprocess.node_file import read_node_file
+from pipeline.solver_physics import physics
 repo, scratch, quick = sys.argv[1], sys.argv[2], sys.argv[3] == "quick"
 if os.path.dirname(os.path.abspath(accuracy.__file__)) != os.path.join(repo, "bench"):
     raise SystemExit(f"imported {accuracy.__file__}, not the one of {repo}")
@@ -157,11 +155,11 @@ for problem_name, make in (("wave", accuracy.strip_problem), ("fracture", accura
     directory = os.path.join(scratch, "accuracy", problem_name)
     os.makedirs(directory)
     problem = make(directory)
-    cloud = read_node_file(os.path.join(directory, "nodes.vtu"))
-    (block,) = problem["blocks"]
-    c = micromodulus(problem["analysis"], block["youngs_modulus"], problem["horizon"], problem["thickness"])
-    dt_stable, _ = stable_time_step(cloud.points, cloud.volume, cloud.block, np.array([block["density"]]),
-                                    np.array([[c]]), problem["horizon"])
+    # eq. 2.5 of the problem, the solver's (pdsolve --physics: $PDSOLVE, else this checkout's
+    # build/solver/pdsolve, common/paths.py), asked on a case of it that is never run
+    probe = accuracy.write_case(directory, problem, "physics", {"integrator": "verlet", "dt": "stable",
+                                                                "safety_factor": 1.0}, None)
+    dt_stable = physics(probe)["stable"]
     # The reference run of accuracy.main(), then every scheme it sweeps.
     runs = [("reference", 0.05, {"integrator": "verlet", "dt": "stable", "safety_factor": 0.05}, None)]
     runs += list(accuracy.schemes(quick, dt_stable))

@@ -205,6 +205,7 @@ class Case:
         """run()'s stages, with out_dir locked by lock_fd (handed to the solver: the folder stays
         locked while it runs, even if this process is killed)."""
         from pipeline import stages
+        from pipeline.solver_physics import SolverError
 
         from .results import Run
 
@@ -219,11 +220,15 @@ class Case:
                 say(f"mesh: {mesh} → {target}")
                 stages.mesh(yaml_path, mesh, target)
             mesh = target
-        say(f"preprocess: {yaml_path} + {mesh} → {out_dir}/nodes.vtu, case.json")
-        stages.preprocess(yaml_path, mesh, out_dir)
+        # Before preprocess, which asks this solver for the stable step (pipeline/solver_physics.py).
         solver = solver or pdsolve()
         if not os.path.isfile(solver):
             raise RunError(f"{solver}: the solver is not built; run `make solver` in {REPOSITORY}")
+        say(f"preprocess: {yaml_path} + {mesh} → {out_dir}/nodes.vtu, case.json")
+        try:
+            stages.preprocess(yaml_path, mesh, out_dir, solver=solver)
+        except SolverError as error:
+            raise RunError(str(error)) from None
         for stale in glob.glob(os.path.join(out_dir, "frames", "*.vtu")):
             os.unlink(stale)  # frames of an earlier, longer run would stay listed nowhere but on disk
         case_json = os.path.join(out_dir, "case.json")

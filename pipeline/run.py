@@ -24,6 +24,7 @@ from common.output_lock import FolderInUse, output_lock
 from . import stages
 from .case import CaseError
 from .inputs import check_case_inputs
+from .solver_physics import SolverError
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -73,6 +74,9 @@ def main(argv=None) -> int:
     except WriteError as err:  # a full disk: its own exit code, as in the solver
         print(f"error: {err}", file=sys.stderr)
         return DISK_FULL_EXIT
+    except SolverError as err:  # pdsolve missing or refusing: preprocess asks it for the stable step
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     except Exception as err:  # preprocess errors carry the file name in their message
         if type(err).__name__ == "PreprocessError":
             print(f"error: {err}", file=sys.stderr)

@@ -6,7 +6,8 @@ A stage checks everything before it writes, and writes each file under a tempora
 renamed into place (common/atomic.py), so an interrupted stage leaves nothing half-written. What a
 stage does not do is its caller's: pipeline/run.py checks that no input leads out of the case folder
 and takes the output folder's lock (common/output_lock.py); peridyn holds the lock of its run.
-Errors are raised (CaseError, PreprocessError, WriteError), never turned into exit codes here.
+Errors are raised (CaseError, PreprocessError, WriteError, solver_physics.SolverError), never
+turned into exit codes here.
 """
 from __future__ import annotations
 
@@ -26,7 +27,8 @@ from .case import CaseError, load_case
 from .conditions import check_condition_overlaps
 from .cost import check_cost
 from .resolve import check_set_names, resolve
-from .stability import check_discretized_case
+from .solver_physics import CaseQuery
+from .stability import BOND_SLACK, check_discretized_case
 
 
 def check(case_file: str, mesh: str | None = None) -> None:
@@ -105,9 +107,11 @@ def mesh(case_file: str, geo: str, out: str) -> None:
                         f"check that they describe a sound body:\n{err}") from err
 
 
-def preprocess(case_file: str, mesh: str, out_dir: str) -> None:
+def preprocess(case_file: str, mesh: str, out_dir: str, *, solver: str | None = None) -> None:
     """The mesh to a node cloud: out_dir/nodes.vtu and the resolved out_dir/case.json the solver
-    reads, once the discretized case and the run's cost have passed their checks."""
+    reads, once the discretized case and the run's cost have passed their checks. Those checks take
+    eq. 2.5's step from the solver (pdsolve --physics, pipeline/solver_physics.py): `solver`, default
+    $PDSOLVE, else build/solver/pdsolve (common/paths.py); SolverError when it is missing or refuses."""
     from preprocess import PreprocessError, build_node_cloud
     from preprocess.node_file import write_node_file
 
@@ -131,10 +135,12 @@ def preprocess(case_file: str, mesh: str, out_dir: str) -> None:
         raise missing_block_error(case, mesh, err) from err
     resolved = resolve(case, node_sets=list(cloud.sets), grid_spacing=float(cloud.grid_spacing),
                        nodes_file="nodes.vtu")
-    # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written.
-    for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud):
+    # Isolated nodes and the eq. 2.5 step (unit mistakes) are checked before anything is written: the
+    # step is pdsolve's, asked on a temporary copy of the cloud and case.json (solver_physics.py).
+    query = CaseQuery(resolved, cloud, named=os.path.join(out_dir, "case.json"), solver=solver)
+    for warning in check_condition_overlaps(case, cloud.sets) + check_discretized_case(case, resolved, cloud, query):
         print(f"warning: {warning}", file=sys.stderr)
-    plan = check_cost(case, run_cost(case, resolved, cloud), out_dir)  # stops a huge run unless FORCE=1
+    plan = check_cost(case, run_cost(case, resolved, cloud, query), out_dir)  # stops a huge run unless FORCE=1
     os.makedirs(out_dir, exist_ok=True)
     write_node_file(os.path.join(out_dir, "nodes.vtu"), cloud)
     write_atomically(os.path.join(out_dir, "case.json"), json.dumps(resolved, indent=1) + "\n")
@@ -233,13 +239,13 @@ def missing_block_error(case: dict, mesh: str, err) -> CaseError:
     return CaseError("\n".join(messages))
 
 
-def run_cost(case: dict, resolved: dict, cloud) -> dict:
-    """The estimate of pipeline/cost.py for this case: bonds counted on a sample, eq. 2.5's step."""
+def run_cost(case: dict, resolved: dict, cloud, query: CaseQuery | None = None) -> dict:
+    """The estimate of pipeline/cost.py for this case: bonds counted on a sample, eq. 2.5's step
+    (the solver's: query, made here if not given, see solver_physics.CaseQuery)."""
     import numpy as np
     from scipy.spatial import cKDTree
 
     from .cost import estimate, mean_bonds
-    from .stability import BOND_SLACK, case_stable_time_step
 
     points = np.asarray(cloud.points)
     tree = cKDTree(points)
@@ -247,7 +253,7 @@ def run_cost(case: dict, resolved: dict, cloud) -> dict:
     implicit = time["integrator"] == "implicit" or (time["integrator"] == "mixed" and
                                                      case["mixed"]["start"] == "implicit")
     # eq. 2.5's step: Verlet's with its safety factor, and the scale of an implicit step's accuracy
-    dt_stable = case_stable_time_step(case, resolved, cloud, tree)[0] if isinstance(time["dt"], str) or implicit \
+    dt_stable = (query or CaseQuery(resolved, cloud)).stable_step()[0] if isinstance(time["dt"], str) or implicit \
         else None
     if isinstance(time["dt"], str):
         dt = dt_stable * float(time["safety_factor"])   # "exact" is larger: this is an upper bound

@@ -50,7 +50,8 @@ def run_case(case: str, work: str, changes: dict | None = None, *, figures: bool
     out = os.path.join(work, "out", case)
     mesh = os.path.join(out, "mesh.msh")
     quietly(f"mesh {yaml_path}", stages.mesh, yaml_path, os.path.join(case_dir, f"{case}.geo"), mesh)
-    quietly(f"preprocess {yaml_path}", stages.preprocess, yaml_path, mesh, out)
+    # preprocess asks the same solver for eq. 2.5's step (pdsolve --physics, pipeline/solver_physics.py)
+    quietly(f"preprocess {yaml_path}", lambda: stages.preprocess(yaml_path, mesh, out, solver=solver))
     start = time.monotonic()
     result = stages.solve(os.path.join(out, "case.json"), solver=solver, quiet=True, timeout=timeout)
     solver_seconds = time.monotonic() - start

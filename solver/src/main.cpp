@@ -14,6 +14,7 @@
 #include "io/describe.hpp"
 #include "io/node_file.hpp"
 #include "io/output_lock.hpp"
+#include "io/physics_query.hpp"
 #include "parallel/session.hpp"
 #include "run.hpp"
 
@@ -28,6 +29,7 @@ const char* const kUsage =
     "usage: pdsolve CASE.json [--restart CHECKPOINT] [--threads N] [--end-time T] [--max-steps N] [--quiet]\n"
     "               [--progress S] [--help] [--version]\n"
     "       pdsolve --stable-dt CASE.json [--exact] [--threads N]\n"
+    "       pdsolve --physics CASE.json [--exact] [--threads N]\n"
     "       pdsolve --describe\n"
     "\n"
     "Bond-based PMB peridynamics solver. Reads the resolved case CASE.json and its node file\n"
@@ -50,7 +52,12 @@ const char* const kUsage =
     "  --stable-dt     print, as JSON, the stable step of thesis eq. 2.5 that a run of CASE.json would\n"
     "                  compute (before time.safety_factor; null if no node has a bond):\n"
     "                  {\"stable\": s, \"safety_factor\": f}. Writes nothing.\n"
-    "  --exact         with --stable-dt: also \"exact\": 2/omega_max, the Lanczos limit of time.dt \"exact\"\n"
+    "  --physics       print, as JSON, what the Python side needs of CASE.json's set-up: --stable-dt's\n"
+    "                  step and the node where it is reached (\"node\"), each block's micromodulus and\n"
+    "                  critical stretch, the surface correction's range of bond factors\n"
+    "                  (io/physics_query.hpp). Writes nothing.\n"
+    "  --exact         with --stable-dt or --physics: also \"exact\": 2/omega_max, the Lanczos limit of\n"
+    "                  time.dt \"exact\"\n"
     "  --describe      print, as JSON, every case.json key this solver reads: {\"keys\": {\"time.dt\":\n"
     "                  {\"type\", \"default\" | \"required\", \"choices\", \"minimum\", \"maximum\", \"above\",\n"
     "                  \"below\", \"unit\", \"note\"}, ...}, \"registries\": {name: [keys]}}\n"
@@ -188,7 +195,8 @@ void check_thread_environment() {
 }
 
 // --stable-dt: eq. 2.5 on the model built exactly as run() builds it (read_case, read_node_file,
-// build_model), so that pipeline/stability.py can be tested against the solver's own number.
+// build_model), so that tests can hold --physics's step, which preprocess asks
+// (pipeline/solver_physics.py), equal to the one a run of the written files computes.
 int print_stable_dt(const std::filesystem::path& case_file, bool exact) {
   const pd::Case c = pd::read_case(case_file);
   const pd::Model model = pd::build_model(c, pd::read_node_file(c.nodes_file));
@@ -220,7 +228,7 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
   mallopt(M_TOP_PAD, 16 << 20);
   pd::RunOptions options;
-  bool stable_dt = false, exact = false;
+  bool stable_dt = false, physics = false, exact = false;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
     auto value = [&]() -> std::string {
@@ -246,6 +254,8 @@ int main(int argc, char** argv) {
       return pd::kOk;
     } else if (arg == "--stable-dt") {
       stable_dt = true;
+    } else if (arg == "--physics") {
+      physics = true;
     } else if (arg == "--exact") {
       exact = true;
     } else if (arg == "--quiet") {
@@ -262,14 +272,16 @@ int main(int argc, char** argv) {
     }
   }
   if (options.case_file.empty()) usage_error("no case file given");
-  if (exact && !stable_dt) usage_error("--exact goes with --stable-dt");
+  if (exact && !stable_dt && !physics) usage_error("--exact goes with --stable-dt");
   if (options.threads == 0) check_thread_environment();  // before any parallel region
   try {
-    if (stable_dt) {
+    if (stable_dt || physics) {
 #ifdef _OPENMP
       if (options.threads > 0) omp_set_num_threads(options.threads);
 #endif
-      return print_stable_dt(options.case_file, exact);
+      if (stable_dt) return print_stable_dt(options.case_file, exact);
+      std::cout << pd::physics_of_case(options.case_file, exact).dump(1) << "\n";
+      return pd::kOk;
     }
     return pd::run(options);
   } catch (const pd::FolderInUse& e) {

@@ -128,3 +128,15 @@ def test_pdsolve_started_by_hand_into_a_folder_a_run_holds_is_refused(tmp_path):
     assert result.returncode == 0, result.stderr
     assert "pdsolve " in (out / ".lock").read_text()
     assert subprocess.run(["flock", "-n", str(out / ".lock"), "true"]).returncode == 0
+
+
+def test_a_solver_that_refuses_the_physics_query_is_a_run_error_and_nothing_is_written(tmp_path):
+    """Preprocess asks Case.run's own solver for eq. 2.5's step (pdsolve --physics) before it writes:
+    a solver that refuses the query stops the run with a RunError naming it, and no case.json."""
+    refusing = tmp_path / "pdsolve"
+    refusing.write_text("#!/bin/sh\necho 'refused for the test' >&2\nexit 2\n")
+    refusing.chmod(0o755)
+    out = tmp_path / "out"
+    with pytest.raises(peridyn.RunError, match=r"pdsolve --physics .*case\.json failed: refused for the test"):
+        small_case().run(str(out), figures=False, solver=str(refusing))
+    assert not (out / "case.json").exists() and not (out / "nodes.vtu").exists()

@@ -32,7 +32,7 @@ def prepare_stages(yaml_path, geo_path, out):
     """The Makefile's first two stages on one case (pipeline/stages.py): mesh, then preprocess into
     out/ (case.json and the node file); a failing stage raises its error, naming the file."""
     stages.mesh(str(yaml_path), str(geo_path), str(out / "mesh.msh"))
-    stages.preprocess(str(yaml_path), str(out / "mesh.msh"), str(out))
+    stages.preprocess(str(yaml_path), str(out / "mesh.msh"), str(out), solver=SOLVER)
 
 
 def run_stages(yaml_path, geo_path, out):

@@ -120,12 +120,11 @@ def test_run_cost_passes_eq_2_5_to_the_implicit_estimate(tmp_path):
     import math
     from pipeline.resolve import resolve
     from pipeline.stages import run_cost
-    from pipeline.stability import case_stable_time_step
-    from scipy.spatial import cKDTree
+    from pipeline.solver_physics import physics_of_cloud
     case = newton_case(tmp_path, "implicit", end=1.0e-3)
     resolved = resolve(case, node_sets=[], grid_spacing=DX, nodes_file="nodes.vtu")
     c = cloud()
-    dt_eq25 = case_stable_time_step(case, resolved, c, cKDTree(c.points))[0]
+    dt_eq25 = physics_of_cloud(resolved, c)["stable"]
     assert run_cost(case, resolved, c)["steps"] == math.ceil(1.0e-3 / (2.0 * dt_eq25) - 1e-9)
 
 

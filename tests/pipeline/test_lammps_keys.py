@@ -7,7 +7,8 @@ import pytest
 
 from pipeline.case import CaseError, load_case
 from pipeline.resolve import resolve
-from pipeline.stability import block_micromodulus, micromodulus
+from pipeline.solver_physics import physics_of_cloud
+from preprocess.cloud import NodeCloud
 
 LAMMPS_LIKE = """\
 dimension: 3
@@ -26,6 +27,15 @@ breaking_order: lammps
 time:
   end: 1.0e-5
 """
+
+
+def solver_micromodulus(resolved):
+    """c of the case's block as pdsolve computes it (pdsolve --physics), on a 4³ lattice."""
+    side, dx = 4, resolved["grid_spacing"]
+    points = np.array([[i, j, k] for k in range(side) for j in range(side) for i in range(side)], float) * dx
+    cloud = NodeCloud(points=points, volume=np.full(len(points), dx ** 3), block=np.ones(len(points), np.int32),
+                      sets={}, grid_spacing=dx, dimension=3)
+    return physics_of_cloud(resolved, cloud)["blocks"][0]["micromodulus"]
 
 
 def write(tmp_path, text):
@@ -52,7 +62,7 @@ def test_a_lammps_like_case_reaches_case_json(tmp_path):
                                      "micromodulus": 3.4e21, "critical_stretch": 0.001,
                                      "critical_stretch_alpha": 0.25}
     # eq. 2.5's c for the stable step is the given one
-    assert block_micromodulus(case, case["materials"]["brick"], 0.0030002) == 3.4e21
+    assert solver_micromodulus(resolved) == 3.4e21
 
 
 def test_the_defaults_keep_the_thesis(tmp_path):
@@ -65,7 +75,9 @@ def test_the_defaults_keep_the_thesis(tmp_path):
     e = 7.2e10
     by_e = load_case(write(tmp_path, text.replace("micromodulus: 3.4e21", f"youngs_modulus: {e}")
                            .replace("    critical_stretch: 0.001\n", "")))
-    assert block_micromodulus(by_e, by_e["materials"]["brick"], 0.003) == micromodulus("3d", e, 0.003, None)
+    # c from E by docs/theory.md T2 in 3D, 12E/(πδ⁴)
+    resolved = resolve(by_e, node_sets=[], grid_spacing=0.001, nodes_file="nodes.vtu")
+    assert solver_micromodulus(resolved) == pytest.approx(12.0 * e / (np.pi * 0.0030002 ** 4), rel=1e-14)
 
 
 def test_both_pairs_given_is_an_error_at_its_line(tmp_path):

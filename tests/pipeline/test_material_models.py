@@ -1,6 +1,6 @@
 """Material models in the case file: a block gives the keys of its model and no other's (the
 bond-based PMB fixes Poisson's ratio, so poisson_ratio under model: pmb says so and suggests lps),
-LPS's ν range, and the Python stable step (pipeline/stability.py) equal to the solver's for LPS."""
+LPS's ν range, and the stable step preprocess checks (the solver's, pipeline/solver_physics.py) for LPS."""
 import json
 import os
 import subprocess
@@ -10,7 +10,7 @@ import pytest
 
 from pipeline import run as driver
 from pipeline.case import CaseError, load_case
-from pipeline.stability import case_stable_time_step
+from pipeline.solver_physics import physics_of_cloud
 from preprocess.node_file import read_node_file
 
 from common.paths import REPOSITORY as ROOT
@@ -113,8 +113,10 @@ def test_an_lps_case_is_accepted_with_its_defaults(tmp_path):
 
 
 @pytest.mark.parametrize("influence", ["one", "gaussian"])
-def test_python_stable_step_is_the_solvers_for_lps(influence, tmp_path, pdsolve):
-    """The membrane (2D, plane stress) in LPS: pipeline/stability.py's step equals pdsolve --stable-dt."""
+def test_the_checked_stable_step_is_the_solvers_for_lps(influence, tmp_path, pdsolve, monkeypatch):
+    """The membrane (2D, plane stress) in LPS: the step preprocess checks (pdsolve --physics on its
+    cloud and case) equals pdsolve --stable-dt on the files it writes."""
+    monkeypatch.setenv("PDSOLVE", pdsolve)
     case_dir = os.path.join(ROOT, "cases", "membrane")
     with open(os.path.join(case_dir, "membrane.yaml"), encoding="utf-8") as stream:
         text = stream.read()
@@ -128,8 +130,7 @@ def test_python_stable_step_is_the_solvers_for_lps(influence, tmp_path, pdsolve)
     with open(tmp_path / "case.json", encoding="utf-8") as stream:
         resolved = json.load(stream)
     assert resolved["blocks"][0]["model"] == "lps" and resolved["blocks"][0]["influence"] == influence
-    ours, _ = case_stable_time_step(load_case(str(yaml)), resolved, read_node_file(str(tmp_path / "nodes.vtu")),
-                                    sample=None)
+    ours = physics_of_cloud(resolved, read_node_file(str(tmp_path / "nodes.vtu")), solver=pdsolve)["stable"]
     out = subprocess.run([pdsolve, str(tmp_path / "case.json"), "--stable-dt"], check=True,
                          capture_output=True, text=True).stdout
-    assert ours == pytest.approx(json.loads(out)["stable"], rel=1e-12, abs=0)
+    assert ours == json.loads(out)["stable"]

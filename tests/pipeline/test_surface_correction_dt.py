@@ -1,8 +1,10 @@
 """With `discretization.surface_correction: energy` the solver multiplies each bond's term of thesis
-eq. 2.5 by its correction factor g; pipeline/stability.py (via pipeline/surface_correction.py, the
-solver's energy method with the stretch linearised) gives the same stable step as
-`pdsolve --stable-dt` to 1e-8 relative, for PMB and LPS, 2D and 3D, and with a pre-crack; and the
-correction does move the step (so the comparison could fail); the same for `surface_correction: volume`."""
+eq. 2.5 by its correction factor g. The step preprocess checks with is the solver's (`pdsolve
+--physics` on a temporary copy of the cloud and case, pipeline/solver_physics.py): equal to
+`pdsolve --stable-dt` on the written case.json, for PMB and LPS, 2D and 3D, and with a pre-crack; the
+correction does move the step, and --physics reports its factors' range (not 1 with a correction, 1
+without); the same for `surface_correction: volume`. (Before issue 37 the Python side had its own
+copy of both corrections, held equal to the solver's here.)"""
 import json
 import os
 import subprocess
@@ -10,8 +12,7 @@ import subprocess
 import pytest
 
 from pipeline import run as driver
-from pipeline.case import load_case
-from pipeline.stability import case_stable_time_step
+from pipeline.solver_physics import physics_of_cloud
 from preprocess.node_file import read_node_file
 
 from common.paths import REPOSITORY as ROOT
@@ -28,7 +29,7 @@ VARIANTS = {
 }
 
 
-def steps(name, tmp_path, pdsolve, correction):
+def steps(name, tmp_path, pdsolve, correction, monkeypatch):
     case, old, new = VARIANTS[name]
     case_dir = os.path.join(ROOT, "cases", case)
     with open(os.path.join(case_dir, case + ".yaml"), encoding="utf-8") as stream:
@@ -47,35 +48,35 @@ def steps(name, tmp_path, pdsolve, correction):
     yaml = work / (case + ".yaml")
     yaml.write_text(text)
     mesh = str(work / "mesh.msh")
+    monkeypatch.setenv("PDSOLVE", pdsolve)
     assert driver.main(["mesh", str(yaml), os.path.join(case_dir, case + ".geo"), mesh]) == 0
     assert driver.main(["preprocess", str(yaml), mesh, str(work)]) == 0
     with open(work / "case.json", encoding="utf-8") as stream:
         resolved = json.load(stream)
     assert resolved["surface_correction"] == correction
-    ours, _ = case_stable_time_step(load_case(str(yaml)), resolved, read_node_file(str(work / "nodes.vtu")),
-                                    sample=None)
+    asked = physics_of_cloud(resolved, read_node_file(str(work / "nodes.vtu")), solver=pdsolve)
+    assert asked["surface_correction"]["method"] == correction
+    g = asked["surface_correction"]["bond_factor"]
+    assert (g == [1.0, 1.0]) == (correction == "none")
     out = subprocess.run([pdsolve, str(work / "case.json"), "--stable-dt"], check=True,
                          capture_output=True, text=True).stdout
-    return ours, json.loads(out)["stable"]
+    return asked["stable"], json.loads(out)["stable"]
 
 
 @pytest.mark.parametrize("name", sorted(VARIANTS))
-def test_python_stable_step_is_the_solvers_with_the_energy_correction(name, tmp_path, pdsolve):
-    ours, solver = steps(name, tmp_path, pdsolve, "energy")
-    plain, _ = steps(name, tmp_path, pdsolve, "none")
-    print(f"{name}: stable step {solver:.6e} s corrected, {plain:.6e} s without; python/solver - 1 = "
-          f"{ours / solver - 1.0:.2e}")
-    assert ours == pytest.approx(solver, rel=1e-8, abs=0)
+def test_the_checked_step_is_the_solvers_with_the_energy_correction(name, tmp_path, pdsolve, monkeypatch):
+    ours, solver = steps(name, tmp_path, pdsolve, "energy", monkeypatch)
+    plain, _ = steps(name, tmp_path, pdsolve, "none", monkeypatch)
+    print(f"{name}: stable step {solver:.6e} s corrected, {plain:.6e} s without")
+    assert ours == solver
     assert abs(solver / plain - 1.0) > 1e-3  # the factors do change the step
 
 
 @pytest.mark.parametrize("name", ["membrane-pmb", "plate_3d-lps", "branching-pmb"])
-def test_python_stable_step_is_the_solvers_with_the_volume_correction(name, tmp_path, pdsolve):
-    """`surface_correction: volume`: g = 2V0/(V_i + V_j) per bond (volume_factors), the same in
-    stability.py's eq. 2.5 as in the solver's; LPS's q unchanged (κ, α and m all times ḡ)."""
-    ours, solver = steps(name, tmp_path, pdsolve, "volume")
-    plain, _ = steps(name, tmp_path, pdsolve, "none")
-    print(f"{name}: stable step {solver:.6e} s with the volume correction, {plain:.6e} s without; "
-          f"python/solver - 1 = {ours / solver - 1.0:.2e}")
-    assert ours == pytest.approx(solver, rel=1e-8, abs=0)
+def test_the_checked_step_is_the_solvers_with_the_volume_correction(name, tmp_path, pdsolve, monkeypatch):
+    """`surface_correction: volume`: g = 2V0/(V_i + V_j) per bond (volume_factors)."""
+    ours, solver = steps(name, tmp_path, pdsolve, "volume", monkeypatch)
+    plain, _ = steps(name, tmp_path, pdsolve, "none", monkeypatch)
+    print(f"{name}: stable step {solver:.6e} s with the volume correction, {plain:.6e} s without")
+    assert ours == solver
     assert abs(solver / plain - 1.0) > 1e-3
