@@ -32,7 +32,7 @@ DEATH_NOTICED_WITHIN_S = 30
 # The interrupted runs: 10 ms (about 9 200 steps), a checkpoint every 0.1 ms. Long enough that a
 # signal sent after the first checkpoint finds the run still going on a quiet machine too: at 2 ms
 # the whole 2-rank run took 0.41 s and ended before mpirun had passed SIGTERM on.
-LONG_END, LONG_EVERY = 1.0e-2, 1.0e-4
+LONG_END, LONG_EVERY = 5.0e-2, 1.0e-4   # 5e-2: on a quiet machine a 1e-2 run (0.97 s on 2 ranks) ended before the SIGTERM sent at its first checkpoint arrived
 
 
 def with_checkpoints(end, every):
