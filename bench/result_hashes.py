@@ -282,6 +282,9 @@ def cmd_run(args) -> int:
     launcher = []
     if args.ranks > 1:
         env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        # OpenMPI refuses to start as root without these (bench/mpi_ranks.py sets them too).
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         launcher = ["mpiexec", "-n", str(args.ranks)]
     results: dict = {}
     seconds = {}

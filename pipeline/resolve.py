@@ -41,8 +41,9 @@ def check_set_names(case: dict, existing: list[str]):
         missing(name, ("no_fail", i))
     for name in case["node_sets"]:
         missing(name, ("node_sets", name))
-    for i, name in enumerate(case["output"]["reactions"]):
-        missing(name, ("output", "reactions", i))
+    for key in ("reactions", "probes"):
+        for i, name in enumerate(case["output"][key]):
+            missing(name, ("output", key, i))
     if isinstance(case["figures"]["probe"], str):
         missing(case["figures"]["probe"], ("figures", "probe"))
     if problems:

@@ -367,6 +367,10 @@ CASE = {
         reactions=Key("names", "node sets whose reaction force (the force the prescribed displacement or "
                       "velocity applies to the set) goes to history.csv as reaction_<set>_fx, _fy, _fz",
                       default=[], unit="N"),
+        probes=Key("names", "node sets whose volume-weighted mean displacement and velocity go to history.csv "
+                   "at every history row as probe_<set>_ux, _uy, _uz (m) and _vx, _vy, _vz (m/s); figures.probe "
+                   "naming one of them draws probe.png from these rows instead of the frames",
+                   default=[]),
         restart_every_time=Key("number", "write the checkpoint out/<case>/checkpoint.bin after the first step "
                                "at or past every multiple of this much simulated time (it never shortens a "
                                "step); SIGINT/SIGTERM always write one; `pdsolve case.json --restart "
@@ -411,7 +415,9 @@ CASE = {
                                    default="x", choices=("x", "y", "z")),
         probe=Key("point_or_name", "where probe.png follows the displacement component: a point "
                   "[x, y] or [x, y, z] (the node nearest to it), or a node-set name (the mean over its "
-                  "nodes); default: the node nearest the centre of the bounding box", default=None, unit="m"),
+                  "nodes); default: the first set of output.probes, else the node nearest the centre of the "
+                  "bounding box. A set of output.probes is drawn from every history row, anything else from "
+                  "the frames", default=None, unit="m"),
     ),
 }
 

@@ -71,7 +71,7 @@ def physics_of_cloud(resolved: dict, cloud, *, exact: bool = False, solver: str 
 
     physics_only = dict(resolved, nodes_file="nodes.vtu", output_dir=".", boundary_conditions=[],
                         initial_conditions=[], no_fail_sets=[])
-    physics_only["output"] = {k: v for k, v in resolved.get("output", {}).items() if k != "reactions"}
+    physics_only["output"] = {k: v for k, v in resolved.get("output", {}).items() if k not in ("reactions", "probes")}
     with tempfile.TemporaryDirectory(prefix="pd-physics-") as folder:
         write_node_file(os.path.join(folder, "nodes.vtu"), cloud)
         case_json = os.path.join(folder, "case.json")

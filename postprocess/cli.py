@@ -133,6 +133,9 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
         + (f"; Gmsh copy of {'all of them' if case.gmsh == 'all' else 'those of the figures'}" if do_gmsh else ""))
     kept: dict = {}
     probe: dict = {"values": [], "nodes": None, "where": "", "position": None}
+    # A probe the solver recorded at every history row (output.probes) needs nothing from the frames.
+    from .probe import probe_from_history
+    recorded = probe_from_history(history, case) if do_figures else None
     nodes_file = os.path.join(out_dir, "nodes.vtu")
     state: dict = {"last": None, "count": None}
     # crack nodes (φ > DAMAGED) of every frame, for the crack-tip tracks: a bool per node and frame
@@ -145,13 +148,15 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
             frame = read_frame(path)
             if state["count"] is None:
                 state["count"] = len(frame.points)
-                probe["nodes"], probe["where"] = probe_nodes(frame.points, case.probe, nodes_file)
-                if len(probe["nodes"]) == 1:
-                    probe["position"] = frame.points[probe["nodes"][0]]
+                if recorded is None:
+                    probe["nodes"], probe["where"] = probe_nodes(frame.points, case.probe, nodes_file)
+                    if len(probe["nodes"]) == 1:
+                        probe["position"] = frame.points[probe["nodes"][0]]
             elif len(frame.points) != state["count"]:
                 raise PostprocessError(f"{path}: {len(frame.points)} points, the first frame "
                                        f"{series[0][1]} has {state['count']}")
-            probe["values"].append(float(np.mean(frame.displacement[probe["nodes"], case.component])))
+            if recorded is None:
+                probe["values"].append(float(np.mean(frame.displacement[probe["nodes"], case.component])))
             if case.breakable:
                 crack_masks.append(frame.damage > DAMAGED)
             if index in selected:
@@ -229,7 +234,11 @@ def run(out_dir: str, case_json: str | None = None, only: str | None = None, log
             + ("" if damaged else "; no damage maps: nothing can break (no fracture_energy) and no damage"))
         _remove_stale_maps(fig_dir, len(selected), keep_damage=damaged)
         path = os.path.join(fig_dir, "probe.png")
-        say(plot_probe(times, probe["values"], case, path, where=probe["where"], position=probe["position"]))
+        if recorded is not None:  # every history row (output.probes): not aliased by the frame interval
+            rows, values, where = recorded
+            say(plot_probe(rows, values, case, path, where=where, samples="history rows"))
+        else:
+            say(plot_probe(times, probe["values"], case, path, where=probe["where"], position=probe["position"]))
         written.append(path)
         path = os.path.join(fig_dir, "damage_3d.png")
         if case.dimension == 3 and damaged:  # a rendered view of where the damage is inside the body

@@ -43,12 +43,16 @@ COLUMNS = {
     "mode": ("1", "kind of step: 1 quasi-static load step, 2 implicit step of mixed (mixed.start: implicit), "
                    "0 any other dynamic (explicit or implicit) step"),
 }
-# Families of columns, one triple per indenter or node set: (pattern, unit, description template).
+# Families of columns, one triple per indenter, reaction set or probe quantity: (pattern, unit, description template).
 FAMILIES = (
     (re.compile(r"^indenter_(?P<name>.+)_f(?P<axis>[xyz])$"), "N",
      "reaction force on indenter '{name}' along {axis} (minus its force on the body)"),
     (re.compile(r"^reaction_(?P<name>.+)_f(?P<axis>[xyz])$"), "N",
      "force the prescribed displacement or velocity applies to node set '{name}' along {axis}"),
+    (re.compile(r"^probe_(?P<name>.+)_u(?P<axis>[xyz])$"), "m",
+     "volume-weighted mean displacement of node set '{name}' along {axis} (output.probes)"),
+    (re.compile(r"^probe_(?P<name>.+)_v(?P<axis>[xyz])$"), "m/s",
+     "volume-weighted mean velocity of node set '{name}' along {axis} (output.probes)"),
 )
 
 

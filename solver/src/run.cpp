@@ -86,7 +86,9 @@ int run(const RunOptions& opt) {
 
   // Output starts here. open_output refuses a restart whose history.csv or frames do not match the
   // checkpoint (bad input, exit 1, before it changes a file); a full disk there is a failed run.
-  const HistoryColumns columns(p.model, p.c, p.integrator.get(), &p.op->model().contact_list);
+  // On a decomposed run the columns read the piece (the operator's model) and this rank's state.
+  const HistoryColumns columns(p.decomposed ? p.op->model() : p.model, p.c, p.integrator.get(),
+                               &p.op->model().contact_list, p.decomposed.get());
   try {
     const std::unique_ptr<OutputWriter> out = open_output_on_ranks(opt, p, s, columns);
     return run_with_output(opt, p, s, columns, out.get());

@@ -16,6 +16,7 @@ import re
 import shutil
 import subprocess
 
+import numpy as np
 import pytest
 import yaml
 
@@ -128,6 +129,10 @@ def with_loads(case):
         {"name": "wall", "shape": "plane", "radius": 0.0, "centre": [0.0013, 0.0, 0.0],
          "velocity": [1.0, 0.0, 0.0], "axis": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0], "stiffness": 1.0e14},
     ]
+    # Probes (output.probes: exact sums, so any order) and a reaction (rank 0 adds the pieces' terms in
+    # the serial order: core/reactions.hpp), neither gathering the whole state.
+    case["output"]["probes"] = ["right", "plate"]
+    case["output"]["reactions"] = ["right"]
 
 
 def as_lps(case):
@@ -174,6 +179,16 @@ def test_loads_lps_and_adaptive_equal_the_serial_run_byte_for_byte(variant_runs)
         assert float(last[header.index("indenter_wall_fx")]) < 0.0
         assert float(last[header.index("indenter_energy")]) > 0.0  # its own column since issue 16
         assert float(last[header.index("contact_energy")]) == 0.0   # no contact pairs in this scene
+        assert float(last[header.index("reaction_right_fx")]) != 0.0
+        # The right grip moves with its velocity table: its probe says so at the last row.
+        case = json.loads((serial / "case.json").read_text())
+        grip = next(bc for bc in case["boundary_conditions"]
+                    if bc["set"] == "right" and bc["kind"] == "velocity" and bc["component"] == 0)
+        t = float(last[header.index("time")])
+        assert float(last[header.index("probe_right_vx")]) == pytest.approx(
+            float(np.interp(t, grip["times"], grip["values"])), rel=1e-12)
+        assert [name for name in header if name.startswith("probe_plate_")] == [
+            f"probe_plate_{q}" for q in ("ux", "uy", "uz", "vx", "vy", "vz")]
     else:
         assert int(last[header.index("broken_bonds")]) > 100  # the plate cracked
     frames = sorted(os.listdir(serial / "frames"))

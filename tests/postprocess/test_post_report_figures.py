@@ -294,3 +294,27 @@ def test_a_run_crack_s_many_bonds_are_not_drawn_over_the_damage_colours(run2d, k
     ax = keep["damage_0.png"].axes[0]
     assert not [c for c in ax.collections if isinstance(c, LineCollection)]
     assert f"{len(pairs)} broken bonds (not drawn)" in ax.get_title()
+
+
+def test_a_probe_the_solver_recorded_is_drawn_from_every_history_row(run2d, keep):
+    """output.probes puts probe_<set>_u<axis> in every history row (formats.md §4): probe.png draws those
+    rows, not the frames (which alias a motion faster than their interval), for figures.probe naming the
+    set, or by default the first recorded set; a set the solver did not record still comes from the frames."""
+    path = run2d.out / "history.csv"
+    lines = path.read_text().splitlines()
+    time = lines[0].split(",").index("time")
+    rows = [float(line.split(",")[time]) for line in lines[1:]]
+    wiggle = [np.sin(9.0e5 * t) * 1e-6 for t in rows]  # a motion the frames cannot follow
+    header = lines[0] + "," + ",".join(f"probe_tip_{q}" for q in ("ux", "uy", "uz", "vx", "vy", "vz"))
+    body = [line + "," + ",".join(repr(w * (k + 1)) for k in range(6)) for line, w in zip(lines[1:], wiggle)]
+    path.write_text("\n".join([header] + body) + "\n")
+    for chosen in (None, "tip"):
+        _set(run2d, probe=chosen)
+        cli.run(str(run2d.out), only="figures", log=lambda *_: None)
+        line = keep["probe.png"].axes[0].get_lines()[0]
+        assert len(line.get_ydata()) == len(rows) > len(run2d.times)
+        factor, _ = si_scale([w * 3 for w in wiggle], "m")  # u_z: the column's third value (component 2)
+        assert np.allclose(line.get_ydata(), np.array(wiggle) * 3 * factor, rtol=1e-12)
+        assert "'tip'" in line.get_label()
+    case = probe.CaseSettings(name="x", dimension=2, title="x", probe="elsewhere")
+    assert probe.probe_from_history({"time": np.zeros(2), "probe_tip_ux": np.zeros(2)}, case) is None

@@ -102,6 +102,7 @@ struct OutputSettings {
   std::optional<std::int64_t> every_steps;
   std::int64_t history_every = 1;
   std::vector<std::string> reactions;      // node sets whose reaction force goes to history.csv
+  std::vector<std::string> probes;         // node sets whose mean displacement and velocity go to history.csv
   // A checkpoint (io/checkpoint.hpp) after the first step at or past every k·restart_every_time of
   // simulated time and/or every restart_every_steps steps; neither: only on SIGINT/SIGTERM.
   std::optional<double> restart_every_time;  // s

@@ -574,9 +574,10 @@ Case parse_case(const std::string& text, const std::filesystem::path& path) {
   read_section("output");
   if (c.output.every_time.has_value() == c.output.every_steps.has_value())
     ck.fail("output", "exactly one of every_time and every_steps must be set (not null)");
-  for (const auto& name : c.output.reactions)
-    if (std::find(c.node_sets.begin(), c.node_sets.end(), name) == c.node_sets.end())
-      ck.fail("output.reactions", "'" + name + "' is not in node_sets");
+  for (const auto& [key, names] : {std::pair{"output.reactions", &c.output.reactions}, std::pair{"output.probes", &c.output.probes}})
+    for (const auto& name : *names)
+      if (std::find(c.node_sets.begin(), c.node_sets.end(), name) == c.node_sets.end())
+        ck.fail(key, "'" + name + "' is not in node_sets");
   return c;
 }
 

@@ -83,6 +83,7 @@ std::vector<SettingsSection> settings_sections(Case& c) {
         integer("every_steps", o.every_steps, 1),
         integer("history_every", o.history_every, 1),
         names("reactions", o.reactions).with_note("each one of node_sets"),
+        names("probes", o.probes).with_note("each one of node_sets"),
         positive("restart_every_time", o.restart_every_time).in_unit("s"),
         integer("restart_every_steps", o.restart_every_steps, 1),
         non_negative("restart_every_wall", o.restart_every_wall).in_unit("s").with_note("wall time; 0: none"),

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/bonds.hpp"
@@ -97,6 +98,11 @@ class Decomposed {
   // order, lines.broken all 1 (empty elsewhere). What a gathered frame's line cells need, without
   // the whole bond list (issue 15). Collective.
   virtual void gather_broken_lines(const BondList& local, BondList& lines) const = 0;
+  // Every rank's (key, value) entries on rank 0, sorted by key (empty elsewhere); a key comes from
+  // one rank only. A few values from each rank that rank 0 adds in the serial run's order (the
+  // reaction of a support: core/reactions.hpp), without gathering the whole model. Collective.
+  virtual std::vector<std::pair<std::int64_t, double>> gather_keyed(const std::vector<std::int64_t>& keys,
+                                                                    const std::vector<double>& values) const = 0;
   // Every rank's value, rank after rank, on rank 0 (empty elsewhere): run.log's per-rank lines. Collective.
   virtual std::vector<double> per_rank(double value) const = 0;
   // Rank 0's bytes on every rank (MPI_Bcast): what rank 0 alone read (a checkpoint file, or the

@@ -63,6 +63,10 @@ class MpiDecomposed : public Decomposed {
                                          const BondList& global) const override {
     return sum_->gather_bond_values(local, per_bond, width, global);
   }
+  std::vector<std::pair<std::int64_t, double>> gather_keyed(const std::vector<std::int64_t>& keys,
+                                                            const std::vector<double>& values) const override {
+    return sum_->gather_keyed(keys, values);
+  }
   std::string broadcast(const std::string& bytes_on_rank_0) const override;
   std::vector<double> per_rank(double value) const override;
   void gather_broken_lines(const BondList& local, BondList& lines) const override;

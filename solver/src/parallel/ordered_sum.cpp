@@ -1,6 +1,7 @@
 // Gathers of per-node values to rank 0 in global node order (parallel/ordered_sum.hpp).
 #include "parallel/ordered_sum.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <string>
 
@@ -186,6 +187,28 @@ void OrderedSum::gather_lines(const BondList& local, const std::vector<std::int3
     const auto g = static_cast<std::size_t>(g32);
     for (std::int64_t k = lines.offsets[g]; k < lines.offsets[g + 1]; ++k) lines.neighbour[static_cast<std::size_t>(k)] = all[at++];
   }
+}
+
+std::vector<std::pair<std::int64_t, double>> OrderedSum::gather_keyed(const std::vector<std::int64_t>& keys,
+                                                                      const std::vector<double>& values) const {
+  const double start = MPI_Wtime();
+  const int mine = static_cast<int>(keys.size());
+  std::vector<int> counts(rank_ == 0 ? static_cast<std::size_t>(ranks_) : 0), starts;
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+  std::int64_t total = 0;
+  if (rank_ == 0)
+    for (int count : counts) starts.push_back(static_cast<int>(total)), total += count;
+  std::vector<std::int64_t> all_keys(static_cast<std::size_t>(total));
+  std::vector<double> all_values(static_cast<std::size_t>(total));
+  MPI_Gatherv(keys.data(), mine, MPI_INT64_T, all_keys.data(), counts.data(), starts.data(), MPI_INT64_T, 0, comm_);
+  MPI_Gatherv(values.data(), mine, MPI_DOUBLE, all_values.data(), counts.data(), starts.data(), MPI_DOUBLE, 0, comm_);
+  std::vector<std::pair<std::int64_t, double>> out(static_cast<std::size_t>(total));
+  for (std::size_t k = 0; k < out.size(); ++k) out[k] = {all_keys[k], all_values[k]};
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  ++calls_;
+  bytes_ += static_cast<std::int64_t>(16 * keys.size());
+  seconds_ += MPI_Wtime() - start;
+  return out;
 }
 
 }  // namespace pd

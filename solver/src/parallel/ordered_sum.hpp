@@ -7,6 +7,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "parallel/local_model.hpp"
@@ -33,6 +34,10 @@ class OrderedSum {
   // The broken bonds j > i of the owned rows of `local` (global: the piece's global numbers), as
   // rows of the whole model on rank 0 (Decomposed::gather_broken_lines). Collective.
   void gather_lines(const BondList& local, const std::vector<std::int32_t>& global, BondList& lines) const;
+  // Every rank's (key, value) entries on rank 0 sorted by key, keys unique (Decomposed::gather_keyed).
+  // Two MPI_Gatherv after one MPI_Gather of the counts. Collective.
+  std::vector<std::pair<std::int64_t, double>> gather_keyed(const std::vector<std::int64_t>& keys,
+                                                            const std::vector<double>& values) const;
   // Gathers so far, the bytes this rank sent in them, and their wall time.
   std::int64_t calls() const { return calls_; }
   std::int64_t bytes_sent() const { return bytes_; }

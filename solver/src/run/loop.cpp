@@ -79,7 +79,7 @@ class TimeLoop {
   void finish();
 
   const State& output_state();
-  void history_row(double dt_taken, const State* whole);
+  void history_row(double dt_taken);
   void frame_in_pieces();
   void frame_from_rows(const State& st);
   void frame(double dt_taken);
@@ -189,7 +189,7 @@ std::optional<Failure> TimeLoop::advance() {
   warn_indenter_depth();
   timed([&] {
     if (schedule.frame_due(loop, h)) frame(h);
-    else if (schedule.history_due(loop)) history_row(h, nullptr);
+    else if (schedule.history_due(loop)) history_row(h);
   });
   return std::nullopt;
 }
@@ -361,11 +361,10 @@ const State& TimeLoop::output_state() {
   return gathered;
 }
 
-// whole: the state output reads, when the caller has it already (output_state is collective).
-void TimeLoop::history_row(double dt_taken, const State* whole) {
+// Collective: every rank fills the columns from its own state (run/history_columns.hpp), rank 0
+// writes the row.
+void TimeLoop::history_row(double dt_taken) {
   energies.at(loop.step);
-  const State& st = whole ? *whole : output_state();
-  if (!out) return;
   HistoryRow r;
   r.step = loop.step;
   r.time = loop.t;
@@ -378,8 +377,8 @@ void TimeLoop::history_row(double dt_taken, const State* whole) {
   r.damping_work = state.damping_work;
   r.broken_bonds = loop.broken;
   r.wall_time = wall_before + seconds_since(loop_start);
-  columns.fill(r, HistoryInputs{st, loop.t, loop.broken_energy});
-  out->history(r);
+  columns.fill(r, HistoryInputs{state, loop.t, loop.broken_energy});
+  if (out) out->history(r);
 }
 
 // output.parallel_frames: pieces. Every rank writes its piece (its nodes and ghosts, io/output.hpp
@@ -412,12 +411,11 @@ void TimeLoop::frame_from_rows(const State& st) {
 
 // A frame and the history row of its step. Collective.
 void TimeLoop::frame(double dt_taken) {
-  const State& st = output_state();  // the history row's columns read the whole state
   if (p.frames_in_pieces()) frame_in_pieces();
-  else if (!p.whole_bonds) frame_from_rows(st);
-  else if (out) out->frame(model, st, loop.t, loop.step);
+  else if (!p.whole_bonds) frame_from_rows(output_state());
+  else if (const State& st = output_state(); out) out->frame(model, st, loop.t, loop.step);
   frames_here.emplace_back(loop.step, loop.t);
-  history_row(dt_taken, &st);
+  history_row(dt_taken);
   schedule.frame_written(loop);
 }
 

@@ -236,6 +236,10 @@ class WatchedDecomposed : public pd::Decomposed {
     return d_.gather_bond_values(l, v, w, g);
   }
   void gather_broken_lines(const pd::BondList& l, pd::BondList& g) const override { d_.gather_broken_lines(l, g); }
+  std::vector<std::pair<std::int64_t, double>> gather_keyed(const std::vector<std::int64_t>& k,
+                                                            const std::vector<double>& v) const override {
+    return d_.gather_keyed(k, v);
+  }
   std::vector<double> per_rank(double v) const override { return d_.per_rank(v); }
   std::string broadcast(const std::string& b) const override { return d_.broadcast(b); }
   void exchange_in_boxes(const double lo[3], const double hi[3], const std::vector<std::int32_t>& g, const pd::Vec3Array& x,
