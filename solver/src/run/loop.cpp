@@ -7,10 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 
 #include "forces/indenter.hpp"
+#include "io/checkpoint.hpp"
 #include "parallel/gather_state.hpp"
+#include "run/state_checkpoint.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
 #include "run/progress.hpp"
@@ -79,7 +82,8 @@ class TimeLoop {
   void finish();
 
   const State& output_state();
-  void history_row(double dt_taken, const State* whole);
+  const State& history_state();
+  void history_row(double dt_taken);
   void frame_in_pieces();
   void frame_from_rows(const State& st);
   void frame(double dt_taken);
@@ -113,7 +117,7 @@ class TimeLoop {
   IndenterDepthWatch indenter_depth;
   Progress progress;
   LoopEnd end;
-  State gathered;  // a decomposed run's state on rank 0, for output (output_state)
+  State gathered;  // a decomposed run's state on rank 0: for gathered frames, failures and reactions
   std::vector<std::pair<std::int64_t, double>> frames_here;  // (step, t) of the frames this process wrote
   const std::string while_growing = "while the energy grew ×" + format("%g", BlowUpWatch::kGrowthPerStep) + " a step";
   const std::string while_unbalanced = "while the energy held was more than " + format("%g", EnergyBalanceWatch::kSuspect) +
@@ -189,7 +193,7 @@ std::optional<Failure> TimeLoop::advance() {
   warn_indenter_depth();
   timed([&] {
     if (schedule.frame_due(loop, h)) frame(h);
-    else if (schedule.history_due(loop)) history_row(h, nullptr);
+    else if (schedule.history_due(loop)) history_row(h);
   });
   return std::nullopt;
 }
@@ -347,8 +351,9 @@ void TimeLoop::finish() {
   }
 }
 
-// What output reads: the run's state, or on a decomposed run every rank's owned part gathered on
-// rank 0 in the whole model's numbering, with the broken flags (frames' damage). Collective.
+// What a gathered frame and a failure's message read: the run's state, or on a decomposed run
+// every rank's owned part gathered on rank 0 in the whole model's numbering, with the broken flags
+// (frames' damage). Frames in pieces and checkpoints need no gather. Collective.
 const State& TimeLoop::output_state() {
   if (!dec) return state;
   gathered.u = dec->gather(state.u);
@@ -361,10 +366,18 @@ const State& TimeLoop::output_state() {
   return gathered;
 }
 
-// whole: the state output reads, when the caller has it already (output_state is collective).
-void TimeLoop::history_row(double dt_taken, const State* whole) {
+// What history.csv's columns read (run/history_columns.cpp): the run's totals and, for
+// output.reactions, the force density of the whole model on rank 0, gathered only then. Collective.
+const State& TimeLoop::history_state() {
+  if (!dec) return state;
+  gathered.copy_totals(state);
+  if (!p.c.output.reactions.empty()) gathered.f = dec->gather(state.f);
+  return gathered;
+}
+
+void TimeLoop::history_row(double dt_taken) {
   energies.at(loop.step);
-  const State& st = whole ? *whole : output_state();
+  const State& st = history_state();
   if (!out) return;
   HistoryRow r;
   r.step = loop.step;
@@ -412,12 +425,15 @@ void TimeLoop::frame_from_rows(const State& st) {
 
 // A frame and the history row of its step. Collective.
 void TimeLoop::frame(double dt_taken) {
-  const State& st = output_state();  // the history row's columns read the whole state
-  if (p.frames_in_pieces()) frame_in_pieces();
-  else if (!p.whole_bonds) frame_from_rows(st);
-  else if (out) out->frame(model, st, loop.t, loop.step);
+  if (p.frames_in_pieces()) {
+    frame_in_pieces();  // no gather: each rank writes its own nodes
+  } else {
+    const State& st = output_state();
+    if (!p.whole_bonds) frame_from_rows(st);
+    else if (out) out->frame(model, st, loop.t, loop.step);
+  }
   frames_here.emplace_back(loop.step, loop.t);
-  history_row(dt_taken, &st);
+  history_row(dt_taken);
   schedule.frame_written(loop);
 }
 
@@ -430,32 +446,49 @@ void TimeLoop::timed(Write write) {
   end.output_seconds += seconds_since(output_start);
 }
 
-// Written atomically (io/checkpoint.hpp), after the history rows so far are on disk. On a
-// decomposed run every rank's owned state and rows are gathered on rank 0 in global node order
-// (the path frames take) at the same step, and rank 0 alone writes the one file, in the format of
-// a serial run: whole, of one step, and readable on any rank count. Collective.
+// Written in pieces (io/checkpoint.hpp), after the history rows so far are on disk: every rank
+// its owned nodes and rows, no gather; then rank 0 the index naming them, once every piece is on
+// disk (the per_rank below returns only when every rank has written), so a crash in between leaves
+// the previous index and its pieces as they were. Collective.
 void TimeLoop::write_restart() {
-  const State& whole = output_state();
-  // The law's declared history (core/state_arrays.hpp) in the whole model's order, as the serial run holds it.
-  if (dec) gather_state(*dec, p.model, [](const StateDeclaration& d) { return d.checkpoint; });
-  // The contact list's displacement at its last build, from the pieces (forces/contact_on_piece).
-  const NeighbourList& contact_list = p.op->model().contact_list;
-  const Vec3Array contact_u_build =
-      dec && model.contact.pairs && contact_list.rebuilds() > 0 ? dec->gather(contact_list.u_build()) : Vec3Array{};
-  // Collective too: an integrator's per-node state is gathered on rank 0 (integrators/implicit.cpp).
+  const Model& local = p.op->model();  // the piece's on a decomposed run
+  const NeighbourList& contact_list = local.contact_list;
+  const bool contact = model.contact.pairs && contact_list.rebuilds() > 0;
   std::vector<char> integrator_state = p.integrator->save_state();
-  // Ranks holding only their rows: the broken flags in the whole list's order, on rank 0 for the
-  // write only (1 byte per directed bond, freed after it).
-  if (!p.whole_bonds) {
-    if (out) p.model.bonds.broken.assign(static_cast<std::size_t>(p.directed_bonds()), 0);
-    dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
+  if (out) out->flush_history();
+  const int rank = dec ? dec->rank() : 0;
+  CheckpointPieceRef mine;
+  std::string failure;
+  try {
+    mine = write_checkpoint_piece(checkpoint_file, checkpoint_piece_file(loop.step, rank),
+                                  checkpoint_piece_of(local, dec ? &dec->piece() : nullptr, state,
+                                                      integrator.checkpointed_node_arrays(),
+                                                      contact ? &contact_list.u_build() : nullptr));
+  } catch (const Error& e) {
+    if (!dec) throw;
+    failure = e.what();
+  }
+  std::vector<CheckpointPieceRef> pieces{mine};
+  if (dec) {
+    // Every rank's reference on rank 0 (the numbers as bits: per_rank moves doubles unchanged).
+    if (dec->minimum(failure.empty() ? 1.0 : 0.0) == 0.0) {
+      if (!failure.empty()) throw Error(failure);
+      throw Error(checkpoint_file.string() + ": another rank could not write its piece of the checkpoint (its error is on its stderr)");
+    }
+    auto bits = [](std::uint64_t v) { double d; std::memcpy(&d, &v, sizeof d); return d; };
+    auto back = [](double d) { std::uint64_t v; std::memcpy(&v, &d, sizeof v); return v; };
+    const std::vector<double> nodes = dec->per_rank(bits(mine.nodes)), bonds = dec->per_rank(bits(mine.bonds)),
+                              bytes = dec->per_rank(bits(mine.bytes)), sums = dec->per_rank(bits(mine.checksum));
+    pieces.clear();
+    for (std::size_t r = 0; r < nodes.size(); ++r)
+      pieces.push_back({checkpoint_piece_file(loop.step, static_cast<int>(r)), back(nodes[r]),
+                        back(bonds[r]), back(bytes[r]), back(sums[r])});
   }
   if (!out) return;
-  out->flush_history();
   LoopState saved = loop;
   saved.wall_time = wall_before + seconds_since(loop_start);
-  write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, std::move(integrator_state), contact_u_build));
-  if (!p.whole_bonds) std::vector<std::uint8_t>().swap(p.model.bonds.broken);
+  write_checkpoint_index(checkpoint_file,
+                         checkpoint_of(p, s, state, saved, *out, std::move(integrator_state), contact, std::move(pieces)));
 }
 
 // write_restart timed for the wall-time schedule (only rank 0's clock decides it, stop_or_checkpoint).
