@@ -42,10 +42,13 @@ def with_checkpoints(end, every):
     return change
 
 
-def restart(folder, ranks, timeout=900):
+def restart(folder, ranks, timeout=900, frames="gathered"):
+    """frames: as test_mpi_ranks.solve's."""
     command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1", "--restart", str(folder / "checkpoint.bin")]
     if ranks:
         command = [MPIEXEC, "--oversubscribe", "-np", str(ranks)] + command
+        if frames:
+            command += ["--parallel-frames", frames]
     return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=MPI_ENV)
 
 
@@ -66,7 +69,8 @@ def restarted_at_step(folder):
 
 
 def start_two_ranks(folder):
-    command = [MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1"]
+    command = [MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1",
+               "--parallel-frames", "gathered"]
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=MPI_ENV)
 
 
@@ -197,7 +201,8 @@ def test_a_checkpoint_rank_0_cannot_write_ends_every_rank_with_the_error(prepare
     (folder / "checkpoint.bin.part").mkdir()  # the checkpoint's temporary name: open() fails
     started = time.monotonic()
     result = subprocess.run([MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet",
-                             "--threads", "1"], capture_output=True, text=True, timeout=300, env=MPI_ENV)
+                             "--threads", "1", "--parallel-frames", "gathered"], capture_output=True, text=True, timeout=300,
+                            env=MPI_ENV)
     assert result.returncode == 3, result.stderr
     assert time.monotonic() - started < 300
     message = "checkpoint.bin.part: cannot open for writing: Is a directory"

@@ -28,7 +28,8 @@ PVPYTHON = shutil.which("pvpython")
 
 
 def in_pieces(case):
-    case["output"]["parallel_frames"] = "pieces"
+    """No output.parallel_frames at all: pdsolve's default on several ranks is pieces."""
+    case["output"].pop("parallel_frames", None)
 
 
 def listed(folder):
@@ -65,7 +66,7 @@ def runs(prepared):
     assert solve(folders["serial"], None).returncode == 0
     for ranks in (2, 3):
         folders[ranks] = copy_case(prepared, f"pieces_np{ranks}", in_pieces)
-        result = solve(folders[ranks], ranks)
+        result = solve(folders[ranks], ranks, frames=None)  # the default on several ranks: pieces
         assert result.returncode == 0, result.stderr
     return folders
 
@@ -145,11 +146,11 @@ def test_a_checkpoint_in_pieces_continues_on_3_ranks(prepared, runs):
         in_pieces(case)
         with_checkpoints(3.0e-4, 1.2e-4)(case)
     written = copy_case(prepared, "pieces_ckpt_np2", change)
-    result = solve(written, 2)
+    result = solve(written, 2, frames=None)
     assert result.returncode == 0, result.stderr
     folder = prepared[0] / "pieces_ckpt_np2_to_np3"
     shutil.copytree(written, folder)
-    result = restart(folder, 3)
+    result = restart(folder, 3, frames=None)
     assert result.returncode == 0, result.stderr
     assert restarted_at_step(folder) > 200
     assert history_without_wall_time(folder) == history_without_wall_time(written)  # the uninterrupted run's

@@ -67,19 +67,21 @@ def copy_case(prepared, name, change=None):
     target.mkdir()
     shutil.copy(out / "nodes.vtu", target / "nodes.vtu")
     case = json.loads((out / "case.json").read_text())
-    # These runs compare frames byte for byte with the serial run's: gathered on rank 0, not the
-    # pieces pdsolve writes on several ranks by default (test_mpi_frame_pieces.py's change asks for those).
-    case["output"]["parallel_frames"] = "gathered"
     if change:
         change(case)
     (target / "case.json").write_text(json.dumps(case))
     return target
 
 
-def solve(folder, ranks, threads=1):
+def solve(folder, ranks, threads=1, frames="gathered"):
+    """frames: pdsolve --parallel-frames on several ranks. These tests compare frames byte for byte
+    with the serial run's, so gathered on rank 0 unless a test asks for the pieces (None: the case's
+    choice, pieces by default)."""
     command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", str(threads)]
     if ranks:
         command = [MPIEXEC, "--oversubscribe", "-np", str(ranks)] + command
+        if frames:
+            command += ["--parallel-frames", frames]
     return subprocess.run(command, capture_output=True, text=True, timeout=900, env=MPI_ENV)
 
 
