@@ -18,10 +18,10 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from e2e_support import PY, ROOT
+from e2e_support import PY, ROOT, SOLVER
 from postprocess import read_frame
 # prepared: the coarse plate, meshed and preprocessed once per module; pytestmark: skip without MPI.
-from test_mpi_checkpoint import restart, restarted_at_step, with_checkpoints
+from test_mpi_checkpoint import assert_same_run, restart, restarted_at_step, with_checkpoints
 from test_mpi_ranks import copy_case, history_without_wall_time, prepared, pytestmark, solve  # noqa: F401, F811
 
 PVPYTHON = shutil.which("pvpython")
@@ -148,16 +148,41 @@ def test_a_checkpoint_in_pieces_continues_on_3_ranks(prepared, runs):
     written = copy_case(prepared, "pieces_ckpt_np2", change)
     result = solve(written, 2, frames=None)
     assert result.returncode == 0, result.stderr
-    folder = prepared[0] / "pieces_ckpt_np2_to_np3"
+    # On 3 ranks, and on 1 (no mpirun; --parallel-frames gathered asked for in vain): the series goes on
+    # in pieces, as the checkpoint records, with the uninterrupted run's values.
+    for ranks, extra in ((3, None), (None, "gathered")):
+        folder = prepared[0] / f"pieces_ckpt_np2_to_{ranks}"
+        shutil.copytree(written, folder)
+        result = restart(folder, ranks, frames=None) if ranks else restart_serially(folder, extra)
+        assert result.returncode == 0, result.stderr
+        assert restarted_at_step(folder) > 200
+        assert history_without_wall_time(folder) == history_without_wall_time(written)  # the uninterrupted run's
+        assert listed(folder) == listed(runs[3])
+        for _, pfile in listed(folder):
+            ids, data, _ = assembled(folder / pfile)
+            ids3, data3, _ = assembled(runs[3] / pfile)
+            assert ids.tolist() == ids3.tolist()
+            for name in data:
+                assert np.array_equal(data[name], data3[name]), (pfile, name)
+
+
+def restart_serially(folder, frames):
+    command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1", "--restart", str(folder / "checkpoint.bin"),
+               "--parallel-frames", frames]
+    return subprocess.run(command, capture_output=True, text=True, timeout=900)
+
+
+def test_a_serial_checkpoint_continues_its_plain_series_on_2_ranks(prepared, runs):
+    """A series of plain .vtu frames (a run on one rank) goes on as plain .vtu frames when it is
+    continued on several ranks, whose default is pieces: the restart keeps the series' format."""
+    def change(case):
+        in_pieces(case)
+        with_checkpoints(3.0e-4, 1.2e-4)(case)
+    written = copy_case(prepared, "serial_ckpt", change)
+    assert solve(written, None).returncode == 0
+    folder = prepared[0] / "serial_ckpt_to_np2"
     shutil.copytree(written, folder)
-    result = restart(folder, 3, frames=None)
+    result = restart(folder, 2, frames=None)
     assert result.returncode == 0, result.stderr
     assert restarted_at_step(folder) > 200
-    assert history_without_wall_time(folder) == history_without_wall_time(written)  # the uninterrupted run's
-    assert listed(folder) == listed(runs[3])
-    for _, pfile in listed(folder):
-        ids, data, _ = assembled(folder / pfile)
-        ids3, data3, _ = assembled(runs[3] / pfile)
-        assert ids.tolist() == ids3.tolist()
-        for name in data:
-            assert np.array_equal(data[name], data3[name]), (pfile, name)
+    assert_same_run(written, folder)

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <string_view>
 #include <iterator>
 #include <type_traits>
 
@@ -22,8 +23,8 @@ constexpr char kMagic[8] = {'P', 'D', 'C', 'K', 'P', 'T', '\r', '\n'};
 constexpr std::uint32_t kByteOrderMark = 0x01020304;
 constexpr const char* kPiecesFolder = "checkpoint.pieces";
 
-std::uint64_t fnv1a(const char* data, std::size_t size) {
-  std::uint64_t h = 14695981039346656037ull;
+// `h`: the hash of the bytes before these (FNV-1a runs over its input in order).
+std::uint64_t fnv1a(const char* data, std::size_t size, std::uint64_t h = 14695981039346656037ull) {
   for (std::size_t k = 0; k < size; ++k) {
     h ^= static_cast<unsigned char>(data[k]);
     h *= 1099511628211ull;
@@ -169,7 +170,10 @@ void fields(IO& io, Checkpoint& c) {
   io.scalar(c.contact_rebuilds), io.scalar(c.contact_seconds);
   io.array(c.frame_times), io.scalar(c.history_bytes);
   text(io, c.linear_solver);  // version 4 (issue 36)
-  pieces(io, c.pieces);       // version 6
+  auto in_pieces = static_cast<std::uint8_t>(c.frames_in_pieces);
+  io.scalar(in_pieces);  // version 6
+  c.frames_in_pieces = in_pieces != 0;
+  pieces(io, c.pieces);  // version 6
 }
 
 // Header + payload + checksum, as both files are framed.
@@ -251,24 +255,37 @@ std::string checkpoint_piece_file(std::int64_t step, int rank) {
 
 CheckpointPieceRef write_checkpoint_piece(const std::filesystem::path& index, const std::string& file,
                                           const CheckpointPieceOut& piece) {
-  Writer payload;
-  payload.scalar(kPieceTag);
-  payload.array(piece.nodes);
+  // Written from the sections as they are, without copying them into one string (a piece is its
+  // rank's state: the copy would double the rank's peak at a checkpoint).
+  Writer payload_head;
+  payload_head.scalar(kPieceTag);
+  payload_head.array(piece.nodes);
   std::uint64_t bonds = 0;
   for (std::size_t k = 1; k < piece.nodes.size(); k += 2) bonds += static_cast<std::uint64_t>(piece.nodes[k]);
-  std::string bytes = payload.bytes();
+  std::vector<std::string> counts;  // each section's byte count, before it
   for (const std::string& section : piece.sections) {
     Writer count;
-    count.scalar(static_cast<std::uint64_t>(section.size()));  // in bytes here; the reader checks entries
-    bytes += count.bytes();
-    bytes += section;
+    count.scalar(static_cast<std::uint64_t>(section.size()));
+    counts.push_back(count.bytes());
   }
+  std::vector<std::string_view> parts{std::string_view(), payload_head.bytes()};
+  for (std::size_t k = 0; k < counts.size(); ++k) parts.push_back(counts[k]), parts.push_back(piece.sections[k]);
+  std::uint64_t size = 0, sum = 14695981039346656037ull;
+  for (std::size_t k = 1; k < parts.size(); ++k) {
+    size += parts[k].size();
+    sum = fnv1a(parts[k].data(), parts[k].size(), sum);
+  }
+  Writer head, tail;
+  head.scalar(kCheckpointVersion), head.scalar(kByteOrderMark), head.scalar(size);
+  const std::string header = std::string(kMagic, sizeof kMagic) + head.bytes();
+  tail.scalar(sum);
+  parts[0] = header;
+  parts.push_back(tail.bytes());
   std::error_code ec;
   std::filesystem::create_directories(checkpoint_pieces_dir(index), ec);
   if (ec) throw Error(checkpoint_pieces_dir(index).string() + ": cannot create the directory: " + ec.message());
-  const std::string text = framed(bytes);
-  write_file_atomically(index.parent_path() / file, text, Durability::synced);
-  return {file, piece.nodes.size() / 2, bonds, text.size(), fnv1a(bytes.data(), bytes.size())};
+  write_file_atomically(index.parent_path() / file, parts, Durability::synced);
+  return {file, piece.nodes.size() / 2, bonds, kHead + size + 8, sum};
 }
 
 void write_checkpoint_index(const std::filesystem::path& path, const Checkpoint& index) {

@@ -10,7 +10,8 @@
 // the payload. A payload is a fixed sequence of scalars and arrays (an array: uint64 count, then
 // the raw elements). The index's: the fields of Checkpoint below but the arrays (`sections` names
 // them), then the pieces. A piece's: a uint32 tag "PIEC", its owned nodes as int32 pairs (global
-// number, row length; ascending), then one array per section in the index's order.
+// number, row length; ascending), then per section in the index's order a uint64 byte count and
+// the values.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -88,6 +89,8 @@ struct Checkpoint {
   // Integrator::linear_solver() ("direct", "cg block_jacobi", "cg amg"; "" for a scheme without
   // one): auto's choice depends on the rank count, and a restart keeps it where it can (run/start.cpp).
   std::string linear_solver;
+  // The frames written so far are in pieces (a .pvtu each): a restart goes on so (run/start.cpp).
+  bool frames_in_pieces = false;
 
   // The index's list of the pieces' arrays and the pieces themselves.
   std::vector<CheckpointSection> sections;

@@ -398,18 +398,25 @@ void TimeLoop::history_row(double dt_taken) {
 // output.parallel_frames: pieces. Every rank writes its piece (its nodes and ghosts, io/output.hpp
 // frame_grid), then rank 0 the .pvtu naming them. Collective. The frame number is rank 0's (the
 // broadcast also keeps the other ranks from writing before rank 0's OutputWriter has cleared the
-// frames of an earlier run).
+// frames of an earlier run). On one rank (a restart continuing a series in pieces) one piece of
+// every node.
 void TimeLoop::frame_in_pieces() {
   std::vector<double> k{out ? static_cast<double>(out->frames_written()) : 0.0};
-  dec->broadcast(k);
+  if (dec) dec->broadcast(k);
   FrameFormat format = frame_format_of(p.c.output);
-  const LocalPiece& piece = dec->piece();
-  const FramePiece nodes{piece.owned, piece.global};
-  const VtuGrid grid = frame_grid(piece.model, state, loop.t, loop.step, format, &nodes);
-  write_vtu(p.c.output_dir / frame_piece_file(static_cast<std::size_t>(k[0]), dec->rank()), grid,
+  std::vector<std::uint8_t> all;
+  std::vector<std::int32_t> identity;
+  if (!dec) {
+    all.assign(model.nodes.size(), 1);
+    identity.resize(model.nodes.size());
+    for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<std::int32_t>(i);
+  }
+  const FramePiece nodes = dec ? FramePiece{dec->piece().owned, dec->piece().global} : FramePiece{all, identity};
+  const VtuGrid grid = frame_grid(dec ? dec->piece().model : model, state, loop.t, loop.step, format, &nodes);
+  write_vtu(p.c.output_dir / frame_piece_file(static_cast<std::size_t>(k[0]), dec ? dec->rank() : 0), grid,
             format.zlib ? VtuCompression::zlib : VtuCompression::none);
-  dec->total(0);  // every piece is on disk before the .pvtu names it
-  if (out) out->frame_of_pieces(grid, dec->ranks(), loop.t);
+  if (dec) dec->total(0);  // every piece is on disk before the .pvtu names it
+  if (out) out->frame_of_pieces(grid, dec ? dec->ranks() : 1, loop.t);
 }
 
 // A gathered frame of a run whose ranks hold only their rows: the damage per node and the broken

@@ -96,6 +96,9 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
                 std::to_string(n) + ", " + std::to_string(directed / 2) + ", " + integrator.name() + ")");
   if (checkpoint.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
   keep_linear_solver(opt, integrator, checkpoint.linear_solver, s);
+  // The series goes on in the format it was written in, whatever the rank count and output.parallel_frames.
+  p.resumes_pieces = checkpoint.frames_in_pieces;
+  p.c.output.parallel_frames = checkpoint.frames_in_pieces ? "pieces" : "gathered";
   // initialize() sizes the integrator's scratch; then everything it set is replaced by the
   // checkpoint, so the run continues bitwise as if it had never stopped.
   s.state = State(local.nodes.size());
@@ -198,6 +201,7 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& totals,
   k.directed_bonds = static_cast<std::size_t>(p.directed_bonds());
   k.integrator = p.integrator->name();
   k.linear_solver = p.integrator->linear_solver();
+  k.frames_in_pieces = p.frames_in_pieces();
   k.loop = loop;
   k.integrator_state = std::move(integrator_state);
   k.state.copy_totals(totals);
