@@ -6,7 +6,7 @@ the solver) and then every solver build runs exactly the same input files:
 
     /usr/bin/python3 bench/result_hashes.py prepare --repo /work/baseline --runs /work/hashruns
     /usr/bin/python3 bench/result_hashes.py run --solver build/solver/pdsolve --runs /work/hashruns \\
-        --out /work/hashruns/new.json [--threads 2] [--only NAME ...] [--keep DIR]
+        --out /work/hashruns/new.json [--threads 2] [--ranks N [--frames gathered]] [--only NAME ...] [--keep DIR]
     /usr/bin/python3 bench/result_hashes.py compare /work/hashruns/baseline.json /work/hashruns/new.json
 
 prepare: the runs are
@@ -32,13 +32,18 @@ prepare: the runs are
 
 run: for each prepared run (in manifest order; --only / --skip to choose; --ranks N under mpiexec), empty
   <runs>/<run>/output/, run `SOLVER <run>/case.json --threads N --quiet` with OMP_WAIT_POLICY=passive
+  (--frames gathered|pieces adds `--parallel-frames gathered|pieces`: on several ranks pdsolve writes its
+  frames in pieces by default, and `--frames gathered` makes them the serial run's files, byte for
+  byte comparable with a serial baseline. An option of pdsolve rather than an edited copy of
+  case.json: the input files, their hashes and the paths relative to case.json stay as prepared)
   unless the environment sets it (much faster on a shared, loaded machine; no effect on results),
   stdout and stderr going to <runs>/<run>/solver.txt (not hashed), then record the SHA-256 of
   - "history.csv": the file with its wall_time column removed (found by name in the header; every
     other byte of every line, line ends included, exactly as written: no number is re-parsed);
   - "frames.pvd" and every "frames/frame_NNNNNN.vtu", byte for byte;
   - any other file the solver leaves in output/, byte for byte (today there is none; a new one
-    shows up as a difference), except run.log (timings, paths), checkpoint.bin (written
+    shows up as a difference), except run.log (timings, paths), checkpoint.bin and the pieces in
+    checkpoint.pieces/ (written
     on a signal, with output.restart_every_*, and every 600 s of wall time; it holds the wall time)
     and .lock (the folder's lock: the solver's pid and start time);
   - "input/case.json" and "input/nodes.vtu" (<run>/case.json and nodes.vtu), so that hashes of
@@ -68,6 +73,7 @@ import tempfile
 import time
 
 EXCLUDED = {"run.log", "checkpoint.bin", ".lock"}  # output files not hashed (see the module docstring)
+CHECKPOINT_PIECES = "checkpoint.pieces/"  # a checkpoint's pieces (pipeline/formats.md §5), not hashed either
 HISTORY = "history.csv"
 DROPPED_COLUMN = b"wall_time"
 
@@ -252,7 +258,7 @@ def hash_run(run_dir: str) -> dict:
         for file in files:
             path = os.path.join(folder, file)
             rel = os.path.relpath(path, output).replace(os.sep, "/")
-            if rel in EXCLUDED:
+            if rel in EXCLUDED or rel.startswith(CHECKPOINT_PIECES):
                 continue
             with open(path, "rb") as stream:
                 data = stream.read()
@@ -300,8 +306,10 @@ def cmd_run(args) -> int:
         os.makedirs(output)
         begin = time.monotonic()
         with open(os.path.join(run_dir, "solver.txt"), "wb") as log:
+            frames = ["--parallel-frames", args.frames] if args.frames else []
             code = subprocess.run([*launcher, solver, os.path.join(run_dir, "case.json"), "--threads",
-                                   str(args.threads), "--quiet"], stdout=log, stderr=subprocess.STDOUT, env=env).returncode
+                                   str(args.threads), "--quiet", *frames], stdout=log, stderr=subprocess.STDOUT,
+                                  env=env).returncode
         seconds[name] = round(time.monotonic() - begin, 3)
         results[name] = dict(hash_run(run_dir), exit=code)
         if args.keep:
@@ -313,7 +321,7 @@ def cmd_run(args) -> int:
         print(f"{name:44s} exit {code:3d}  {files:4d} files  {seconds[name]:8.2f} s", flush=True)
     total = time.monotonic() - start
     results["_about"] = {"solver": solver, "version": version, "threads": args.threads, "ranks": args.ranks,
-                         "OMP_WAIT_POLICY": env["OMP_WAIT_POLICY"], "runs": runs,
+                         "frames": args.frames, "OMP_WAIT_POLICY": env["OMP_WAIT_POLICY"], "runs": runs,
                          "seconds": seconds, "total_seconds": round(total, 1)}
     with open(args.out, "w", encoding="utf-8") as stream:
         json.dump(results, stream, indent=1)
@@ -374,6 +382,9 @@ def main(argv=None) -> int:
     p.add_argument("--out", required=True, help="JSON file of the hashes")
     p.add_argument("--threads", type=int, default=2, help="OpenMP threads of every run (default 2)")
     p.add_argument("--ranks", type=int, default=1, help="MPI ranks of every run, under mpiexec when above 1 (default 1)")
+    p.add_argument("--frames", choices=("gathered", "pieces"),
+                   help="pdsolve --parallel-frames: gathered makes a run on several ranks write the serial "
+                        "run's frames (default: the case's output.parallel_frames, pieces if it has none)")
     p.add_argument("--only", nargs="+", metavar="NAME", help="only these runs")
     p.add_argument("--skip", nargs="+", metavar="NAME", help="all runs but these")
     p.add_argument("--keep", metavar="DIR", help="also copy each run's output/ to DIR/<run>/")

@@ -392,11 +392,13 @@ CASE = {
         fields=Key("names", "point fields a frame carries (postprocess's maps need displacement and damage)",
                    default=["displacement", "velocity", "damage", "block"],
                    choices=("displacement", "velocity", "damage", "block")),
-        parallel_frames=Key("choice", "frames of a run on several MPI ranks: gathered (rank 0 writes the "
-                            "serial run's frame_NNNNNN.vtu) or pieces (each rank writes its nodes to "
-                            "frame_NNNNNN_pR.vtu, rank 0 a frame_NNNNNN.pvtu naming them; ParaView reads "
-                            "them, postprocess does not: pipeline/formats.md §4); one rank: gathered",
-                            default="gathered", choices=("gathered", "pieces")),
+        parallel_frames=Key("choice", "frames of a run on several MPI ranks: pieces (each rank writes its "
+                            "nodes to frame_NNNNNN_pR.vtu, rank 0 a frame_NNNNNN.pvtu naming them, so that "
+                            "no rank holds the whole model; ParaView and postprocess read them: "
+                            "pipeline/formats.md §4) or gathered (rank 0 writes the serial run's "
+                            "frame_NNNNNN.vtu; pdsolve --parallel-frames overrides it); one rank always "
+                            "writes the plain .vtu",
+                            default="pieces", choices=("gathered", "pieces")),
         gmsh=Key("choice", "frames copied into gmsh/results.msh by postprocess: all, only those of the "
                  "figures (figures.times), or none (no gmsh/ files)", default="figures",
                  choices=("all", "figures", "none")),

@@ -39,12 +39,6 @@ def read_series(pvd_path: str) -> list[tuple[float, str]]:
         except ValueError:
             raise PostprocessError(f"{pvd_path}: DataSet {number}: timestep '{time}' is not a number") from None
         path = os.path.normpath(os.path.join(base, file))
-        if file.endswith(".pvtu"):
-            # output.parallel_frames: pieces (formats.md §4): one .vtu per MPI rank, with ghosts.
-            raise PostprocessError(f"{pvd_path}: lists {file}, a frame in pieces (one .vtu per MPI rank, "
-                                   f"output.parallel_frames: pieces), which postprocess does not read; "
-                                   f"open frames.pvd in ParaView, or run the case again with "
-                                   f"output.parallel_frames: gathered (the default)")
         if not os.path.isfile(path):
             raise PostprocessError(f"{pvd_path}: lists {file}, which does not exist ({path}); "
                                    f"rerun the solver (make case=<case>)")
@@ -75,7 +69,12 @@ class Frame:
 
 
 def read_frame(vtu_path: str) -> Frame:
-    """Read one frame with meshio: points, point data, and the VTK_LINE cells of broken bonds."""
+    """Read one frame with meshio: points, point data, and the VTK_LINE cells of broken bonds.
+
+    A frame in pieces (a .pvtu, output.parallel_frames: pieces on several MPI ranks) is read piece
+    by piece and assembled as the gathered frame: owned points in global node order."""
+    if vtu_path.endswith(".pvtu"):
+        return _read_frame_in_pieces(vtu_path)
     # meshio's VTU reader itself: meshio.read() would call sys.exit on a malformed file
     from meshio import vtu  # imported here: the readers of history and series do not need it
 
@@ -124,3 +123,52 @@ def read_frame(vtu_path: str) -> Frame:
     time, step = scalar("TIME"), scalar("step")
     return Frame(path=vtu_path, points=points, point_data=point_data, broken_bonds=broken,
                  time=None if time is None else float(time), step=None if step is None else int(step))
+
+
+def _pieces_of(pvtu_path: str) -> list[str]:
+    """The .vtu files a .pvtu names (Piece Source, relative to its folder)."""
+    try:
+        root = ET.parse(pvtu_path).getroot()
+    except FileNotFoundError:
+        raise PostprocessError(f"{pvtu_path}: no such file; rerun the solver (make case=<case>)") from None
+    except ET.ParseError as error:
+        raise PostprocessError(f"{pvtu_path}: not well-formed XML ({error}); was the solver interrupted?") from None
+    if root.tag != "VTKFile" or root.get("type") != "PUnstructuredGrid":
+        raise PostprocessError(f"{pvtu_path}: not a VTK PUnstructuredGrid (expected <VTKFile type=\"PUnstructuredGrid\">)")
+    base = os.path.dirname(os.path.abspath(pvtu_path))
+    pieces = [os.path.join(base, piece.get("Source", "")) for piece in root.iter("Piece")]
+    if not pieces:
+        raise PostprocessError(f"{pvtu_path}: names no piece; was the solver interrupted?")
+    return pieces
+
+
+def _read_frame_in_pieces(pvtu_path: str) -> Frame:
+    """Every piece's owned points (vtkGhostType 0) placed at their node_id: the gathered frame's
+    points and point data, bit for bit; each broken bond once (from the piece of its owned row)."""
+    parts = []
+    for piece in _pieces_of(pvtu_path):
+        frame = read_frame(piece)
+        for name in ("node_id", "vtkGhostType"):
+            if name not in frame.point_data:
+                raise PostprocessError(f"{piece}: a piece of {pvtu_path} without point data '{name}' "
+                                       f"(pipeline/formats.md §4)")
+        parts.append(frame)
+    ids = [f.point_data["node_id"].astype(np.int64).reshape(-1) for f in parts]
+    owned = [f.point_data["vtkGhostType"].reshape(-1) == 0 for f in parts]
+    n = sum(int(o.sum()) for o in owned)
+    node = np.concatenate([i[o] for i, o in zip(ids, owned)])
+    if not np.array_equal(np.sort(node), np.arange(n)):
+        raise PostprocessError(f"{pvtu_path}: its pieces do not own every node 0..{n - 1} once")
+    order = np.argsort(node, kind="stable")
+    names = [name for name in parts[0].point_data if name not in ("node_id", "vtkGhostType")]
+    point_data = {}
+    for name in names:
+        if any(name not in f.point_data for f in parts):
+            raise PostprocessError(f"{pvtu_path}: point data '{name}' is not in every piece")
+        point_data[name] = np.concatenate([f.point_data[name][o] for f, o in zip(parts, owned)])[order]
+    points = np.concatenate([f.points[o] for f, o in zip(parts, owned)])[order]
+    lines = [i[f.broken_bonds] for f, i in zip(parts, ids) if len(f.broken_bonds)]
+    broken = np.concatenate(lines) if lines else np.zeros((0, 2), dtype=np.int64)
+    first = parts[0]
+    return Frame(path=pvtu_path, points=points, point_data=point_data, broken_bonds=broken,
+                 time=first.time, step=first.step)

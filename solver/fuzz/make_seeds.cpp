@@ -86,6 +86,7 @@ pd::Checkpoint checkpoint(std::size_t nodes, bool rich) {
   if (rich) c.state.indenter_force = {{0.0, -2.5, 0.0}};
   c.broken_flags.assign(c.directed_bonds, 0);
   c.broken_flags[1] = 1;
+  c.row_length.assign(nodes, 2);  // 2·nodes directed bonds
   if (rich) c.contact_rebuilds = 3, c.contact_seconds = 1e-3, c.contact_u_build = pd::make_vec3(nodes, 1e-7);
   c.frame_times = {0.0, 1e-6};
   c.history_bytes = 1234;

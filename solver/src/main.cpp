@@ -27,7 +27,7 @@ namespace {
 
 const char* const kUsage =
     "usage: pdsolve CASE.json [--restart CHECKPOINT] [--threads N] [--end-time T] [--max-steps N] [--quiet]\n"
-    "               [--progress S] [--help] [--version]\n"
+    "               [--progress S] [--parallel-frames gathered|pieces] [--help] [--version]\n"
     "       pdsolve --stable-dt CASE.json [--exact] [--threads N]\n"
     "       pdsolve --physics CASE.json [--exact] [--threads N]\n"
     "       pdsolve --describe\n"
@@ -47,6 +47,10 @@ const char* const kUsage =
     "  --progress S    a progress line (step, t, %, steps/s, ETA) every S seconds of wall time in\n"
     "                  run.log, and on stderr when it is not a terminal (a terminal gets one updating\n"
     "                  line); default 10, 0: none\n"
+    "  --parallel-frames gathered|pieces\n"
+    "                  overrides output.parallel_frames: on several MPI ranks, one gathered .vtu per\n"
+    "                  frame written by rank 0, or one .vtu piece per rank named by a .pvtu (the\n"
+    "                  default); one rank always writes the gathered .vtu\n"
     "  --help          this text\n"
     "  --version       the solver version and how it was built (compiler, flags, OpenMP, sanitizers)\n"
     "  --stable-dt     print, as JSON, the stable step of thesis eq. 2.5 that a run of CASE.json would\n"
@@ -247,6 +251,10 @@ int main(int argc, char** argv) {
       options.end_time = parse_number(arg, value());
     } else if (arg == "--max-steps") {
       options.max_steps = parse_integer(arg, value());
+    } else if (arg == "--parallel-frames") {
+      const std::string how = value();
+      if (how != "gathered" && how != "pieces") usage_error("--parallel-frames takes gathered or pieces, not '" + how + "'");
+      options.parallel_frames = how;
     } else if (arg == "--restart") {
       options.restart = value();
     } else if (arg == "--describe") {

@@ -29,7 +29,12 @@ int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryC
   std::unique_ptr<RunLog> log;
   try {
     // A checkpoint of an earlier run would not match the frames this run writes.
-    if (!s.restarting && out) std::filesystem::remove(checkpoint_path(p.c));
+    // (Its pieces too: the other ranks write theirs only at a checkpoint, after collectives rank 0
+    // enters once this is done.)
+    if (!s.restarting && out) {
+      std::filesystem::remove(checkpoint_path(p.c));
+      std::filesystem::remove_all(checkpoint_pieces_dir(checkpoint_path(p.c)));
+    }
     log = std::make_unique<RunLog>(out ? p.c.output_dir / "run.log" : std::filesystem::path(), opt.quiet,
                                    s.restarting);
     log->title(opt, p);

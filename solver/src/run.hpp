@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <string>
 
 namespace pd {
 
@@ -14,6 +15,9 @@ struct RunOptions {
   std::optional<std::int64_t> max_steps;  // caps time.max_steps
   bool quiet = false;                     // nothing on stdout, no progress on stderr (run.log still has it)
   double progress_interval = 10.0;        // [s] of wall time between progress lines; 0: none (run/progress.hpp's default)
+  // Overrides output.parallel_frames (bench/result_hashes.py compares gathered MPI frames with the
+  // serial run's byte for byte without editing the case file).
+  std::optional<std::string> parallel_frames;
   std::filesystem::path restart;          // a checkpoint.bin to continue from (empty: start at t = 0)
   // Called after every completed step with the step number (tests raise a signal from it).
   std::function<void(std::int64_t step)> after_step;

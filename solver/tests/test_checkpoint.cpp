@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -365,14 +366,36 @@ TEST(Checkpoint, RefusedForAnotherCaseOrWhenDamaged) {
   EXPECT_NE(error_of(dir / "case.json").find("truncated"), std::string::npos) << error_of(dir / "case.json");
   std::ofstream(ck, std::ios::binary) << "not a checkpoint";
   EXPECT_NE(error_of(dir / "case.json").find("not a pdsolve checkpoint"), std::string::npos);
-  // Of version 4, before the declared state and the list of term energies (issue 37): refused,
-  // saying how to start over.
+  // Of version 5, one file holding the whole model (issue 37): refused, saying how to start over.
   std::string old = good;
-  old[8] = 4;  // the uint32 version after the 8-byte magic, little-endian
+  old[8] = 5;  // the uint32 version after the 8-byte magic, little-endian
   std::ofstream(ck, std::ios::binary) << old;
-  EXPECT_NE(error_of(dir / "case.json").find("checkpoint format version 4, this pdsolve reads version 5; to start the "
+  EXPECT_NE(error_of(dir / "case.json").find("checkpoint format version 5, this pdsolve reads version 6; to start the "
                                              "run over instead, delete"),
             std::string::npos) << error_of(dir / "case.json");
+  // Its piece (a serial run writes one): damaged, cut short or missing, it is named; the history
+  // the restart would have cut stays as it was.
+  std::ofstream(ck, std::ios::binary) << good;
+  const pd::Checkpoint index = pd::parse_checkpoint(good, ck.string());
+  ASSERT_EQ(index.pieces.size(), 1u);
+  const fs::path piece = ck.parent_path() / index.pieces[0].file;
+  EXPECT_EQ(piece.parent_path().filename(), "checkpoint.pieces");
+  EXPECT_EQ(std::distance(fs::directory_iterator(piece.parent_path()), fs::directory_iterator()), 1);  // earlier pieces went
+  const std::string good_piece = slurp(piece);
+  const std::string history = slurp(dir / "out" / "history.csv");
+  std::string bad_piece = good_piece;
+  bad_piece[bad_piece.size() - 20] = static_cast<char>(bad_piece[bad_piece.size() - 20] ^ 0x01);
+  std::ofstream(piece, std::ios::binary) << bad_piece;
+  EXPECT_NE(error_of(dir / "case.json").find(piece.string() + ": checkpoint piece checksum mismatch"), std::string::npos)
+      << error_of(dir / "case.json");
+  std::ofstream(piece, std::ios::binary) << good_piece.substr(0, good_piece.size() - 8);
+  EXPECT_NE(error_of(dir / "case.json").find(piece.string() + ": " + std::to_string(good_piece.size() - 8) + " bytes, but"),
+            std::string::npos) << error_of(dir / "case.json");
+  fs::remove(piece);
+  EXPECT_NE(error_of(dir / "case.json").find(piece.string() + ": missing, but " + ck.string() + " names it as piece 0 of 1"),
+            std::string::npos) << error_of(dir / "case.json");
+  EXPECT_EQ(slurp(dir / "out" / "history.csv"), history);
+  std::ofstream(piece, std::ios::binary) << good_piece;
   // Still good after all that.
   std::ofstream(ck, std::ios::binary) << good;
   EXPECT_EQ(run(dir / "case.json", {}, ck), pd::kOk);

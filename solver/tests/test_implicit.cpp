@@ -367,6 +367,8 @@ TEST(Implicit, RestartContinuesBitwiseWithTheFactorisationRebuilt) {
   PlateRun second(plate(), controlled(w1), lin.dofs, std::vector<double>(u0.size(), 0.0));
   second.model.bonds.broken = first.model.bonds.broken;
   second.state = state;
+  // a_n travels in the checkpoint's pieces, not in save_state's bytes (run/state_checkpoint.hpp).
+  *second.integrator.checkpointed_node_arrays().at(0) = *first.integrator.checkpointed_node_arrays().at(0);
   second.integrator.load_state(saved);
   second.t = first.t;
   second.dt = first.dt;

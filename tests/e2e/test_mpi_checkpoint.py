@@ -42,10 +42,13 @@ def with_checkpoints(end, every):
     return change
 
 
-def restart(folder, ranks, timeout=900):
+def restart(folder, ranks, timeout=900, frames="gathered"):
+    """frames: as test_mpi_ranks.solve's."""
     command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1", "--restart", str(folder / "checkpoint.bin")]
     if ranks:
         command = [MPIEXEC, "--oversubscribe", "-np", str(ranks)] + command
+        if frames:
+            command += ["--parallel-frames", frames]
     return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=MPI_ENV)
 
 
@@ -66,7 +69,8 @@ def restarted_at_step(folder):
 
 
 def start_two_ranks(folder):
-    command = [MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1"]
+    command = [MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1",
+               "--parallel-frames", "gathered"]
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=MPI_ENV)
 
 
@@ -197,7 +201,8 @@ def test_a_checkpoint_rank_0_cannot_write_ends_every_rank_with_the_error(prepare
     (folder / "checkpoint.bin.part").mkdir()  # the checkpoint's temporary name: open() fails
     started = time.monotonic()
     result = subprocess.run([MPIEXEC, "--oversubscribe", "-np", "2", SOLVER, str(folder / "case.json"), "--quiet",
-                             "--threads", "1"], capture_output=True, text=True, timeout=300, env=MPI_ENV)
+                             "--threads", "1", "--parallel-frames", "gathered"], capture_output=True, text=True, timeout=300,
+                            env=MPI_ENV)
     assert result.returncode == 3, result.stderr
     assert time.monotonic() - started < 300
     message = "checkpoint.bin.part: cannot open for writing: Is a directory"
@@ -241,3 +246,93 @@ def test_checkpoints_of_the_other_decomposed_terms_continue_bitwise(prepared, ki
     assert result.returncode == 0, f"{kind}: {result.stderr}"
     assert restarted_at_step(folder) > 0
     assert_same_run(reference, folder)
+
+
+def pieces_of_checkpoint(folder):
+    return sorted(p.name for p in (folder / "checkpoint.pieces").iterdir())
+
+
+@pytest.fixture(scope="module")
+def written_on_2(prepared):
+    """A run on 2 ranks with checkpoints (the pieces format, issue 37) and its serial reference."""
+    change = with_checkpoints(3.0e-4, 1.2e-4)
+    reference = copy_case(prepared, "pieces_reference", change)
+    assert solve(reference, None).returncode == 0
+    written = copy_case(prepared, "pieces_np2", change)
+    result = solve(written, 2)
+    assert result.returncode == 0, result.stderr
+    return reference, written
+
+
+def test_each_rank_writes_its_piece_and_the_index_names_only_the_last_checkpoints(written_on_2):
+    reference, written = written_on_2
+    pieces = pieces_of_checkpoint(written)
+    step = re.fullmatch(r"s(\d+)\.p0\.bin", pieces[0]).group(1)
+    assert pieces == [f"s{step}.p0.bin", f"s{step}.p1.bin"]  # the earlier checkpoints' pieces went
+    assert int(step) == restarted_at_step_of_index(written)
+    # No piece holds the whole model: each is well under the serial run's one piece.
+    serial = pieces_of_checkpoint(reference)
+    assert len(serial) == 1
+    whole = (reference / "checkpoint.pieces" / serial[0]).stat().st_size
+    for name in pieces:
+        assert (written / "checkpoint.pieces" / name).stat().st_size < 0.75 * whole
+
+
+def restarted_at_step_of_index(folder):
+    """The step of the checkpoint, as its index names its pieces (s<step>.pR.bin)."""
+    data = (folder / "checkpoint.bin").read_bytes()
+    return int(re.search(rb"checkpoint\.pieces/s(\d+)\.p0\.bin", data).group(1))
+
+
+@pytest.mark.parametrize("ranks", [1, 2, 3])
+def test_a_checkpoint_in_pieces_restarts_on_any_rank_count_bitwise(prepared, written_on_2, ranks):
+    reference, written = written_on_2
+    folder = prepared[0] / f"pieces_np2_to_{ranks}"
+    shutil.copytree(written, folder)
+    result = restart(folder, ranks if ranks > 1 else None)
+    assert result.returncode == 0, result.stderr
+    assert restarted_at_step(folder) == restarted_at_step_of_index(written) > 200
+    assert_same_run(reference, folder)
+
+
+def test_a_crash_while_writing_a_checkpoint_leaves_the_previous_one_usable(prepared, written_on_2):
+    """A run killed after some ranks wrote their pieces of a later checkpoint but before rank 0
+    renamed the new index into place: the pieces of that step and a half-written index lie beside
+    the previous checkpoint, which still continues the run bitwise."""
+    reference, written = written_on_2
+    folder = prepared[0] / "pieces_crash"
+    shutil.copytree(written, folder)
+    step = restarted_at_step_of_index(folder)
+    stray = folder / "checkpoint.pieces" / f"s{step + 7}.p0.bin"
+    stray.write_bytes(b"half a piece")
+    (folder / "checkpoint.bin.part").write_bytes(b"half an index")
+    result = restart(folder, 3)
+    assert result.returncode == 0, result.stderr
+    assert_same_run(reference, folder)
+
+
+@pytest.mark.parametrize("damage", ["missing", "flipped", "foreign"])
+def test_a_bad_piece_is_named_before_any_output_changes(prepared, written_on_2, damage):
+    reference, written = written_on_2
+    folder = prepared[0] / f"pieces_{damage}"
+    shutil.copytree(written, folder)
+    step = restarted_at_step_of_index(folder)
+    piece = folder / "checkpoint.pieces" / f"s{step}.p1.bin"
+    if damage == "missing":
+        piece.unlink()
+        expected = f"{piece}: missing, but {folder / 'checkpoint.bin'} names it as piece 1 of 2"
+    elif damage == "flipped":
+        data = bytearray(piece.read_bytes())
+        data[len(data) // 2] ^= 0x04
+        piece.write_bytes(bytes(data))
+        expected = f"{piece}: checkpoint piece checksum mismatch"
+    else:  # rank 0's piece in place of rank 1's: another size
+        shutil.copy(folder / "checkpoint.pieces" / f"s{step}.p0.bin", piece)
+        expected = f"{piece}: "
+    before = {p.relative_to(folder): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    result = restart(folder, 3, timeout=180)
+    assert result.returncode == 1, result.stderr
+    assert expected in result.stderr, result.stderr
+    assert "to start the run over instead, delete" in result.stderr
+    after = {p.relative_to(folder): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    assert after == before  # no output written: frames, history.csv, run.log as they were

@@ -6,7 +6,7 @@ them, which frames.pvd lists. Checked against the serial run's gathered frames: 
 the pieces are every node once, with the serial frame's displacement, velocity, damage and block
 bit for bit, and the pieces' broken-bond lines are the serial frame's; history.csv is the serial
 run's. ParaView (pvpython, skipped without it) opens the series and sees every node once per frame.
-postprocess refuses the series with a message naming the .pvtu. A checkpoint of a run in pieces on
+postprocess reads a .pvtu as the gathered frame of the same run, bit for bit. A checkpoint of a run in pieces on
 2 ranks continues on 3 with the series of the uninterrupted run.
 """
 import os
@@ -18,17 +18,18 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from e2e_support import PY, ROOT
+from e2e_support import PY, ROOT, SOLVER
 from postprocess import read_frame
 # prepared: the coarse plate, meshed and preprocessed once per module; pytestmark: skip without MPI.
-from test_mpi_checkpoint import restart, restarted_at_step, with_checkpoints
+from test_mpi_checkpoint import assert_same_run, restart, restarted_at_step, with_checkpoints
 from test_mpi_ranks import copy_case, history_without_wall_time, prepared, pytestmark, solve  # noqa: F401, F811
 
 PVPYTHON = shutil.which("pvpython")
 
 
 def in_pieces(case):
-    case["output"]["parallel_frames"] = "pieces"
+    """No output.parallel_frames at all: pdsolve's default on several ranks is pieces."""
+    case["output"].pop("parallel_frames", None)
 
 
 def listed(folder):
@@ -65,7 +66,7 @@ def runs(prepared):
     assert solve(folders["serial"], None).returncode == 0
     for ranks in (2, 3):
         folders[ranks] = copy_case(prepared, f"pieces_np{ranks}", in_pieces)
-        result = solve(folders[ranks], ranks)
+        result = solve(folders[ranks], ranks, frames=None)  # the default on several ranks: pieces
         assert result.returncode == 0, result.stderr
     return folders
 
@@ -92,12 +93,23 @@ def test_the_pieces_hold_every_node_once_with_the_serial_frames_values(runs, ran
     assert len(names) == 7 * (ranks + 1) and not any(re.fullmatch(r"frame_\d{6}\.vtu", n) for n in names)
 
 
-def test_postprocess_refuses_a_series_in_pieces_clearly(runs):
+def test_postprocess_reads_a_frame_in_pieces_as_the_gathered_frame_bit_for_bit(prepared, runs):
+    """postprocess's reader (meshio, piece by piece) opens a .pvtu and finds the gathered frame of the
+    same run: points and every point array in global node order, and the broken bonds, bit for bit."""
+    gathered = copy_case(prepared, "gathered_np2", lambda case: case["output"].update(parallel_frames="gathered"))
+    assert solve(gathered, 2).returncode == 0
+    assert listed(runs[2]) == [(t, f.replace(".vtu", ".pvtu")) for t, f in listed(gathered)]
+    for (_, file), (_, pfile) in zip(listed(gathered), listed(runs[2])):
+        whole, pieces = read_frame(str(gathered / file)), read_frame(str(runs[2] / pfile))
+        assert np.array_equal(pieces.points, whole.points)
+        assert sorted(pieces.point_data) == sorted(whole.point_data)
+        for name, values in whole.point_data.items():
+            assert pieces.point_data[name].dtype == values.dtype and np.array_equal(pieces.point_data[name], values), name
+        assert (pieces.time, pieces.step) == (whole.time, whole.step)
+        assert sorted(map(tuple, pieces.broken_bonds.tolist())) == sorted(map(tuple, whole.broken_bonds.tolist()))
     result = subprocess.run([PY, "-m", "postprocess", str(runs[2])], cwd=ROOT, capture_output=True, text=True,
-                            timeout=300, env=dict(os.environ, PYTHONPATH=ROOT))
-    assert result.returncode != 0
-    assert "frame_000000.pvtu, a frame in pieces" in result.stderr + result.stdout
-    assert "output.parallel_frames: gathered" in result.stderr + result.stdout
+                            timeout=600, env=dict(os.environ, PYTHONPATH=ROOT))
+    assert result.returncode == 0, result.stderr
 
 
 PV_SCRIPT = """
@@ -134,18 +146,43 @@ def test_a_checkpoint_in_pieces_continues_on_3_ranks(prepared, runs):
         in_pieces(case)
         with_checkpoints(3.0e-4, 1.2e-4)(case)
     written = copy_case(prepared, "pieces_ckpt_np2", change)
-    result = solve(written, 2)
+    result = solve(written, 2, frames=None)
     assert result.returncode == 0, result.stderr
-    folder = prepared[0] / "pieces_ckpt_np2_to_np3"
+    # On 3 ranks, and on 1 (no mpirun; --parallel-frames gathered asked for in vain): the series goes on
+    # in pieces, as the checkpoint records, with the uninterrupted run's values.
+    for ranks, extra in ((3, None), (None, "gathered")):
+        folder = prepared[0] / f"pieces_ckpt_np2_to_{ranks}"
+        shutil.copytree(written, folder)
+        result = restart(folder, ranks, frames=None) if ranks else restart_serially(folder, extra)
+        assert result.returncode == 0, result.stderr
+        assert restarted_at_step(folder) > 200
+        assert history_without_wall_time(folder) == history_without_wall_time(written)  # the uninterrupted run's
+        assert listed(folder) == listed(runs[3])
+        for _, pfile in listed(folder):
+            ids, data, _ = assembled(folder / pfile)
+            ids3, data3, _ = assembled(runs[3] / pfile)
+            assert ids.tolist() == ids3.tolist()
+            for name in data:
+                assert np.array_equal(data[name], data3[name]), (pfile, name)
+
+
+def restart_serially(folder, frames):
+    command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", "1", "--restart", str(folder / "checkpoint.bin"),
+               "--parallel-frames", frames]
+    return subprocess.run(command, capture_output=True, text=True, timeout=900)
+
+
+def test_a_serial_checkpoint_continues_its_plain_series_on_2_ranks(prepared, runs):
+    """A series of plain .vtu frames (a run on one rank) goes on as plain .vtu frames when it is
+    continued on several ranks, whose default is pieces: the restart keeps the series' format."""
+    def change(case):
+        in_pieces(case)
+        with_checkpoints(3.0e-4, 1.2e-4)(case)
+    written = copy_case(prepared, "serial_ckpt", change)
+    assert solve(written, None).returncode == 0
+    folder = prepared[0] / "serial_ckpt_to_np2"
     shutil.copytree(written, folder)
-    result = restart(folder, 3)
+    result = restart(folder, 2, frames=None)
     assert result.returncode == 0, result.stderr
     assert restarted_at_step(folder) > 200
-    assert history_without_wall_time(folder) == history_without_wall_time(written)  # the uninterrupted run's
-    assert listed(folder) == listed(runs[3])
-    for _, pfile in listed(folder):
-        ids, data, _ = assembled(folder / pfile)
-        ids3, data3, _ = assembled(runs[3] / pfile)
-        assert ids.tolist() == ids3.tolist()
-        for name in data:
-            assert np.array_equal(data[name], data3[name]), (pfile, name)
+    assert_same_run(written, folder)

@@ -74,10 +74,15 @@ def copy_case(prepared, name, change=None):
     return target
 
 
-def solve(folder, ranks, threads=1):
+def solve(folder, ranks, threads=1, frames="gathered"):
+    """frames: pdsolve --parallel-frames on several ranks. These tests compare frames byte for byte
+    with the serial run's, so gathered on rank 0 unless a test asks for the pieces (None: the case's
+    choice, pieces by default)."""
     command = [SOLVER, str(folder / "case.json"), "--quiet", "--threads", str(threads)]
     if ranks:
         command = [MPIEXEC, "--oversubscribe", "-np", str(ranks)] + command
+        if frames:
+            command += ["--parallel-frames", frames]
     return subprocess.run(command, capture_output=True, text=True, timeout=900, env=MPI_ENV)
 
 

@@ -105,14 +105,18 @@ def test_series_errors(run2d, tmp_path):
         read_series(str(tmp_path / "frames.pvd"))
 
 
-def test_series_refuses_frames_in_pieces_clearly(tmp_path):
-    """output.parallel_frames: pieces (an MPI run) lists .pvtu files, which postprocess does not read."""
+def test_series_lists_frames_in_pieces_and_a_broken_pvtu_is_named(tmp_path):
+    """output.parallel_frames: pieces (an MPI run's default) lists .pvtu files: the series lists
+    them, and reading one that is not a PUnstructuredGrid, or names no piece, says which file."""
     (tmp_path / "frames").mkdir()
     (tmp_path / "frames" / "frame_000000.pvtu").write_text("<VTKFile/>")
     synth.write_pvd(tmp_path / "frames.pvd", [(0.0, "frames/frame_000000.pvtu")])
-    with pytest.raises(PostprocessError, match=r"frame_000000\.pvtu, a frame in pieces .*output\.parallel_frames: "
-                                               r"gathered \(the default\)"):
-        read_series(str(tmp_path / "frames.pvd"))
+    assert read_series(str(tmp_path / "frames.pvd")) == [(0.0, str(tmp_path / "frames" / "frame_000000.pvtu"))]
+    with pytest.raises(PostprocessError, match=r"frame_000000\.pvtu: not a VTK PUnstructuredGrid"):
+        read_frame(str(tmp_path / "frames" / "frame_000000.pvtu"))
+    (tmp_path / "frames" / "frame_000000.pvtu").write_text('<VTKFile type="PUnstructuredGrid"/>')
+    with pytest.raises(PostprocessError, match=r"frame_000000\.pvtu: names no piece"):
+        read_frame(str(tmp_path / "frames" / "frame_000000.pvtu"))
 
 
 # ---------------------------------------------------------------- one frame

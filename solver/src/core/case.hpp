@@ -119,9 +119,10 @@ struct OutputSettings {
   std::string compression = "zlib";   // zlib | none
   std::vector<std::string> fields = {"displacement", "velocity", "damage", "block"};
   std::string gmsh = "figures";       // read by postprocess only: all | figures | none
-  // A decomposed run's frames (pipeline/formats.md §4): gathered on rank 0 into the serial run's
-  // .vtu, or one .vtu piece per rank named by a .pvtu. A run on one rank writes gathered frames.
-  std::string parallel_frames = "gathered";  // gathered | pieces
+  // A decomposed run's frames (pipeline/formats.md §4): one .vtu piece per rank named by a .pvtu
+  // (no rank holds the whole model for them, issue 37), or, when asked, gathered on rank 0 into the
+  // serial run's .vtu. A run on one rank writes the gathered (plain) .vtu whatever this says.
+  std::string parallel_frames = "pieces";  // pieces | gathered
 };
 
 // A pre-crack: bonds crossing the segment from–to (in the xy plane; in 3D the plane through it

@@ -354,10 +354,7 @@ std::vector<char> Implicit::save_state() const {
   const std::uint8_t have = linear_.have_factor() ? 1 : 0, definite = at.definite ? 1 : 0;
   const int factorisations = linear_.factorisations();
   put(have), put(definite), put(at.t), put(at.dt), put(proposal_), put(last_error_), put(factorisations);
-  // A decomposed run saves the whole model's a_n in global node order (gathered on rank 0, the one
-  // that writes), as a serial run does: the checkpoint restarts on any rank count.
-  if (const Decomposed* d = op_.decomposed()) put_vec3(d->gather(a_));
-  else put_vec3(a_);
+  // a_n is in the checkpoint's pieces (checkpointed_node_arrays): each rank writes its owned nodes'.
   if (linear_.have_factor()) put_vec3(linear_.factor_u());
   return bytes;
 }
@@ -365,12 +362,12 @@ std::vector<char> Implicit::save_state() const {
 void Implicit::load_state(const std::vector<char>& bytes) {
   constexpr std::size_t fixed_part = 2 + 4 * sizeof(double) + sizeof(int);
   const Decomposed* decomposed = op_.decomposed();
-  // The checkpoint's arrays are the whole model's (save_state); a decomposed run takes its piece.
+  // A factor's u is the whole model's (a factor is made on one process); a decomposed run drops it.
   const std::size_t n = decomposed ? static_cast<std::size_t>(decomposed->piece().global_nodes) : op_.size();
   const std::size_t vec3 = 3 * n * sizeof(double);
   if (bytes.size() < kReportBytes + fixed_part) throw std::runtime_error("integrator state of the wrong size");
   const bool have = bytes[kReportBytes] != 0;
-  if (bytes.size() != kReportBytes + fixed_part + vec3 + (have ? vec3 : 0))
+  if (bytes.size() != kReportBytes + fixed_part + (have ? vec3 : 0))
     throw std::runtime_error("integrator state of the wrong size");
   load_report(std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kReportBytes)), 0);
   const char* at = bytes.data() + kReportBytes + 1;
@@ -383,8 +380,6 @@ void Implicit::load_state(const std::vector<char>& bytes) {
     for (auto& component : a) std::memcpy(component.data(), at, n * sizeof(double)), at += n * sizeof(double);
   };
   get(t), get(h), get(proposal_), get(last_error_), get(factorisations);
-  get_vec3(a_);
-  if (decomposed) a_ = to_local(decomposed->piece(), a_);
   linear_.forget_factor();
   if (have) {
     State s(n);

@@ -96,6 +96,7 @@ class Implicit : public Integrator {
   // in use was assembled (u, t, Δt); load_state() assembles and factorises it there again, so a
   // restarted run reuses exactly the factor the uninterrupted one does (bitwise).
   std::vector<char> save_state() const override;
+  std::vector<Vec3Array*> checkpointed_node_arrays() override { return {&a_}; }
   void load_state(const std::vector<char>& bytes) override;
 
   std::vector<std::string> describe(double dt_exact) const override;

@@ -57,6 +57,10 @@ class Integrator {
     put(report_.force_evaluations), put(report_.next_dt);
     return bytes;
   }
+  // The integrator's per-node arrays that a checkpoint carries (the implicit scheme's a_n), over
+  // the operator's nodes: written in pieces, each rank its owned nodes, and restored into every
+  // node of the piece before load_state (run/state_checkpoint.hpp), not in save_state's bytes.
+  virtual std::vector<Vec3Array*> checkpointed_node_arrays() { return {}; }
   // Throws std::runtime_error if the bytes are not what save_state() of this integrator writes.
   virtual void load_state(const std::vector<char>& bytes) { load_report(bytes, 0); }
 

@@ -98,6 +98,9 @@ class Mixed : public Integrator {
 
   // The base state, the mode and its watch, then the quasi-static integrator's own state.
   std::vector<char> save_state() const override;
+  std::vector<Vec3Array*> checkpointed_node_arrays() override {
+    return home_ == kImplicit ? implicit_.checkpointed_node_arrays() : static_.checkpointed_node_arrays();
+  }
   void load_state(const std::vector<char>& bytes) override;
 
   std::vector<std::string> describe(double dt_exact) const override;

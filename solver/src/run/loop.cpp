@@ -7,10 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 
 #include "forces/indenter.hpp"
+#include "io/checkpoint.hpp"
 #include "parallel/gather_state.hpp"
+#include "run/state_checkpoint.hpp"
 #include "parallel/local_model.hpp"
 #include "run/measures.hpp"
 #include "run/progress.hpp"
@@ -113,7 +116,7 @@ class TimeLoop {
   IndenterDepthWatch indenter_depth;
   Progress progress;
   LoopEnd end;
-  State gathered;  // a decomposed run's state on rank 0, for output (output_state)
+  State gathered;  // a decomposed run's state on rank 0: for gathered frames, failures and reactions
   std::vector<std::pair<std::int64_t, double>> frames_here;  // (step, t) of the frames this process wrote
   const std::string while_growing = "while the energy grew ×" + format("%g", BlowUpWatch::kGrowthPerStep) + " a step";
   const std::string while_unbalanced = "while the energy held was more than " + format("%g", EnergyBalanceWatch::kSuspect) +
@@ -347,8 +350,9 @@ void TimeLoop::finish() {
   }
 }
 
-// What output reads: the run's state, or on a decomposed run every rank's owned part gathered on
-// rank 0 in the whole model's numbering, with the broken flags (frames' damage). Collective.
+// What a gathered frame and a failure's message read: the run's state, or on a decomposed run
+// every rank's owned part gathered on rank 0 in the whole model's numbering, with the broken flags
+// (frames' damage). Frames in pieces and checkpoints need no gather. Collective.
 const State& TimeLoop::output_state() {
   if (!dec) return state;
   gathered.u = dec->gather(state.u);
@@ -384,18 +388,25 @@ void TimeLoop::history_row(double dt_taken) {
 // output.parallel_frames: pieces. Every rank writes its piece (its nodes and ghosts, io/output.hpp
 // frame_grid), then rank 0 the .pvtu naming them. Collective. The frame number is rank 0's (the
 // broadcast also keeps the other ranks from writing before rank 0's OutputWriter has cleared the
-// frames of an earlier run).
+// frames of an earlier run). On one rank (a restart continuing a series in pieces) one piece of
+// every node.
 void TimeLoop::frame_in_pieces() {
   std::vector<double> k{out ? static_cast<double>(out->frames_written()) : 0.0};
-  dec->broadcast(k);
+  if (dec) dec->broadcast(k);
   FrameFormat format = frame_format_of(p.c.output);
-  const LocalPiece& piece = dec->piece();
-  const FramePiece nodes{piece.owned, piece.global};
-  const VtuGrid grid = frame_grid(piece.model, state, loop.t, loop.step, format, &nodes);
-  write_vtu(p.c.output_dir / frame_piece_file(static_cast<std::size_t>(k[0]), dec->rank()), grid,
+  std::vector<std::uint8_t> all;
+  std::vector<std::int32_t> identity;
+  if (!dec) {
+    all.assign(model.nodes.size(), 1);
+    identity.resize(model.nodes.size());
+    for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<std::int32_t>(i);
+  }
+  const FramePiece nodes = dec ? FramePiece{dec->piece().owned, dec->piece().global} : FramePiece{all, identity};
+  const VtuGrid grid = frame_grid(dec ? dec->piece().model : model, state, loop.t, loop.step, format, &nodes);
+  write_vtu(p.c.output_dir / frame_piece_file(static_cast<std::size_t>(k[0]), dec ? dec->rank() : 0), grid,
             format.zlib ? VtuCompression::zlib : VtuCompression::none);
-  dec->total(0);  // every piece is on disk before the .pvtu names it
-  if (out) out->frame_of_pieces(grid, dec->ranks(), loop.t);
+  if (dec) dec->total(0);  // every piece is on disk before the .pvtu names it
+  if (out) out->frame_of_pieces(grid, dec ? dec->ranks() : 1, loop.t);
 }
 
 // A gathered frame of a run whose ranks hold only their rows: the damage per node and the broken
@@ -411,9 +422,13 @@ void TimeLoop::frame_from_rows(const State& st) {
 
 // A frame and the history row of its step. Collective.
 void TimeLoop::frame(double dt_taken) {
-  if (p.frames_in_pieces()) frame_in_pieces();
-  else if (!p.whole_bonds) frame_from_rows(output_state());
-  else if (const State& st = output_state(); out) out->frame(model, st, loop.t, loop.step);
+  if (p.frames_in_pieces()) {
+    frame_in_pieces();  // no gather: each rank writes its own nodes
+  } else {
+    const State& st = output_state();
+    if (!p.whole_bonds) frame_from_rows(st);
+    else if (out) out->frame(model, st, loop.t, loop.step);
+  }
   frames_here.emplace_back(loop.step, loop.t);
   history_row(dt_taken);
   schedule.frame_written(loop);
@@ -428,32 +443,49 @@ void TimeLoop::timed(Write write) {
   end.output_seconds += seconds_since(output_start);
 }
 
-// Written atomically (io/checkpoint.hpp), after the history rows so far are on disk. On a
-// decomposed run every rank's owned state and rows are gathered on rank 0 in global node order
-// (the path frames take) at the same step, and rank 0 alone writes the one file, in the format of
-// a serial run: whole, of one step, and readable on any rank count. Collective.
+// Written in pieces (io/checkpoint.hpp), after the history rows so far are on disk: every rank
+// its owned nodes and rows, no gather; then rank 0 the index naming them, once every piece is on
+// disk (the per_rank below returns only when every rank has written), so a crash in between leaves
+// the previous index and its pieces as they were. Collective.
 void TimeLoop::write_restart() {
-  const State& whole = output_state();
-  // The law's declared history (core/state_arrays.hpp) in the whole model's order, as the serial run holds it.
-  if (dec) gather_state(*dec, p.model, [](const StateDeclaration& d) { return d.checkpoint; });
-  // The contact list's displacement at its last build, from the pieces (forces/contact_on_piece).
-  const NeighbourList& contact_list = p.op->model().contact_list;
-  const Vec3Array contact_u_build =
-      dec && model.contact.pairs && contact_list.rebuilds() > 0 ? dec->gather(contact_list.u_build()) : Vec3Array{};
-  // Collective too: an integrator's per-node state is gathered on rank 0 (integrators/implicit.cpp).
+  const Model& local = p.op->model();  // the piece's on a decomposed run
+  const NeighbourList& contact_list = local.contact_list;
+  const bool contact = model.contact.pairs && contact_list.rebuilds() > 0;
   std::vector<char> integrator_state = p.integrator->save_state();
-  // Ranks holding only their rows: the broken flags in the whole list's order, on rank 0 for the
-  // write only (1 byte per directed bond, freed after it).
-  if (!p.whole_bonds) {
-    if (out) p.model.bonds.broken.assign(static_cast<std::size_t>(p.directed_bonds()), 0);
-    dec->gather_broken(dec->piece().model.bonds, p.model.bonds);
+  if (out) out->flush_history();
+  const int rank = dec ? dec->rank() : 0;
+  CheckpointPieceRef mine;
+  std::string failure;
+  try {
+    mine = write_checkpoint_piece(checkpoint_file, checkpoint_piece_file(loop.step, rank),
+                                  checkpoint_piece_of(local, dec ? &dec->piece() : nullptr, state,
+                                                      integrator.checkpointed_node_arrays(),
+                                                      contact ? &contact_list.u_build() : nullptr));
+  } catch (const Error& e) {
+    if (!dec) throw;
+    failure = e.what();
+  }
+  std::vector<CheckpointPieceRef> pieces{mine};
+  if (dec) {
+    // Every rank's reference on rank 0 (the numbers as bits: per_rank moves doubles unchanged).
+    if (dec->minimum(failure.empty() ? 1.0 : 0.0) == 0.0) {
+      if (!failure.empty()) throw Error(failure);
+      throw Error(checkpoint_file.string() + ": another rank could not write its piece of the checkpoint (its error is on its stderr)");
+    }
+    auto bits = [](std::uint64_t v) { double d; std::memcpy(&d, &v, sizeof d); return d; };
+    auto back = [](double d) { std::uint64_t v; std::memcpy(&v, &d, sizeof v); return v; };
+    const std::vector<double> nodes = dec->per_rank(bits(mine.nodes)), bonds = dec->per_rank(bits(mine.bonds)),
+                              bytes = dec->per_rank(bits(mine.bytes)), sums = dec->per_rank(bits(mine.checksum));
+    pieces.clear();
+    for (std::size_t r = 0; r < nodes.size(); ++r)
+      pieces.push_back({checkpoint_piece_file(loop.step, static_cast<int>(r)), back(nodes[r]),
+                        back(bonds[r]), back(bytes[r]), back(sums[r])});
   }
   if (!out) return;
-  out->flush_history();
   LoopState saved = loop;
   saved.wall_time = wall_before + seconds_since(loop_start);
-  write_checkpoint(checkpoint_file, checkpoint_of(p, s, whole, saved, *out, std::move(integrator_state), contact_u_build));
-  if (!p.whole_bonds) std::vector<std::uint8_t>().swap(p.model.bonds.broken);
+  write_checkpoint_index(checkpoint_file,
+                         checkpoint_of(p, s, state, saved, *out, std::move(integrator_state), contact, std::move(pieces)));
 }
 
 // write_restart timed for the wall-time schedule (only rank 0's clock decides it, stop_or_checkpoint).

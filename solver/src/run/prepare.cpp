@@ -195,6 +195,7 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   Case& c = p->c;
   c = read_case(opt.case_file);
   if (opt.end_time) c.time.end = *opt.end_time;
+  if (opt.parallel_frames) c.output.parallel_frames = *opt.parallel_frames;
   if (opt.threads > 0) omp_set_num_threads(opt.threads);
   p->threads = omp_get_max_threads();
   Nodes nodes = read_node_file(c.nodes_file);

@@ -38,8 +38,11 @@ struct Prepared {
   // operator then works on the piece's model. Null on one rank: the serial path.
   std::unique_ptr<Decomposed> decomposed;
   bool writes_output() const { return !decomposed || decomposed->rank() == 0; }
-  // output.parallel_frames: pieces on a decomposed run (one rank writes gathered frames).
-  bool frames_in_pieces() const { return decomposed && c.output.parallel_frames == "pieces"; }
+  // output.parallel_frames: pieces on a decomposed run (one rank writes gathered frames), or on a
+  // restart the format of the series it continues (resumes_pieces: a series in pieces goes on in
+  // pieces on any rank count, one piece on one rank; run/start.cpp sets both from the checkpoint).
+  bool resumes_pieces = false;
+  bool frames_in_pieces() const { return (decomposed || resumes_pieces) && c.output.parallel_frames == "pieces"; }
   double build_seconds = 0.0;  // wall time of build_model
 
   // The time step (time.dt stable | exact | fixed, × safety_factor; adaptive.dt_initial first).

@@ -22,11 +22,12 @@ Error start_over(const RunOptions& opt, const std::exception& e) {
   return Error(std::string(e.what()) + "; to start the run over instead, delete " + opt.restart.string());
 }
 
-// The checkpoint file. On a decomposed run rank 0 alone reads it and broadcasts its bytes (or the
-// error it met): every rank then parses the same bytes and checks them alike, so a bad file is
-// refused by every rank with one message, and no rank waits for another that gave up.
+// The checkpoint's index (io/checkpoint.hpp; a few hundred bytes, whatever the model). On a
+// decomposed run rank 0 alone reads it and broadcasts its bytes (or the error it met): every rank
+// then parses the same bytes and checks them alike, so a bad file is refused by every rank with
+// one message, and no rank waits for another that gave up.
 Checkpoint read_checkpoint_on_ranks(const RunOptions& opt, const Decomposed* d) {
-  if (!d) return read_checkpoint(opt.restart);
+  if (!d) return parse_checkpoint(read_whole_file(opt.restart, "the checkpoint"), opt.restart.string());
   std::string bytes, failure;
   if (d->rank() == 0) try {
       bytes = read_whole_file(opt.restart, "the checkpoint");
@@ -47,20 +48,6 @@ std::int64_t broken_bonds(const Prepared& p) {
   return p.decomposed->total(flags) / 2;
 }
 
-// A decomposed run's piece of the restored state: the checkpoint holds the whole model's state in
-// global node order (whatever rank count wrote it), and each rank takes its owned nodes and their
-// ghosts — exact copies, as a halo exchange would make them — and its rows' broken flags.
-void restore_piece(Prepared& p, State& whole, Start& s) {
-  LocalPiece& piece = p.decomposed->piece();
-  State& local = s.state;  // sized to the piece, initialize()d
-  local.u = to_local(piece, whole.u);
-  local.v = to_local(piece, whole.v);
-  local.f = to_local(piece, whole.f);
-  local.w = to_local(piece, whole.w);
-  local.copy_totals(whole);
-  rows_to_local(piece, p.model.bonds, piece.model.bonds);
-}
-
 // The checkpoint's linear solver, before initialize() sizes the scratch for it. Auto's choice
 // depends on the rank count (a 2-rank quasi_static run solves by CG, one rank would factorise), and
 // either gives other bits: kept where this run can (CG runs on any rank count), else said, since
@@ -74,12 +61,25 @@ void keep_linear_solver(const RunOptions& opt, Integrator& integrator, const std
                      ", and its results will not be bitwise those of the uninterrupted run";
 }
 
-// Replaces the fresh state by the checkpoint's, after checking that it belongs to this case.
+// Whether the index's arrays are what this run writes: the state, the law's declared state, the
+// integrator's per-node arrays and (if the index has it) contact's u_build.
+bool fits_sections(const Checkpoint& index, const Model& local, Integrator& integrator, bool& contact) {
+  contact = false;
+  for (const CheckpointSection& section : index.sections) contact = contact || section.name == "contact_u_build.x";
+  return index.sections == checkpoint_sections_of(local, integrator.checkpointed_node_arrays().size(), contact);
+}
+
+// Replaces the fresh state by the checkpoint's, after checking that it belongs to this case: the
+// index on every rank, then each rank streams the pieces and keeps its own nodes and rows
+// (run/state_checkpoint.hpp), whatever rank count wrote them.
 void restore(const RunOptions& opt, Prepared& p, Start& s) {
   Model& model = p.model;
   Integrator& integrator = *p.integrator;
+  Decomposed* dec = p.decomposed.get();
+  LocalPiece* piece = dec ? &dec->piece() : nullptr;
+  Model& local = piece ? piece->model : model;  // the operator's model
   const auto n = static_cast<std::size_t>(p.nodes);
-  Checkpoint checkpoint = read_checkpoint_on_ranks(opt, p.decomposed.get());
+  Checkpoint checkpoint = read_checkpoint_on_ranks(opt, dec);
   const std::string where = opt.restart.string() + ": ";
   if (checkpoint.case_hash != s.case_hash)
     throw Error(where + "the checkpoint belongs to another case file (or " + opt.case_file.string() +
@@ -88,36 +88,35 @@ void restore(const RunOptions& opt, Prepared& p, Start& s) {
     throw Error(where + "the checkpoint belongs to another node file (or " + p.c.nodes_file.string() +
                 " changed since it was written)");
   const auto directed = static_cast<std::size_t>(p.directed_bonds());
-  if (checkpoint.nodes != n || checkpoint.directed_bonds != directed || checkpoint.broken_flags.size() != directed ||
-      !fits_checkpointed_state(checkpoint.state_arrays, model, n, directed) ||
-      checkpoint.integrator != integrator.name() ||
-      (model.contact.pairs && checkpoint.contact_rebuilds > 0 && checkpoint.contact_u_build[0].size() != n))
+  bool contact = false;
+  if (checkpoint.nodes != n || checkpoint.directed_bonds != directed || !fits_sections(checkpoint, local, integrator, contact) ||
+      checkpoint.integrator != integrator.name() || (contact && !model.contact.pairs))
     throw Error(where + "the checkpoint does not fit this model (" + std::to_string(checkpoint.nodes) + " nodes, " +
                 std::to_string(checkpoint.directed_bonds / 2) + " bonds, integrator " + checkpoint.integrator + "; here " +
                 std::to_string(n) + ", " + std::to_string(directed / 2) + ", " + integrator.name() + ")");
   if (checkpoint.frame_times.empty()) throw Error(where + "the checkpoint lists no frame; cannot restart");
-  // Checked before any rank takes its piece: every rank holds the same whole state and decides alike
-  // (a serial run checks after restore, in start_or_restore).
-  if (p.decomposed && first_non_finite(checkpoint.state) >= 0) throw Error(where + "the checkpoint's state is not finite");
   keep_linear_solver(opt, integrator, checkpoint.linear_solver, s);
+  // The series goes on in the format it was written in, whatever the rank count and output.parallel_frames.
+  p.resumes_pieces = checkpoint.frames_in_pieces;
+  p.c.output.parallel_frames = checkpoint.frames_in_pieces ? "pieces" : "gathered";
   // initialize() sizes the integrator's scratch; then everything it set is replaced by the
   // checkpoint, so the run continues bitwise as if it had never stopped.
-  if (p.decomposed) s.state = State(p.decomposed->piece().size());
+  s.state = State(local.nodes.size());
   integrator.initialize(s.state, checkpoint.loop.t);
-  model.bonds.broken = std::move(checkpoint.broken_flags);
-  if (p.decomposed) restore_piece(p, checkpoint.state, s);
-  else s.state = std::move(checkpoint.state);  // moved: a restarted run holds one copy of the state
-  if (!p.whole_bonds) std::vector<std::uint8_t>().swap(model.bonds.broken);  // the rows are in the piece now
-  restore_checkpointed_state(std::move(checkpoint.state_arrays), model, p.decomposed ? &p.decomposed->piece() : nullptr);
-  if (model.contact.pairs && p.decomposed) {
+  s.state.copy_totals(checkpoint.state);
+  Vec3Array u_build;
+  restore_from_pieces(opt.restart, checkpoint, local, piece, s.state, integrator.checkpointed_node_arrays(),
+                      contact ? &u_build : nullptr, dec && p.whole_bonds ? &model.bonds : nullptr);
+  // Every rank decides alike: one rank's non-finite entry stops them all.
+  bool finite = first_non_finite(s.state) < 0;
+  if (dec) finite = dec->minimum(finite ? 1.0 : 0.0) == 1.0;
+  if (!finite) throw Error(where + "the checkpoint's state is not finite");
+  if (model.contact.pairs && dec) {
     // The piece's record of the last build; its first force evaluation searches again at that
     // displacement on every rank (forces/contact_on_piece), the list the serial restore finds.
-    const LocalPiece& piece = p.decomposed->piece();
-    piece.model.contact_list.restore_record(
-        checkpoint.contact_rebuilds > 0 ? to_local(piece, checkpoint.contact_u_build) : Vec3Array{},
-        checkpoint.contact_rebuilds, checkpoint.contact_seconds);
+    local.contact_list.restore_record(u_build, checkpoint.contact_rebuilds, checkpoint.contact_seconds);
   } else if (model.contact.pairs)
-    model.contact_list.restore(model.nodes.x, checkpoint.contact_u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
+    model.contact_list.restore(model.nodes.x, u_build, model.block_index, model.contact, checkpoint.contact_rebuilds,
                                checkpoint.contact_seconds);
   try {
     integrator.load_state(checkpoint.integrator_state);
@@ -191,8 +190,9 @@ std::unique_ptr<OutputWriter> open_output(const RunOptions& opt, const Prepared&
   return out;
 }
 
-Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
-                         const OutputWriter& out, std::vector<char> integrator_state, const Vec3Array& contact_u_build) {
+Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& totals, const LoopState& loop,
+                         const OutputWriter& out, std::vector<char> integrator_state, bool contact,
+                         std::vector<CheckpointPieceRef> pieces) {
   const Model& model = p.model;
   Checkpoint k;
   k.case_hash = s.case_hash;
@@ -201,17 +201,16 @@ Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, 
   k.directed_bonds = static_cast<std::size_t>(p.directed_bonds());
   k.integrator = p.integrator->name();
   k.linear_solver = p.integrator->linear_solver();
+  k.frames_in_pieces = p.frames_in_pieces();
   k.loop = loop;
   k.integrator_state = std::move(integrator_state);
-  k.state = whole;
-  k.broken_flags = model.bonds.broken;
-  k.state_arrays = checkpointed_state(model);
-  // The operator's list: the whole model's, or on a decomposed run the piece's record, whose
-  // displacement at the last build the caller gathered in global node order (contact_u_build).
-  const NeighbourList& list = p.op->model().contact_list;
-  k.contact_rebuilds = list.rebuilds();
-  k.contact_seconds = list.seconds();
-  k.contact_u_build = p.decomposed ? contact_u_build : list.u_build();
+  k.state.copy_totals(totals);
+  // The operator's model: the piece's on a decomposed run; its declared arrays are every rank's.
+  const Model& local = p.op->model();
+  k.sections = checkpoint_sections_of(local, p.integrator->checkpointed_node_arrays().size(), contact);
+  k.pieces = std::move(pieces);
+  k.contact_rebuilds = local.contact_list.rebuilds();
+  k.contact_seconds = local.contact_list.seconds();
   k.frame_times = out.frame_times();
   k.history_bytes = out.history_bytes();
   return k;

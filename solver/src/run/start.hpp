@@ -40,13 +40,12 @@ std::filesystem::path checkpoint_path(const Case& c);
 std::unique_ptr<OutputWriter> open_output(const RunOptions& options, const Prepared& p, const Start& s,
                                           const HistoryColumns& columns);
 
-// Everything the loop carries from step to step, for checkpoint.bin. loop.wall_time: the time
-// loop's seconds up to now.
-// `whole`: the run's state in the whole model's numbering (on a decomposed run, gathered on rank 0;
-// the broken flags are then p.model's, gathered too). integrator_state: Integrator::save_state(),
-// which every rank of a decomposed run calls (it may gather). contact_u_build: on a decomposed run
-// with contact, the displacement at the last Verlet-list build gathered the same way (empty otherwise).
-Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& whole, const LoopState& loop,
-                         const OutputWriter& out, std::vector<char> integrator_state, const Vec3Array& contact_u_build = {});
+// The index of a checkpoint (io/checkpoint.hpp): everything the loop carries from step to step
+// but the arrays, which the pieces hold. loop.wall_time: the time loop's seconds up to now.
+// totals: the run's State totals (State::copy_totals). integrator_state: Integrator::save_state().
+// contact: the pieces hold contact's u_build (a contact list was built). pieces: every rank's, in rank order.
+Checkpoint checkpoint_of(const Prepared& p, const Start& s, const State& totals, const LoopState& loop,
+                         const OutputWriter& out, std::vector<char> integrator_state, bool contact,
+                         std::vector<CheckpointPieceRef> pieces);
 
 }  // namespace pd

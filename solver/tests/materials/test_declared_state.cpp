@@ -20,6 +20,7 @@
 #include "files.hpp"
 #include "io/checkpoint.hpp"
 #include "io/output.hpp"
+#include "io/read_file.hpp"
 #include "lattice.hpp"
 #include "materials/pmb/pmb.hpp"
 #include "operator/force_operator.hpp"
@@ -104,9 +105,9 @@ TEST(DeclaredState, AWrongDeclarationIsRefusedNamingTheArray) {
   EXPECT_NE(message({node, node}).find("declared state 'peak': declared twice"), std::string::npos);
 }
 
-// The run's checkpoint takes every array with `checkpoint` (run/start.cpp checkpoint_of calls
-// checkpointed_state), the file carries them by name, and a restart puts them back bitwise
-// (restore calls fits_checkpointed_state, then restore_checkpointed_state): the restored model's next
+// A checkpoint takes every array with `checkpoint` (checkpointed_state; a run's pieces by the same
+// declarations, checkpoint_sections_of), the file carries them by name, and read_checkpoint gives
+// them back (fits_checkpointed_state, restore_checkpointed_state): the restored model's next
 // pass is the uninterrupted one's, bit for bit.
 TEST(DeclaredState, IsCheckpointedAndRestoredBitwise) {
   pd::Model run = plate();
@@ -117,6 +118,7 @@ TEST(DeclaredState, IsCheckpointedAndRestoredBitwise) {
   k.integrator = "verlet";
   k.state = pd::State(run.nodes.size());
   k.broken_flags = run.bonds.broken;
+  for (std::size_t i = 0; i < k.nodes; ++i) k.row_length.push_back(static_cast<std::int32_t>(run.bonds.offsets[i + 1] - run.bonds.offsets[i]));
   k.state_arrays = pd::checkpointed_state(run);
   const fs::path file = pdtest::temp_dir("declared_state") / "checkpoint.bin";
   pd::write_checkpoint(file, k);
@@ -125,7 +127,7 @@ TEST(DeclaredState, IsCheckpointedAndRestoredBitwise) {
   pd::Model restarted = plate();
   ASSERT_TRUE(pd::fits_checkpointed_state(read.state_arrays, restarted, k.nodes, k.directed_bonds));
   restarted.bonds.broken = read.broken_flags;
-  pd::restore_checkpointed_state(read.state_arrays, restarted, nullptr);
+  pd::restore_checkpointed_state(read.state_arrays, restarted);
   for (const char* name : {kBondPeak, kNodePeak}) EXPECT_TRUE(same_bits(values(restarted, name), values(run, name))) << name;
   const pd::Vec3Array further = pulled(run, 3e-3);
   breaking_pass(run, further);
@@ -182,7 +184,7 @@ TEST(DeclaredState, IsWrittenToFramesPerNode) {
 // A decomposed run: the per-node array with `halo` travels with u in the breaking pass's exchange
 // (operator/force_operator.cpp breaking_ghost_values is u + add_halo_state), the per-bond one does
 // not (a ghost has no row); each piece starts from the whole model's arrays — its local nodes', its
-// owned rows' — and a restart gives the piece the same (restore_checkpointed_state).
+// owned rows'.
 TEST(DeclaredState, TravelsWithTheGhostsAndIntoThePieces) {
   pd::Model m = plate();
   breaking_pass(m, pulled(m, 2e-3));
@@ -209,11 +211,75 @@ TEST(DeclaredState, TravelsWithTheGhostsAndIntoThePieces) {
                   values(m, kBondPeak)[static_cast<std::size_t>(m.bonds.offsets[i] + q)];
     }
     EXPECT_EQ(differ, 0) << "rank " << r;
-    // A restart: the piece's arrays from the checkpoint's whole-model ones.
-    pd::LocalPiece fresh = pd::make_local_piece(plate(), d.owner, r);
-    pd::Model whole = plate();
-    pd::restore_checkpointed_state(pd::checkpointed_state(m), whole, &fresh);
-    EXPECT_TRUE(same_bits(values(fresh.model, kNodePeak), node)) << "rank " << r;
-    EXPECT_TRUE(same_bits(values(fresh.model, kBondPeak), bond)) << "rank " << r;
   }
+}
+
+// A checkpoint in pieces (io/checkpoint.hpp, run/state_checkpoint.hpp): written by 2 pieces, each
+// its owned nodes and rows, it restores into 3 pieces and into the whole model (one rank) with
+// every array bitwise what the uninterrupted model holds there — the state, the law's declared
+// per-node and per-bond history, the broken flags — and read_checkpoint assembles the whole model.
+// Pure bookkeeping (no MPI): the pieces are cut with make_local_piece as a decomposed run cuts them.
+TEST(DeclaredState, CheckpointInPiecesRestoresIntoAnyPieceCountBitwise) {
+  pd::Model m = plate();
+  breaking_pass(m, pulled(m, 2e-3));
+  const std::size_t n = m.nodes.size();
+  pd::State whole(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t d = 0; d < 3; ++d) {
+      whole.u[d][i] = 1e-6 * static_cast<double>(i) + 0.1 * static_cast<double>(d) + 1.0 / 3.0;
+      whole.v[d][i] = -std::sqrt(static_cast<double>(i + d));
+      whole.f[d][i] = std::exp(0.001 * static_cast<double>(i)) * static_cast<double>(d + 1);
+      whole.w[i] = std::cos(static_cast<double>(i));
+    }
+  auto local_state = [&](const pd::LocalPiece& piece) {
+    pd::State s(piece.size());
+    s.u = pd::to_local(piece, whole.u), s.v = pd::to_local(piece, whole.v), s.f = pd::to_local(piece, whole.f);
+    s.w = pd::to_local(piece, whole.w);
+    return s;
+  };
+  const fs::path index = pdtest::temp_dir("checkpoint_pieces") / "checkpoint.bin";
+  pd::Checkpoint k;
+  k.nodes = n, k.directed_bonds = m.bonds.directed(), k.integrator = "verlet", k.frame_times = {0.0};
+  k.sections = pd::checkpoint_sections_of(m, 0, false);
+  const pd::Decomposition two = pd::decompose(m.nodes.x, m.bonds, 2, m.horizon);
+  for (int r = 0; r < 2; ++r) {
+    const pd::LocalPiece piece = pd::make_local_piece(m, two.owner, r);
+    k.pieces.push_back(pd::write_checkpoint_piece(index, pd::checkpoint_piece_file(7, r),
+                                                  pd::checkpoint_piece_of(piece.model, &piece, local_state(piece), {}, nullptr)));
+    EXPECT_LT(k.pieces.back().nodes, n);
+  }
+  pd::write_checkpoint_index(index, k);
+  const pd::Checkpoint read = pd::parse_checkpoint(pd::read_whole_file(index, "the checkpoint"), index.string());
+  ASSERT_EQ(read.pieces.size(), 2u);
+
+  const pd::Decomposition three = pd::decompose(m.nodes.x, m.bonds, 3, m.horizon);
+  for (int r = 0; r < 3; ++r) {
+    const pd::LocalPiece expected = pd::make_local_piece(m, three.owner, r);
+    pd::LocalPiece fresh = pd::make_local_piece(plate(), three.owner, r);
+    pd::State got(fresh.size());
+    pd::restore_from_pieces(index, read, fresh.model, &fresh, got, {}, nullptr, nullptr);
+    const pd::State want = local_state(expected);
+    for (std::size_t d = 0; d < 3; ++d) {
+      EXPECT_TRUE(same_bits(got.u[d], want.u[d]) && same_bits(got.v[d], want.v[d]) && same_bits(got.f[d], want.f[d])) << r;
+    }
+    EXPECT_TRUE(same_bits(got.w, want.w)) << r;
+    for (const char* name : {kNodePeak, kBondPeak}) EXPECT_TRUE(same_bits(values(fresh.model, name), values(expected.model, name))) << name;
+    EXPECT_EQ(fresh.model.bonds.broken, expected.model.bonds.broken) << r;
+  }
+  pd::Model serial = plate();
+  pd::State got(n);
+  pd::restore_from_pieces(index, read, serial, nullptr, got, {}, nullptr, nullptr);
+  for (std::size_t d = 0; d < 3; ++d) EXPECT_TRUE(same_bits(got.u[d], whole.u[d]) && same_bits(got.f[d], whole.f[d]));
+  for (const char* name : {kNodePeak, kBondPeak}) EXPECT_TRUE(same_bits(values(serial, name), values(m, name))) << name;
+  EXPECT_EQ(serial.bonds.broken, m.bonds.broken);
+  EXPECT_GT(std::count(m.bonds.broken.begin(), m.bonds.broken.end(), 1), 0);  // the pass broke bonds
+  const pd::Checkpoint assembled = pd::read_checkpoint(index);
+  EXPECT_TRUE(same_bits(assembled.state.v[2], whole.v[2]));
+  EXPECT_EQ(assembled.broken_flags, m.bonds.broken);
+
+  // A model of another law's history does not fit: its rows differ from the pieces' rows.
+  pd::Model other = pd::build_model(pdtest::lattice_case(2, "plane_stress", kDx, 3.015 * kDx, 70e9, 2500.0, 1000.0, 1e-3),
+                                    pdtest::cubic_lattice(12, 6, 1, kDx, 2, 1e-3));
+  EXPECT_NE(pd::checkpoint_sections_of(other, 0, false), read.sections);
+  fs::remove_all(index.parent_path());
 }
