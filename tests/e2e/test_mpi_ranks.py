@@ -6,8 +6,9 @@ A coarse, short copy of cases/plate_with_hole (1234 nodes, pulled faster so that
 then under `mpiexec --oversubscribe -np R` for R = 1, 2, 3 with one thread per rank and for R = 2
 with two. The same holds for the plate with body forces and indenters (a disk pressing its top
 edge, a plane pushing its left grip; their reactions in history.csv are sums over the nodes inside)
-for the plate of LPS, the state-based law, and for the adaptive integrator (the Newton integrators:
-test_mpi_implicit.py). What is not decomposed yet is refused on several
+for the plate of LPS, the state-based law, for the adaptive integrator (the Newton integrators:
+test_mpi_implicit.py), and for dt: exact and a fixed dt above eq. 2.5, whose exact limit the ranks
+compute on their pieces. What is not decomposed yet is refused on several
 ranks before any output.
 """
 import json
@@ -153,15 +154,37 @@ def adaptive(case):
 
 
 def exact_dt(case):
-    """Verlet at 0.9 × the exact limit 2/ω_max (Lanczos), which every rank computes on the whole
-    model before the decomposition: the same bits as the serial run's."""
+    """Verlet at 0.9 × the exact limit 2/ω_max (Lanczos), which the ranks compute on their pieces
+    (core/stability.hpp): the same bits as the serial run's."""
     case["time"]["dt"] = "exact"
     case["time"]["safety_factor"] = 0.9
 
 
-@pytest.fixture(scope="module", params=["loads", "lps", "adaptive", "exact"])
+def steps_of_the_plate(prepared):
+    """Eq. 2.5's step and the exact limit 2/ω_max of the prepared plate, as pdsolve computes them."""
+    _, out = prepared
+    result = subprocess.run([SOLVER, "--stable-dt", str(out / "case.json"), "--exact"], capture_output=True,
+                            text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    steps = json.loads(result.stdout)
+    assert steps["stable"] < steps["exact"], steps
+    return steps["stable"], steps["exact"]
+
+
+def fixed_dt(prepared):
+    """A fixed time.dt (what a LAMMPS deck gives) halfway between eq. 2.5 and the exact limit: set-up
+    judges it against the exact limit (run.log's warning), on the pieces."""
+    stable, exact = steps_of_the_plate(prepared)
+
+    def change(case):
+        case["time"]["dt"] = 0.5 * (stable + exact)
+    return change
+
+
+@pytest.fixture(scope="module", params=["loads", "lps", "adaptive", "exact", "fixed"])
 def variant_runs(request, prepared):
-    change = {"loads": with_loads, "lps": as_lps, "adaptive": adaptive, "exact": exact_dt}[request.param]
+    change = {"loads": with_loads, "lps": as_lps, "adaptive": adaptive, "exact": exact_dt,
+              "fixed": fixed_dt(prepared) if request.param == "fixed" else None}[request.param]
     folders = {}
     for name, ranks, threads in (("serial", None, 1), ("np2", 2, 1), ("np3", 3, 1), ("np2t2", 2, 2)):
         folder = copy_case(prepared, f"{request.param}_{name}", change)
@@ -264,14 +287,47 @@ def test_only_rank_0_keeps_the_whole_clouds_node_data(runs):
 
 
 def test_a_feature_that_reads_whole_rows_keeps_the_whole_list_and_says_so(variant_runs):
-    """LPS (its per-node constants), the adaptive step's default dt_max and dt: exact (the exact limit's
-    Lanczos on the whole model) keep the whole bond list on every rank, and run.log says which."""
+    """LPS (its per-node constants) keeps the whole bond list on every rank, and run.log says why. What
+    needs only the exact limit — dt: exact, a fixed dt above eq. 2.5, the adaptive step's default
+    dt_max, the indenters' depth bound — runs its Lanczos on the pieces (issue 37, item 3): each rank
+    holds only its rows, and says so."""
     kind, folders = variant_runs
-    total, held, line = bonds_held((folders["np2"] / "run.log").read_text())
-    reason = {"loads": "indenters", "lps": "blocks[].model lps", "adaptive": "adaptive without dt_max",
-              "exact": "time.dt exact"}[kind]
-    assert f"every rank holds the whole bond list too, for {reason}" in line, line
-    assert all(h > total for h in held), line
+    for name, ranks in (("np2", 2), ("np3", 3), ("np2t2", 2)):
+        total, held, line = bonds_held((folders[name] / "run.log").read_text())
+        assert len(held) == ranks, line
+        if kind == "lps":
+            assert "every rank holds the whole bond list too, for blocks[].model lps" in line, line
+            assert all(h > total for h in held), line
+        else:
+            assert "every rank holds the whole bond list too" not in line, line
+            assert "each rank built only the rows of its own nodes" in line, line
+            assert sum(held) == total and all(0 < h < 0.6 * total for h in held), line
+
+
+def step_lines(log):
+    """run.log's lines on the step and the exact limit: the dt line, the set-up's warning, the
+    adaptive step's dt_max and the indenters' depth bounds."""
+    lines = [line for line in log.splitlines()
+             if line.startswith(("dt ", "warning: the fixed dt", "adaptive", "indenter '"))]
+    # The adaptive line's note on where its default came from names the Lanczos wall time serially.
+    return [line.split(" (default:")[0] for line in lines]
+
+
+def test_the_exact_limit_on_the_pieces_is_the_serial_one(variant_runs):
+    """What run.log says of the step, computed on the pieces (the exact limit, the fixed dt's warning,
+    the default dt_max, the indenters' depth), is the serial run's, digit for digit."""
+    kind, folders = variant_runs
+    serial = step_lines((folders["serial"] / "run.log").read_text())
+    assert serial, kind
+    if kind == "fixed":
+        assert any("exceeds the stable time step of thesis eq. 2.5" in line and "but not the exact limit" in line
+                   for line in serial), serial
+    if kind == "exact":
+        assert any("exact limit" in line for line in serial), serial
+    if kind == "loads":
+        assert sum(line.startswith("indenter '") for line in serial) == 2, serial
+    for name in ("np2", "np3", "np2t2"):
+        assert step_lines((folders[name] / "run.log").read_text()) == serial, (kind, name)
 
 
 def test_what_is_not_decomposed_is_refused_before_any_output(prepared):

@@ -26,7 +26,14 @@ struct LanczosReport {
   bool converged = false;
 };
 
-LanczosReport largest_eigenvalue(const Model& model, std::array<double, 3> period = {0.0, 0.0, 0.0});
+class Decomposed;
+
+// On a decomposed run (decomposed non-null) `model` is this rank's piece (parallel/local_model) and
+// the iteration runs on its owned rows, the ghosts' entries exchanged before each product, its sums
+// those of the serial loop (stability.cpp says how): the same bits as the serial run of the whole
+// model on any number of ranks. Collective then: every rank calls it at the same point.
+LanczosReport largest_eigenvalue(const Model& model, std::array<double, 3> period = {0.0, 0.0, 0.0},
+                                 const Decomposed* decomposed = nullptr);
 
 // y = M^{-1/2} K M^{-1/2} x: the symmetric form of M⁻¹K whose eigenvalues Lanczos finds
 // (x and y have 3 entries per node, component-major like Vec3Array).
@@ -34,6 +41,7 @@ void apply_symmetric_operator(const Model& model, const std::array<double, 3>& p
                               Vec3Array& y);
 
 // Velocity-Verlet stability limit 2/ω_max without safety factor; +inf if no node has a bond.
-double exact_time_step(const Model& model);
+// Collective on a decomposed run, as largest_eigenvalue.
+double exact_time_step(const Model& model, const Decomposed* decomposed = nullptr);
 
 }  // namespace pd

@@ -149,14 +149,19 @@ IndenterStepLimit indenter_step_limit(const Model& m, double t, const Vec3Array&
   return out;
 }
 
-double indenter_stable_depth(const Model& m, const IndenterSettings& ind, double dt, double omega2_exact) {
+double indenter_stable_depth(const Model& m, const IndenterSettings& ind, double dt, double omega2_exact,
+                             const Decomposed* d) {
+  // A ghost's row is empty (its Σ would be 0): a decomposed run looks at its owned nodes only.
+  const std::vector<std::int32_t>* owned = d ? &d->piece().owned_local : nullptr;
+  const auto n = static_cast<std::int64_t>(owned ? owned->size() : m.nodes.size());
   double depth = HUGE_VAL, lightest = HUGE_VAL;
 #pragma omp parallel for schedule(static) reduction(min : depth, lightest)
-  for (std::int64_t i = 0; i < static_cast<std::int64_t>(m.nodes.size()); ++i) {
-    const auto q = static_cast<std::size_t>(i);
+  for (std::int64_t i = 0; i < n; ++i) {
+    const auto q = static_cast<std::size_t>(owned ? (*owned)[static_cast<std::size_t>(i)] : i);
     depth = std::min(depth, (2.0 * m.density[q] / (dt * dt) - node_stiffness(m, q)) / ind.stiffness);  // (a)
     lightest = std::min(lightest, m.density[q]);
   }
+  if (d) depth = d->minimum(depth), lightest = d->minimum(lightest);  // least of least: exact in any order
   depth = std::max(depth, 0.0);
   if (omega2_exact > 0.0)  // (b): 2K·h/ρ ≤ 4/dt² − ω_max² at every node
     depth = std::max(depth, (4.0 / (dt * dt) - omega2_exact) * lightest / (2.0 * ind.stiffness));

@@ -50,8 +50,10 @@ IndenterStepLimit indenter_step_limit(const Model& model, double t, const Vec3Ar
 
 // How deep indenter `ind` may push any node while step dt keeps satisfying (a) or (b): the larger of
 // min_i (2ρ_i/dt² − Σ_i)/K and (4/dt² − ω_max²)·min_i ρ_i/(2K), ≥ 0. A lower bound of the depth
-// at which the step actually becomes unstable.
-double indenter_stable_depth(const Model& model, const IndenterSettings& ind, double dt, double omega2_exact = 0.0);
+// at which the step actually becomes unstable. On a decomposed run (d not null; model a rank's
+// piece): the minima over the owned nodes, then over the ranks (exact), the serial value. Collective.
+double indenter_stable_depth(const Model& model, const IndenterSettings& ind, double dt, double omega2_exact = 0.0,
+                             const Decomposed* d = nullptr);
 
 class IndenterForce {
  public:

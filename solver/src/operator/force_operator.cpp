@@ -394,8 +394,8 @@ double ForceOperator::stable_time_step() const {
 }
 
 double ForceOperator::exact_time_step() const {
-  if (decomposed_) throw Error("time.dt: exact (the Lanczos limit) is not decomposed yet: use dt: stable on several ranks");
-  return pd::exact_time_step(model_);
+  // On a piece: Lanczos on the owned rows, collective (core/stability.hpp).
+  return pd::exact_time_step(model_, decomposed_);
 }
 
 std::vector<std::string> ForceOperator::work_plan(const Case& c) const {

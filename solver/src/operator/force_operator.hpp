@@ -122,7 +122,8 @@ class ForceOperator {
   // dt/2·(P_old + P_new) to the ledger; dt = 0 only initialises the powers.
   void update_work(State& s, double t, double dt) const;
 
-  // The stable step of thesis eq. 2.5 and the exact explicit limit 2/ω_max (core/stability) [s].
+  // The stable step of thesis eq. 2.5 and the exact explicit limit 2/ω_max (core/stability) [s],
+  // the whole model's on a decomposed run (both collective then).
   double stable_time_step() const;
   double exact_time_step() const;
 

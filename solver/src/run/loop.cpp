@@ -516,7 +516,7 @@ void TimeLoop::drop_frames_from(std::int64_t from_step, const std::string& while
 // to land on an output time.
 std::string TimeLoop::likely_cause(double h) {
   const double step = integrator.explicit_step() && p.dt > 0.0 ? std::max(h, p.dt) : h;
-  return BlowUpWatch::likely_cause(step, p.exact_limit(), p.dt_stable, integrator.explicit_step(), model.contact.pairs);
+  return BlowUpWatch::likely_cause(step, p.known_exact_limit(), p.dt_stable, integrator.explicit_step(), model.contact.pairs);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/stability.hpp"
 #include "core/time_step_rule.hpp"
+#include "forces/indenter.hpp"
 #include "io/case_reader.hpp"
 #include "io/node_file.hpp"
 #include "materials/bond_model.hpp"
@@ -92,8 +93,8 @@ void check_decomposable(const Prepared& p) {
   // every integrator: verlet, adaptive (its norms of eq. 2.6 are exact sums: core/exact_sum.hpp),
   // and quasi_static, implicit and mixed on their matrix-free path (their norms and CG's dot
   // products exact sums: parallel/dof_sums.hpp; linear_solver: direct is refused by the
-  // integrator). dt: exact is decomposed too: choose_dt ran on the whole model on every rank,
-  // before the decomposition.
+  // integrator). dt: exact and fixed are decomposed too: the exact limit's Lanczos runs on the
+  // pieces (core/stability.hpp) unless the ranks hold the whole model anyway.
   if (!what.empty())
     throw Error(c.file.string() + ": " + what + " is not decomposed over MPI ranks yet (issue 15; decomposed: the "
                 "verlet, adaptive, quasi_static, implicit and mixed integrators with pmb and lps bonds, dt: stable, exact or fixed, "
@@ -105,27 +106,26 @@ void check_decomposable(const Prepared& p) {
 }  // namespace
 
 std::string whole_bonds_reason(const Case& c) {
-  // Each needs rows of nodes a rank does not own: the exact limit's Lanczos runs on the whole model
-  // (dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the indenters' depth
-  // bound), the surface correction's passes and LPS's per-node constants read whole rows, and
-  // mixed's load-path check walks the whole bond graph.
+  // Each needs rows of nodes a rank does not own: the surface correction's passes and LPS's
+  // per-node constants read whole rows, and mixed's load-path check walks the whole bond graph.
+  // (The exact limit — dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the
+  // indenters' depth bound — runs on the pieces: Prepared::exact_limit.)
   const std::string law = c.blocks.empty() ? std::string("pmb") : c.blocks[0].model;
   if (law != "pmb") return "blocks[].model " + law;
   if (c.surface_correction != "none") return "surface_correction " + c.surface_correction;
   if (c.time.integrator == "mixed") return "time.integrator mixed (its load-path check)";
-  if (c.time.dt_rule != "stable" || c.time.safety_factor > 1.0) return "time.dt " + c.time.dt_rule + " (the exact limit)";
-  if (c.time.integrator == "adaptive" && !c.adaptive.dt_max) return "adaptive without dt_max (the exact limit)";
-  if (!c.indenters.empty()) return "indenters (their stable depth)";
   return "";
 }
 
 double Prepared::exact_limit() {
-  // Not computable from one rank's rows: NaN, "not computed" (whole_bonds_reason keeps every case
-  // that needs it on the whole model; only a failed run's diagnosis asks for it then).
-  if (!whole_bonds) return std::nan("");
-  if (!(dt_exact > 0.0)) dt_exact = exact_time_step(model);
+  // Lanczos on what this rank holds: the whole model serially and where every rank keeps the whole
+  // bond list (no message then), else the rank's piece, collectively, with the same bits.
+  if (!(dt_exact > 0.0))
+    dt_exact = whole_bonds ? exact_time_step(model) : exact_time_step(decomposed->piece().model, decomposed.get());
   return dt_exact;
 }
+
+double Prepared::known_exact_limit() { return whole_bonds || dt_exact > 0.0 ? exact_limit() : std::nan(""); }
 
 namespace {
 
@@ -245,9 +245,9 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
   p->integrator = integrator_registry().get(c.time.integrator)(*p->op);
   if (p->decomposed) p->integrator->set_whole_model(p->model);
-  // The adaptive step's default Δt_max needs the exact limit (Lanczos), which the operator of a
-  // piece cannot give (ForceOperator::exact_time_step): every rank computes it on the whole model,
-  // the same bits as the serial run's configure() does.
+  // The adaptive step's default Δt_max needs the exact limit (Lanczos): computed here, at the same
+  // point on every rank, on the whole model where every rank holds it (no message), else on the
+  // pieces — the same bits as the serial run's configure() computes.
   if (p->decomposed && c.time.integrator == "adaptive" && !c.adaptive.dt_max && std::isfinite(p->dt_stable))
     p->exact_limit();
   p->dt_exact_configured = p->dt_exact;
@@ -266,6 +266,13 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
     const double dt_exact = p->exact_limit();
     if (dt_exact > 0.0 && std::isfinite(dt_exact)) p->omega2_exact = 4.0 / (dt_exact * dt_exact);
   }
+  // run.log's depth per indenter: here, where every rank is, since on pieces it is a minimum over
+  // the ranks (rank 0 alone holds no rows but its own).
+  if (p->indenter_watch)
+    for (const auto& ind : p->model.indenters)
+      p->indenter_depths.push_back(p->decomposed ? indenter_stable_depth(p->decomposed->piece().model, ind, p->dt,
+                                                                         p->omega2_exact, p->decomposed.get())
+                                                 : indenter_stable_depth(p->model, ind, p->dt, p->omega2_exact));
   // After configure(): the integrator sees the same dt_exact as before this check existed.
   if (p->integrator->explicit_step() && !p->integrator->controls_step()) p->step_warnings = step_warnings(*p);
   return p;

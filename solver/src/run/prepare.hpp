@@ -61,11 +61,17 @@ struct Prepared {
   // body from the exact limit when the step is above eq. 2.5, else 0 (eq. 2.5 alone).
   bool indenter_watch = false;
   double omega2_exact = 0.0;
+  std::vector<double> indenter_depths;  // per indenter: forces/indenter.hpp indenter_stable_depth, for run.log
   std::vector<std::string> step_warnings;  // a step above eq. 2.5 judged against the exact limit, for run.log
 
   // The exact stability limit, computed on first use (Lanczos, about as costly as tens of force
-  // evaluations): for time.dt "exact", an indenter watch above eq. 2.5, or a failed run's message.
+  // evaluations): for time.dt "exact", the adaptive step's default Δt_max, an indenter watch or a
+  // fixed dt above eq. 2.5, or a failed run's message. On a rank that holds only its rows it runs
+  // on the pieces: collective then, every rank calls it at the same point.
   double exact_limit();
+  // For a message that rank 0 writes alone (a failed run's likely cause): exact_limit() if it is
+  // known or needs no other rank, else NaN ("not computed").
+  double known_exact_limit();
 
   Prepared() = default;
   Prepared(const Prepared&) = delete;

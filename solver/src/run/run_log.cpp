@@ -107,8 +107,9 @@ void RunLog::setup(const Prepared& p) {
     line(text);
   }
   if (p.indenter_watch)
-    for (const auto& ind : model.indenters) {
-      const double depth = indenter_stable_depth(model, ind, p.dt, p.omega2_exact);
+    for (std::size_t k = 0; k < model.indenters.size(); ++k) {
+      const IndenterSettings& ind = model.indenters[k];
+      const double depth = p.indenter_depths[k];
       const std::string basis = std::string("its stiffness 2K·h with ") + (p.omega2_exact > 0.0 ? "the exact limit" : "eq. 2.5");
       // A sphere or a disk cannot push a node deeper than its radius: a bound past it (1.007 m for a
       // 1.5 mm disk, issue 16) says only that the stiffness never limits the step.

@@ -35,8 +35,9 @@ std::string BlowUpWatch::non_finite_message(const std::string& where, std::int64
 }
 
 std::string BlowUpWatch::likely_cause(double h, double dt_exact, double dt_stable, bool explicit_step, bool contact) {
-  // A decomposed run whose ranks hold only their rows does not compute the exact limit (NaN): its
-  // step is eq. 2.5's × safety factor ≤ 1 (run/prepare whole_bonds_reason), below the exact limit.
+  // A decomposed run whose ranks hold only their rows has not computed the exact limit when its
+  // step needed none (NaN: rank 0 cannot compute it alone): its step is eq. 2.5's × a safety factor
+  // ≤ 1, below the exact limit.
   if (std::isnan(dt_exact) && explicit_step)
     return "dt = " + format("%.6g", h) + " s is within eq. 2.5's limit " + format("%.6g", dt_stable) +
            " s, so within the linear limit, which large deformation lowers" +
