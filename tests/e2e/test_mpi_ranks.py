@@ -6,7 +6,8 @@ A coarse, short copy of cases/plate_with_hole (1234 nodes, pulled faster so that
 then under `mpiexec --oversubscribe -np R` for R = 1, 2, 3 with one thread per rank and for R = 2
 with two. The same holds for the plate with body forces and indenters (a disk pressing its top
 edge, a plane pushing its left grip; their reactions in history.csv are sums over the nodes inside)
-for the plate of LPS, the state-based law, and for the adaptive integrator (the Newton integrators:
+for the plate of LPS, the state-based law (with the energy surface correction too), and for the
+adaptive integrator (the Newton integrators:
 test_mpi_implicit.py). What is not decomposed yet is refused on several
 ranks before any output.
 """
@@ -137,6 +138,13 @@ def as_lps(case):
         block["poisson_ratio"] = 0.3
 
 
+def lps_corrected(case):
+    """The LPS plate with the energy surface correction: its factors and LPS's m_i summed over each
+    rank's own rows, the ghosts' from their owners (no rank holds the whole bond list)."""
+    as_lps(case)
+    case["surface_correction"] = "energy"
+
+
 def adaptive(case):
     """The adaptive integrator (thesis §2.2), its default dt_max from the exact limit of the whole plate."""
     case["time"]["integrator"] = "adaptive"
@@ -149,9 +157,10 @@ def exact_dt(case):
     case["time"]["safety_factor"] = 0.9
 
 
-@pytest.fixture(scope="module", params=["loads", "lps", "adaptive", "exact"])
+@pytest.fixture(scope="module", params=["loads", "lps", "lps_corrected", "adaptive", "exact"])
 def variant_runs(request, prepared):
-    change = {"loads": with_loads, "lps": as_lps, "adaptive": adaptive, "exact": exact_dt}[request.param]
+    change = {"loads": with_loads, "lps": as_lps, "lps_corrected": lps_corrected, "adaptive": adaptive,
+              "exact": exact_dt}[request.param]
     folders = {}
     for name, ranks, threads in (("serial", None, 1), ("np2", 2, 1), ("np3", 3, 1), ("np2t2", 2, 2)):
         folder = copy_case(prepared, f"{request.param}_{name}", change)
@@ -244,14 +253,21 @@ def test_only_rank_0_keeps_the_whole_clouds_node_data(runs):
 
 
 def test_a_feature_that_reads_whole_rows_keeps_the_whole_list_and_says_so(variant_runs):
-    """LPS (its per-node constants), the adaptive step's default dt_max and dt: exact (the exact limit's
-    Lanczos on the whole model) keep the whole bond list on every rank, and run.log says which."""
+    """The adaptive step's default dt_max, dt: exact and the indenters (the exact limit's Lanczos on
+    the whole model) keep the whole bond list on every rank, and run.log says which. LPS and the
+    surface correction no longer do (issue 37 item 3): their per-node constants are summed over each
+    rank's own rows and the ghosts' come from their owners, so each rank builds only its rows."""
     kind, folders = variant_runs
-    total, held, line = bonds_held((folders["np2"] / "run.log").read_text())
-    reason = {"loads": "indenters", "lps": "blocks[].model lps", "adaptive": "adaptive without dt_max",
-              "exact": "time.dt exact"}[kind]
-    assert f"every rank holds the whole bond list too, for {reason}" in line, line
-    assert all(h > total for h in held), line
+    for name, ranks in (("np2", 2), ("np3", 3)):
+        total, held, line = bonds_held((folders[name] / "run.log").read_text())
+        if kind in ("lps", "lps_corrected"):
+            assert "each rank built only the rows of its own nodes" in line, line
+            assert len(held) == ranks and sum(held) == total, line
+            assert all(0 < h < 0.6 * total for h in held), line
+            continue
+        reason = {"loads": "indenters", "adaptive": "adaptive without dt_max", "exact": "time.dt exact"}[kind]
+        assert f"every rank holds the whole bond list too, for {reason}" in line, line
+        assert all(h > total for h in held), line
 
 
 def test_what_is_not_decomposed_is_refused_before_any_output(prepared):

@@ -87,8 +87,8 @@ void check_decomposable(const Prepared& p) {
   if (p.model.bond_model->name() != "pmb" && p.model.bond_model->name() != "lps")
     what = "blocks[].model: " + p.model.bond_model->name();
   // Decomposed: LAMMPS's α rule (the ghosts' s0 refreshed before each breaking pass), breaking_order:
-  // lammps, surface_correction (its factors computed on the whole model, copied into the pieces'
-  // rows), contact (forces/contact_on_piece, its linearised force too) with every integrator, and
+  // lammps, surface_correction (its factors computed on each piece's owned rows, the ghosts' from
+  // their owners), contact (forces/contact_on_piece, its linearised force too) with every integrator, and
   // every integrator: verlet, adaptive (its norms of eq. 2.6 are exact sums: core/exact_sum.hpp),
   // and quasi_static, implicit and mixed on their matrix-free path (their norms and CG's dot
   // products exact sums: parallel/dof_sums.hpp; linear_solver: direct is refused by the
@@ -107,12 +107,10 @@ void check_decomposable(const Prepared& p) {
 std::string whole_bonds_reason(const Case& c) {
   // Each needs rows of nodes a rank does not own: the exact limit's Lanczos runs on the whole model
   // (dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the indenters' depth
-  // bound), the surface correction's passes and LPS's per-node constants read whole rows, and
-  // mixed's load-path check walks the whole bond graph.
-  const std::string law = c.blocks.empty() ? std::string("pmb") : c.blocks[0].model;
-  if (law != "pmb") return "blocks[].model " + law;
-  if (c.surface_correction != "none") return "surface_correction " + c.surface_correction;
-  if (c.time.integrator == "mixed") return "time.integrator mixed (its load-path check)";
+  // bound). LPS's per-node constants and the surface correction's factors are summed over each
+  // rank's owned rows, the ghosts' taken from their owners (LpsModel::set_decomposed,
+  // core/surface_correction.hpp), and mixed's load-path check joins the ranks' components
+  // (integrators/load_path.hpp): none of them needs the whole list.
   if (c.time.dt_rule != "stable" || c.time.safety_factor > 1.0) return "time.dt " + c.time.dt_rule + " (the exact limit)";
   if (c.time.integrator == "adaptive" && !c.adaptive.dt_max) return "adaptive without dt_max (the exact limit)";
   if (!c.indenters.empty()) return "indenters (their stable depth)";
@@ -211,7 +209,9 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   } else {
     p->model = build_model_without_bonds(c, std::move(nodes));
     p->model.bonds.offsets = count_bonds(p->model.nodes.x, bond_search_cutoff(c));
-    p->model.bond_model = material_registry().get("pmb").make(p->model);
+    // The case's law on the skeleton (no rows: a law precomputes nothing there, LpsModel's
+    // constructor) only names the law the pieces make on their rows (for_piece).
+    p->model.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(p->model);
     // The law's per-node history: each piece computes its own; the whole arrays (8 bytes a node
     // each) are where rank 0 gathers them for a checkpoint and a restart reads them back.
     declare_state(p->model, false);
@@ -229,7 +229,7 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
     check_decomposable(*p);
     const auto rows_start = Clock::now();
     p->decomposed = p->whole_bonds ? decompose_over_ranks(p->model)
-                                   : decompose_rows_over_ranks(p->model, bond_search_cutoff(c), c.cracks);
+                                   : decompose_rows_over_ranks(p->model, bond_search_cutoff(c), c.cracks, c.surface_correction);
     if (!p->whole_bonds) {
       p->build_seconds += std::chrono::duration<double>(Clock::now() - rows_start).count();
       // Eq. 2.5 is a least over nodes of their rows' sums: each rank's over its owned rows, then the
@@ -243,7 +243,6 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
   p->integrator = integrator_registry().get(c.time.integrator)(*p->op);
-  if (p->decomposed) p->integrator->set_whole_model(p->model);
   // The adaptive step's default Δt_max needs the exact limit (Lanczos), which the operator of a
   // piece cannot give (ForceOperator::exact_time_step): every rank computes it on the whole model,
   // the same bits as the serial run's configure() does.
