@@ -85,20 +85,16 @@ int main(int argc, char** argv) {
     c.blocks[0].parameters["critical_stretch_alpha"] = alpha;
   }
   // One rank: the serial path (no decomposition), as pdsolve takes it. Several: each rank builds
-  // only the rows of its own nodes, as pdsolve does for a pmb case (run/prepare whole_bonds_reason),
-  // and holds the whole cloud's node data.
+  // only the rows of its own nodes, as pdsolve does for a pmb or lps case (run/prepare
+  // whole_bonds_reason), and holds the whole cloud's node data.
   std::unique_ptr<pd::MpiDecomposed> dec;
   pd::Model global;
   double dt0 = 0.0;
-  if (ranks > 1 && law == "lps") {  // the whole model first: LPS's m_i need whole rows (LpsModel::for_piece)
-    global = pd::build_model(c, pdtest::cubic_lattice(side, side, side, dx, 3));
-    dec = std::make_unique<pd::MpiDecomposed>(MPI_COMM_WORLD, global);
-    dt0 = 0.8 * dec->minimum(pd::stable_time_step(dec->piece().model));
-  } else if (ranks > 1) {
+  if (ranks > 1) {
     global = pd::build_model_without_bonds(c, pdtest::cubic_lattice(side, side, side, dx, 3));
     global.bonds.offsets = pd::count_bonds(global.nodes.x, pd::bond_search_cutoff(c));
     global.bond_model = pd::material_registry().get(law).make(global);
-    dec = std::make_unique<pd::MpiDecomposed>(MPI_COMM_WORLD, global, pd::bond_search_cutoff(c), c.cracks);
+    dec = std::make_unique<pd::MpiDecomposed>(MPI_COMM_WORLD, global, pd::bond_search_cutoff(c), c.cracks, c.surface_correction);
     dt0 = 0.8 * dec->minimum(pd::stable_time_step(dec->piece().model));
   } else {
     global = pd::build_model(c, pdtest::cubic_lattice(side, side, side, dx, 3));

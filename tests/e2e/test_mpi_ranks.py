@@ -6,9 +6,9 @@ A coarse, short copy of cases/plate_with_hole (1234 nodes, pulled faster so that
 then under `mpiexec --oversubscribe -np R` for R = 1, 2, 3 with one thread per rank and for R = 2
 with two. The same holds for the plate with body forces and indenters (a disk pressing its top
 edge, a plane pushing its left grip; their reactions in history.csv are sums over the nodes inside)
-for the plate of LPS, the state-based law, for the adaptive integrator (the Newton integrators:
-test_mpi_implicit.py), and for dt: exact and a fixed dt above eq. 2.5, whose exact limit the ranks
-compute on their pieces. What is not decomposed yet is refused on several
+for the plate of LPS, the state-based law (with the energy surface correction too), for the
+adaptive integrator (the Newton integrators: test_mpi_implicit.py), and for dt: exact and a fixed dt
+above eq. 2.5, whose exact limit the ranks compute on their pieces. What is not decomposed yet is refused on several
 ranks before any output.
 """
 import json
@@ -148,6 +148,13 @@ def as_lps(case):
         block["poisson_ratio"] = 0.3
 
 
+def lps_corrected(case):
+    """The LPS plate with the energy surface correction: its factors and LPS's m_i summed over each
+    rank's own rows, the ghosts' from their owners (no rank holds the whole bond list)."""
+    as_lps(case)
+    case["surface_correction"] = "energy"
+
+
 def adaptive(case):
     """The adaptive integrator (thesis §2.2), its default dt_max from the exact limit of the whole plate."""
     case["time"]["integrator"] = "adaptive"
@@ -181,10 +188,10 @@ def fixed_dt(prepared):
     return change
 
 
-@pytest.fixture(scope="module", params=["loads", "lps", "adaptive", "exact", "fixed"])
+@pytest.fixture(scope="module", params=["loads", "lps", "lps_corrected", "adaptive", "exact", "fixed"])
 def variant_runs(request, prepared):
-    change = {"loads": with_loads, "lps": as_lps, "adaptive": adaptive, "exact": exact_dt,
-              "fixed": fixed_dt(prepared) if request.param == "fixed" else None}[request.param]
+    change = {"loads": with_loads, "lps": as_lps, "lps_corrected": lps_corrected, "adaptive": adaptive,
+              "exact": exact_dt, "fixed": fixed_dt(prepared) if request.param == "fixed" else None}[request.param]
     folders = {}
     for name, ranks, threads in (("serial", None, 1), ("np2", 2, 1), ("np3", 3, 1), ("np2t2", 2, 2)):
         folder = copy_case(prepared, f"{request.param}_{name}", change)
@@ -287,21 +294,18 @@ def test_only_rank_0_keeps_the_whole_clouds_node_data(runs):
 
 
 def test_a_feature_that_reads_whole_rows_keeps_the_whole_list_and_says_so(variant_runs):
-    """LPS (its per-node constants) keeps the whole bond list on every rank, and run.log says why. What
-    needs only the exact limit — dt: exact, a fixed dt above eq. 2.5, the adaptive step's default
-    dt_max, the indenters' depth bound — runs its Lanczos on the pieces (issue 37, item 3): each rank
-    holds only its rows, and says so."""
+    """No feature keeps the whole bond list on every rank any more (issue 37, item 3): the exact limit —
+    dt: exact, a fixed dt above eq. 2.5, the adaptive step's default dt_max, the indenters' depth
+    bound — runs its Lanczos on the pieces, and LPS's per-node constants and the surface correction's
+    factors are summed over each rank's own rows, the ghosts' from their owners: each rank holds
+    only its rows, and run.log says so."""
     kind, folders = variant_runs
     for name, ranks in (("np2", 2), ("np3", 3), ("np2t2", 2)):
         total, held, line = bonds_held((folders[name] / "run.log").read_text())
         assert len(held) == ranks, line
-        if kind == "lps":
-            assert "every rank holds the whole bond list too, for blocks[].model lps" in line, line
-            assert all(h > total for h in held), line
-        else:
-            assert "every rank holds the whole bond list too" not in line, line
-            assert "each rank built only the rows of its own nodes" in line, line
-            assert sum(held) == total and all(0 < h < 0.6 * total for h in held), line
+        assert "every rank holds the whole bond list too" not in line, line
+        assert "each rank built only the rows of its own nodes" in line, line
+        assert sum(held) == total and all(0 < h < 0.6 * total for h in held), line
 
 
 def step_lines(log):

@@ -5,6 +5,7 @@
 
 #include "core/model.hpp"
 #include "materials/bond_model.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
@@ -68,9 +69,24 @@ namespace {
 // The law again with the bonds' current factors (LPS precomputes m_i and its moduli from them).
 void remake_law(Model& m) { m.bond_model = material_registry().get(m.bond_model->name()).make(m); }
 
+// The ghosts' entries of per-node factors, `width` per node (row-major), from their owners.
+void fill_ghosts(const Decomposed* d, std::vector<double>& per_node, std::size_t width) {
+  if (!d) return;
+  const std::size_t n = per_node.size() / width;
+  std::vector<std::vector<double>> column(width, std::vector<double>(n));
+  NodeColumns columns;
+  for (std::size_t c = 0; c < width; ++c) {
+    for (std::size_t i = 0; i < n; ++i) column[c][i] = per_node[width * i + c];
+    columns.add(column[c]);
+  }
+  d->update_ghosts(columns);
+  for (std::size_t c = 0; c < width; ++c)
+    for (std::size_t i = 0; i < n; ++i) per_node[width * i + c] = column[c][i];
+}
+
 }  // namespace
 
-std::vector<double> surface_direction_factors(Model& m, int passes) {
+std::vector<double> surface_direction_factors(Model& m, int passes, const Decomposed* dec) {
   const std::size_t n = m.nodes.size();
   const int dims = m.nodes.dimension == 2 ? 2 : 3;
   std::vector<double> factors(3 * n, 1.0);
@@ -116,6 +132,7 @@ std::vector<double> surface_direction_factors(Model& m, int passes) {
       for (std::size_t i = 0; i < n; ++i)
         if (w[i] > 0.0) factors[3 * i + static_cast<std::size_t>(d)] *= continuum[3 * i + static_cast<std::size_t>(d)] / w[i];
     }
+    fill_ghosts(dec, factors, 3);  // a ghost's row is empty here (w = 0): its owner's factors
   }
   m.bonds.surface_factor = std::move(saved);
   m.bonds.surface_moduli = std::move(saved_moduli);
@@ -241,7 +258,7 @@ double bond_surface_factor(const double* a, const double* b, double n0, double n
   return 1.0 / std::sqrt(n0 * n0 / (s0 * s0) + n1 * n1 / (s1 * s1) + n2 * n2 / (s2 * s2));
 }
 
-std::vector<double> volume_factors(const Model& m) {
+std::vector<double> volume_factors(const Model& m, const Decomposed* d) {
   const std::size_t n = m.nodes.size();
   const auto& x = m.nodes.x;
   std::vector<double> family(n, 0.0);
@@ -252,6 +269,7 @@ std::vector<double> volume_factors(const Model& m) {
       const auto j = static_cast<std::size_t>(m.bonds.neighbour[ku]);
       family[i] += m.nodes.volume[j] * m.bonds.volume_weight(bond_length(x, i, j));
     }
+  fill_ghosts(d, family, 1);  // a ghost's row is empty here: its owner's V_i
   constexpr double kPi = 3.14159265358979323846;
   const double bulk = m.nodes.dimension == 2 ? kPi * m.horizon * m.horizon * m.thickness
                                              : 4.0 / 3.0 * kPi * m.horizon * m.horizon * m.horizon;
@@ -267,14 +285,14 @@ std::vector<double> volume_factors(const Model& m) {
   return g;
 }
 
-void apply_surface_correction(const std::string& method, Model& m) {
+void apply_surface_correction(const std::string& method, Model& m, const Decomposed* d) {
   m.bonds.surface_factor.clear();
   if (!surface_correction_registry().get(method)) return;
   if (method == "volume") {
-    m.bonds.surface_factor = volume_factors(m);
+    m.bonds.surface_factor = volume_factors(m, d);
     return;
   }
-  m.bonds.surface_factor = bond_factors(m, surface_direction_factors(m, kSurfacePasses));
+  m.bonds.surface_factor = bond_factors(m, surface_direction_factors(m, kSurfacePasses, d));
 }
 
 }  // namespace pd

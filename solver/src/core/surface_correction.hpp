@@ -11,6 +11,7 @@
 namespace pd {
 
 struct Model;
+class Decomposed;  // parallel/decomposed.hpp
 
 // none | energy | volume. A registry so that the reader's error and --describe list the same names.
 const Registry<bool>& surface_correction_registry();
@@ -36,7 +37,10 @@ StrainTensor surface_probe_strain(const Model& model, std::size_t i, int d);
 // point; measured in tests/materials/test_surface_correction.cpp). Row-major factors[3 i + d]; 1
 // for d = z in 2D and for a node whose W_d,i is 0 (no bonds). Leaves model.bonds.surface_factor
 // and model.bond_model as they were.
-std::vector<double> surface_direction_factors(Model& model, int passes);
+// On a decomposed run's piece (d not null) each rank probes its owned rows — a node's W_d,i reads
+// its own row only, summed in the serial order — and takes the ghosts' factors from their owners
+// after every pass (the next pass's bond factors read both ends): the serial factors. Collective then.
+std::vector<double> surface_direction_factors(Model& model, int passes, const Decomposed* d = nullptr);
 constexpr int kSurfacePasses = 3;
 
 // g of a bond with unit direction n whose ends have direction factors a and b (3 each):
@@ -91,10 +95,14 @@ std::vector<double> bond_factors(const Model& model, const std::vector<double>& 
 // V0 the continuum's family volume 4πδ³/3 (3D) or πδ²h (2D, h the thickness), so that a truncated
 // family's bonds are stiffened by what it lacks. No probe: g comes from the geometry only (and
 // includes the bulk lattice's own V_i/V0, as PeriLab's does). LPS takes g without moduli factors
-// (both moduli times ḡ, lps.hpp).
-std::vector<double> volume_factors(const Model& model);
+// (both moduli times ḡ, lps.hpp). On a piece (d not null): V_i over the owned rows, the ghosts'
+// from their owners. Collective then.
+std::vector<double> volume_factors(const Model& model, const Decomposed* d = nullptr);
 
 // Sets model.bonds.surface_factor for `method` (none: leaves it empty). Needs model.bond_model.
-void apply_surface_correction(const std::string& method, Model& model);
+// On a decomposed run's piece (d not null): the factors of its owned rows, bitwise the serial
+// ones (see above), without the whole bond list; the caller makes the law again with them, as
+// build_model does. Collective then.
+void apply_surface_correction(const std::string& method, Model& model, const Decomposed* d = nullptr);
 
 }  // namespace pd

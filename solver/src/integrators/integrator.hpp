@@ -84,9 +84,6 @@ class Integrator {
   // factorisations and solves with their wall time, so that a benchmark can weigh them against
   // force evaluations). Empty for a scheme without a linear solver: the done: line is unchanged.
   virtual std::string linear_algebra_summary() const { return {}; }
-  // On a decomposed run, the whole model every rank holds besides its piece (run/prepare.cpp), for
-  // a rule that needs the whole bond graph (mixed's load path). Not called on a serial run.
-  virtual void set_whole_model(Model& /*whole*/) {}
   // The linear solver of the scheme's Newton iterations ("direct", "cg block_jacobi", "cg amg"; ""
   // for a scheme without one). With linear_solver or preconditioner auto it depends on the rank
   // count, the build and the machine (integrators/newton_krylov.hpp), and each solves the systems

@@ -10,7 +10,6 @@
 #include "core/time_step_rule.hpp"
 #include "integrators/messages.hpp"
 #include "parallel/decomposed.hpp"
-#include "parallel/local_model.hpp"
 
 namespace pd {
 
@@ -79,43 +78,10 @@ void Mixed::initialize(State& state, double t) {
   pause_return_ = pause_probation_ = false;
   pause_failures_ = 0;
   log_lines_.clear();
-  // From the bond list with every bond, broken or not: the same before and after a restart.
-  // On a decomposed run the piece holds only its own rows of the bond graph: the groups come from
-  // the whole model (load_path_cut).
-  if (home_ == kQuasiStatic) load_path_.emplace(whole_ ? *whole_ : op_.model());
+  // From the bond list with every bond, broken or not: the same before and after a restart. On a
+  // decomposed run from the piece's rows, the ranks' components joined (load_path.hpp). Collective.
+  if (home_ == kQuasiStatic) load_path_.emplace(op_.model(), op_.decomposed());
   separated_ = false;
-}
-
-// Serial: the piece is the model. Decomposed: the owned rows' broken flags gathered into the whole
-// model's bond list on rank 0 (as for a frame), judged there, and rank 0's verdict taken by all
-// (the least of 0 = cut on rank 0 and 1 elsewhere). Collective.
-bool Mixed::load_path_cut() const {
-  const Decomposed* dec = op_.decomposed();
-  if (!dec || !whole_) return load_path_->separated(op_.model().bonds);
-  dec->gather_broken(op_.model().bonds, whole_->bonds);
-  const bool cut = dec->rank() == 0 && load_path_->separated(whole_->bonds);
-  return dec->minimum(cut ? 0.0 : 1.0) == 0.0;
-}
-
-// Per local node, the group of prescribed motions that alone holds its piece (LoadPath::
-// held_by_one_group). Decomposed: judged on rank 0 from the gathered broken flags, broadcast in
-// global numbering and taken at the piece's nodes. Collective.
-std::vector<std::int32_t> Mixed::pieces_held_by_one_group() const {
-  const Decomposed* dec = op_.decomposed();
-  if (!dec || !whole_) return load_path_->held_by_one_group(op_.model().bonds);
-  dec->gather_broken(op_.model().bonds, whole_->bonds);
-  std::vector<double> group;  // as doubles, for the broadcast (exact: small integers)
-  if (dec->rank() == 0) {
-    const std::vector<std::int32_t> held = load_path_->held_by_one_group(whole_->bonds);
-    group.assign(held.begin(), held.end());
-  } else {
-    group.assign(static_cast<std::size_t>(dec->piece().global_nodes), 0.0);
-  }
-  dec->broadcast(group);
-  const std::vector<double> local = to_local(dec->piece(), group);
-  std::vector<std::int32_t> out(local.size());
-  for (std::size_t l = 0; l < local.size(); ++l) out[l] = static_cast<std::int32_t>(local[l]);
-  return out;
 }
 
 void Mixed::to_explicit(State&, double t, const std::string& reason) {
@@ -215,7 +181,7 @@ void Mixed::step(State& state, double& t, double& dt) {
     // Once separated, every load step starts from the pieces each carried by the one grip that holds
     // it (QuasiStatic::carry_rigidly): unstrained, their equilibrium, which Newton then accepts
     // without a factorisation (measured in the header).
-    if (separated_ && !separation_given_up_) static_.carry_pieces(pieces_held_by_one_group(), load_path_->groups());
+    if (separated_ && !separation_given_up_) static_.carry_pieces(load_path_->held_by_one_group(op_.model().bonds), load_path_->groups());
     try {
       static_.step(state, t, dt);
       report_ = static_.last_step();
@@ -281,7 +247,7 @@ void Mixed::step(State& state, double& t, double& dt) {
   if (report_.broken_now > 0) {
     cracked_ = true;
     // The graph changes only when bonds break: one O(bonds) pass then.
-    if (load_path_ && !separated_ && (separated_ = load_path_cut())) {
+    if (load_path_ && !separated_ && (separated_ = load_path_->separated(op_.model().bonds))) {
       log_lines_.push_back("mixed: t = " + message_number(t) +
                            " s: the cracks have cut the load path between the prescribed motions");
       calm_steps_ = 0;  // the wait after the cut counts from this step (the calm steps before it are another watch's)
@@ -376,8 +342,8 @@ void Mixed::load_state(const std::vector<char>& bytes) {
     get(given_up);
     separation_given_up_ = given_up == 1;
     probation_steps_ = given_up > 1 ? given_up - 1 : 0;
-    // A restart restored the whole model's broken flags on every rank (run/start.cpp) before this.
-    separated_ = load_path_ && load_path_->separated(whole_ ? whole_->bonds : op_.model().bonds);
+    // A restart restored the piece's broken flags (run/start.cpp) before this. Collective.
+    separated_ = load_path_ && load_path_->separated(op_.model().bonds);
     static_.load_path_cut(separated_ && !separation_given_up_);  // the nodes load_state masks, as step() found them
     static_.load_state(inner);
   }

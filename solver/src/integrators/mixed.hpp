@@ -90,7 +90,6 @@ class Mixed : public Integrator {
   enum Mode : int { kExplicit = 0, kQuasiStatic = 1, kImplicit = 2 };
 
   explicit Mixed(ForceOperator& op) : op_(op), static_(op), implicit_(op), explicit_(op) {}
-  void set_whole_model(Model& whole) override { whole_ = &whole; }
   std::string name() const override { return "mixed"; }
   void configure(const Case& c, double dt_exact = 0.0) override;
   void initialize(State& state, double t) override;
@@ -192,11 +191,6 @@ class Mixed : public Integrator {
   // halves ring undamped; that motion is not the quasi-static answer). The first load step then is
   // tentative (kTentativeIterations); if it fails, the rule is given up for the run.
   std::optional<LoadPath> load_path_;
-  // The whole model on a decomposed run (set_whole_model), null on a serial one: the load path is
-  // a property of the whole bond graph, judged on rank 0 from the gathered broken flags.
-  Model* whole_ = nullptr;
-  bool load_path_cut() const;
-  std::vector<std::int32_t> pieces_held_by_one_group() const;
   bool separated_ = false;
   bool separation_given_up_ = false;  // a tentative load step after the separation failed
   // Load steps after a return on the separation rule still to be taken tentatively: the first ones

@@ -208,8 +208,9 @@ class BondModel {
   // A decomposed run (issue 15, parallel/local_model): the law for a rank's piece `local`, whose
   // node l is node global[l] of the model this law was built for. By default built again from the
   // registry on the piece; a law with per-node constants that need a whole row (LPS's m_i) copies
-  // them from this one instead, ghosts included, so they are the serial run's bits. `registry_make`
-  // is the registry's factory of this law.
+  // them from this one when it has them, else (a skeleton's law, no rows) has the owned nodes' from
+  // the piece's rows and takes the ghosts' in set_decomposed. `registry_make` is the registry's
+  // factory of this law; a law outside the registry (the tests') makes itself.
   virtual std::shared_ptr<const BondModel> for_piece(
       const Model& local, const std::vector<std::int32_t>& global,
       std::shared_ptr<const BondModel> (*registry_make)(const Model&)) const {
@@ -217,8 +218,10 @@ class BondModel {
     return registry_make(local);
   }
   // A decomposed run: a law whose force sweep reads per-node values of the bond's far end that only
-  // the end's own row gives (LPS's P_j) fills its ghosts' copies through `d` between its sweeps.
-  // Called once by the operator; the default law needs nothing.
+  // the end's own row gives (LPS's P_j) fills its ghosts' copies through `d` between its sweeps, and
+  // its per-node constants of the ghosts once (LPS's m_j: a ghost's row is empty on the piece).
+  // Collective: called by the piece's maker once the halo exists (parallel/mpi_decomposed), then
+  // by the operator with the same d; the default law needs nothing.
   virtual void set_decomposed(const Decomposed* d) const { (void)d; }
 };
 

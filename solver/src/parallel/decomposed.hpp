@@ -85,6 +85,10 @@ class Decomposed {
   virtual std::vector<double> gather(const std::vector<double>& per_node, int width) const = 0;
   // values = rank 0's values on every rank (the same size everywhere). Collective.
   virtual void broadcast(std::vector<double>& values) const = 0;
+  // Every rank's `values` (any length, the ranks' may differ), rank after rank, on every rank
+  // (MPI_Allgatherv): a small graph that every rank then judges alike, as mixed's load path joins
+  // the ranks' components of the bond graph (integrators/load_path.hpp). Collective.
+  virtual std::vector<std::int64_t> gather_to_all(const std::vector<std::int64_t>& values) const = 0;
   // The broken flags of the owned rows into the whole model's bond list, on rank 0 (whose rows the
   // frames' damage reads). Collective.
   virtual void gather_broken(const BondList& local, BondList& global) const = 0;
@@ -154,9 +158,11 @@ std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global);
 struct CrackSegment;
 // The same without the whole bond list (issue 15): `skeleton` is build_model_without_bonds's model
 // with every node's row length in bonds.offsets (core/bonds count_bonds) and its law; each rank
-// builds only the rows of the nodes it owns (cut-off, pre-cracks). Its piece is bitwise the one
-// decompose_over_ranks cuts from the whole model. Collective.
+// builds only the rows of the nodes it owns (cut-off, pre-cracks) and the surface correction's
+// factors of `surface_correction` on them. Its piece is bitwise the one decompose_over_ranks cuts
+// from the whole model. Collective.
 std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model& skeleton, double cutoff,
-                                                      const std::vector<CrackSegment>& cracks);
+                                                      const std::vector<CrackSegment>& cracks,
+                                                      const std::string& surface_correction);
 
 }  // namespace pd

@@ -68,6 +68,9 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
   m.grid_spacing = g.grid_spacing;
   m.damping = g.damping;
   m.material = g.material;
+  m.block_materials = g.block_materials;  // a law made on the piece reads them (LPS's moduli)
+  m.analysis = g.analysis;
+  m.thickness = g.thickness;
   m.contact = g.contact;
   m.indenters = g.indenters;
   m.density = pick(g.density, p.global);
@@ -85,7 +88,7 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
   // ascending); a ghost's row is empty.
   m.bonds.volume_weight = g.bonds.volume_weight;
   // The split correction's moduli factors, per node (the piece's LPS law copies its moduli from the
-  // whole model's anyway: LpsModel::for_piece).
+  // whole model's anyway, when there is one: LpsModel::for_piece).
   for (std::size_t l = 0; l < nl && !g.bonds.surface_moduli.empty(); ++l)
     for (std::size_t q = 0; q < 2; ++q)
       m.bonds.surface_moduli.push_back(g.bonds.surface_moduli[2 * static_cast<std::size_t>(p.global[l]) + q]);
@@ -146,7 +149,9 @@ LocalPiece make_piece(const Model& g, const std::vector<std::int32_t>& owner, in
       m.conditions.fixed[static_cast<std::size_t>(d)] = pick(g.conditions.fixed[static_cast<std::size_t>(d)], p.global);
 
   // The law for the piece (materials/bond_model.hpp for_piece): by default built again from the
-  // registry on the local model; a law whose per-node constants need whole rows copies them.
+  // registry on the local model; a law whose per-node constants need whole rows copies them from
+  // the whole model's law, or, made on a skeleton, has the owned rows' and the piece's maker fills
+  // the ghosts' (BondModel::set_decomposed).
   m.bond_model = g.bond_model->for_piece(m, p.global, material_registry().get(g.bond_model->name()).make);
   // The law's history (core/state_arrays.hpp) as the whole model holds it: per node, the local
   // nodes' entries (a ghost's are copies that the operator refreshes from their owners before each

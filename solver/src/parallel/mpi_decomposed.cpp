@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/cracks.hpp"
+#include "core/surface_correction.hpp"
 
 namespace pd {
 
@@ -29,12 +30,15 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& global)
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   row_split_ = split_rows(piece_);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
+  // The law's per-node constants of the ghosts from their owners (LPS's m_j: a ghost's row is empty).
+  piece_.model.bond_model->set_decomposed(this);
   // The Morton order served the cut only (8 bytes a node of the whole cloud); the owners stay (the
   // contact ghosts' halo asks them).
   std::vector<std::int64_t>().swap(decomposition_.order);
 }
 
-MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks)
+MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks,
+                             const std::string& surface_correction)
     : comm_(comm), decomposition_(decompose(skeleton.nodes.x, skeleton.bonds.offsets, size_of(comm), skeleton.horizon)) {
   MPI_Comm_rank(comm, &rank_);
   // The Morton order served the cut only (8 bytes a node of the whole cloud): freed before the rows
@@ -52,6 +56,13 @@ MpiDecomposed::MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff
   halo_ = std::make_unique<HaloExchange>(comm, piece_, decomposition_.owner);
   row_split_ = split_rows(piece_);
   sum_ = std::make_unique<OrderedSum>(comm, piece_);
+  // The surface correction on the owned rows, the ghosts' per-node factors from their owners
+  // (core/surface_correction.hpp), and the law made again with them, as build_model does.
+  Model& m = piece_.model;
+  apply_surface_correction(surface_correction, m, this);
+  if (m.bonds.corrected()) m.bond_model = material_registry().get(m.bond_model->name()).make(m);
+  // The law's per-node constants of the ghosts from their owners (LPS's m_j: a ghost's row is empty).
+  m.bond_model->set_decomposed(this);
   // The law's history at rest (core/state_arrays.hpp): the owned rows give the owned nodes' and
   // bonds' values (the serial values: the same rows), and the ghosts take their owners' for the
   // arrays that travel with them (a ghost's row is empty here).
@@ -173,6 +184,20 @@ void MpiDecomposed::broadcast(std::vector<double>& values) const {
   MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, 0, comm_);
 }
 
+std::vector<std::int64_t> MpiDecomposed::gather_to_all(const std::vector<std::int64_t>& values) const {
+  const double start = MPI_Wtime();
+  int mine = static_cast<int>(values.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks())), at(counts.size() + 1, 0);
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (std::size_t r = 0; r < counts.size(); ++r) at[r + 1] = at[r] + counts[r];
+  std::vector<std::int64_t> all(static_cast<std::size_t>(at.back()));
+  MPI_Allgatherv(values.data(), mine, MPI_INT64_T, all.data(), counts.data(), at.data(), MPI_INT64_T, comm_);
+  ++reductions_;
+  reduction_bytes_ += 8 * static_cast<std::int64_t>(all.size());
+  reduction_seconds_ += MPI_Wtime() - start;
+  return all;
+}
+
 std::vector<double> MpiDecomposed::per_rank(double value) const {
   std::vector<double> all(rank_ == 0 ? static_cast<std::size_t>(ranks()) : 0);
   MPI_Gather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, 0, comm_);
@@ -184,12 +209,13 @@ void MpiDecomposed::gather_broken_lines(const BondList& local, BondList& lines) 
 }
 
 std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model& skeleton, double cutoff,
-                                                      const std::vector<CrackSegment>& cracks) {
+                                                      const std::vector<CrackSegment>& cracks,
+                                                      const std::string& surface_correction) {
   int initialized = 0, ranks = 1;
   MPI_Initialized(&initialized);
   if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   if (ranks == 1) return nullptr;
-  return std::make_unique<MpiDecomposed>(MPI_COMM_WORLD, skeleton, cutoff, cracks);
+  return std::make_unique<MpiDecomposed>(MPI_COMM_WORLD, skeleton, cutoff, cracks, surface_correction);
 }
 
 std::unique_ptr<Decomposed> decompose_over_ranks(const Model& global) {

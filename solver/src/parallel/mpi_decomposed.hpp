@@ -26,9 +26,11 @@ class MpiDecomposed : public Decomposed {
   MpiDecomposed(MPI_Comm comm, const Model& global);
   // The same without the whole bond list: `skeleton` has the per-node data and, in bonds.offsets,
   // every node's row length (build_model_without_bonds, count_bonds); this rank builds the rows of
-  // its owned nodes (cut-off `cutoff`, pre-cracks `cracks`) and nothing else. The same piece, bit
-  // for bit.
-  MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks);
+  // its owned nodes (cut-off `cutoff`, pre-cracks `cracks`) and nothing else, then the surface
+  // correction's factors of `surface_correction` (core/surface_correction.hpp) on those rows. The
+  // same piece, bit for bit.
+  MpiDecomposed(MPI_Comm comm, const Model& skeleton, double cutoff, const std::vector<CrackSegment>& cracks,
+                const std::string& surface_correction);
 
   int rank() const override { return rank_; }
   int ranks() const override { return decomposition_.ranks; }
@@ -58,6 +60,7 @@ class MpiDecomposed : public Decomposed {
     return sum_->gather(per_node, width);
   }
   void broadcast(std::vector<double>& values) const override;
+  std::vector<std::int64_t> gather_to_all(const std::vector<std::int64_t>& values) const override;
   void gather_broken(const BondList& local, BondList& global) const override { sum_->gather_rows(local, global); }
   std::vector<double> gather_bond_values(const BondList& local, const std::vector<double>& per_bond, int width,
                                          const BondList& global) const override {

@@ -27,6 +27,8 @@ RankInfo world_ranks() { return RankInfo{}; }
 void abort_ranks(int code) { std::exit(code); }
 bool built_with_mpi() { return false; }
 std::unique_ptr<Decomposed> decompose_over_ranks(const Model&) { return nullptr; }
-std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model&, double, const std::vector<CrackSegment>&) { return nullptr; }
+std::unique_ptr<Decomposed> decompose_rows_over_ranks(const Model&, double, const std::vector<CrackSegment>&, const std::string&) {
+  return nullptr;
+}
 
 }  // namespace pd

@@ -88,8 +88,8 @@ void check_decomposable(const Prepared& p) {
   if (p.model.bond_model->name() != "pmb" && p.model.bond_model->name() != "lps")
     what = "blocks[].model: " + p.model.bond_model->name();
   // Decomposed: LAMMPS's α rule (the ghosts' s0 refreshed before each breaking pass), breaking_order:
-  // lammps, surface_correction (its factors computed on the whole model, copied into the pieces'
-  // rows), contact (forces/contact_on_piece, its linearised force too) with every integrator, and
+  // lammps, surface_correction (its factors computed on each piece's owned rows, the ghosts' from
+  // their owners), contact (forces/contact_on_piece, its linearised force too) with every integrator, and
   // every integrator: verlet, adaptive (its norms of eq. 2.6 are exact sums: core/exact_sum.hpp),
   // and quasi_static, implicit and mixed on their matrix-free path (their norms and CG's dot
   // products exact sums: parallel/dof_sums.hpp; linear_solver: direct is refused by the
@@ -106,14 +106,13 @@ void check_decomposable(const Prepared& p) {
 }  // namespace
 
 std::string whole_bonds_reason(const Case& c) {
-  // Each needs rows of nodes a rank does not own: the surface correction's passes and LPS's
-  // per-node constants read whole rows, and mixed's load-path check walks the whole bond graph.
-  // (The exact limit — dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the
-  // indenters' depth bound — runs on the pieces: Prepared::exact_limit.)
-  const std::string law = c.blocks.empty() ? std::string("pmb") : c.blocks[0].model;
-  if (law != "pmb") return "blocks[].model " + law;
-  if (c.surface_correction != "none") return "surface_correction " + c.surface_correction;
-  if (c.time.integrator == "mixed") return "time.integrator mixed (its load-path check)";
+  // Nothing needs rows of nodes a rank does not own any more (issue 37 item 3): the exact limit —
+  // dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the indenters' depth bound —
+  // runs its Lanczos on the pieces (Prepared::exact_limit); LPS's per-node constants and the surface
+  // correction's factors are summed over each rank's owned rows, the ghosts' taken from their owners
+  // (LpsModel::set_decomposed, core/surface_correction.hpp); mixed's load-path check joins the ranks'
+  // components (integrators/load_path.hpp). A feature that reads whole rows returns its name here.
+  (void)c;
   return "";
 }
 
@@ -212,7 +211,9 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   } else {
     p->model = build_model_without_bonds(c, std::move(nodes));
     p->model.bonds.offsets = count_bonds(p->model.nodes.x, bond_search_cutoff(c));
-    p->model.bond_model = material_registry().get("pmb").make(p->model);
+    // The case's law on the skeleton (no rows: a law precomputes nothing there, LpsModel's
+    // constructor) only names the law the pieces make on their rows (for_piece).
+    p->model.bond_model = material_registry().get(c.blocks.empty() ? std::string("pmb") : c.blocks[0].model).make(p->model);
     // The law's per-node history: each piece computes its own; the whole arrays (8 bytes a node
     // each) are where rank 0 gathers them for a checkpoint and a restart reads them back.
     declare_state(p->model, false);
@@ -230,7 +231,7 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
     check_decomposable(*p);
     const auto rows_start = Clock::now();
     p->decomposed = p->whole_bonds ? decompose_over_ranks(p->model)
-                                   : decompose_rows_over_ranks(p->model, bond_search_cutoff(c), c.cracks);
+                                   : decompose_rows_over_ranks(p->model, bond_search_cutoff(c), c.cracks, c.surface_correction);
     if (!p->whole_bonds) {
       p->build_seconds += std::chrono::duration<double>(Clock::now() - rows_start).count();
       // Eq. 2.5 is a least over nodes of their rows' sums: each rank's over its owned rows, then the
@@ -244,7 +245,6 @@ std::unique_ptr<Prepared> prepare(const RunOptions& opt) {
   p->op = std::make_unique<ForceOperator>(p->decomposed ? p->decomposed->piece().model : p->model);
   if (p->decomposed) p->op->set_decomposed(p->decomposed.get());
   p->integrator = integrator_registry().get(c.time.integrator)(*p->op);
-  if (p->decomposed) p->integrator->set_whole_model(p->model);
   // The adaptive step's default Δt_max needs the exact limit (Lanczos): computed here, at the same
   // point on every rank, on the whole model where every rank holds it (no message), else on the
   // pieces — the same bits as the serial run's configure() computes.

@@ -230,6 +230,7 @@ class WatchedDecomposed : public pd::Decomposed {
   std::vector<double> gather(const std::vector<double>& v) const override { return d_.gather(v); }
   std::vector<double> gather(const std::vector<double>& v, int width) const override { return d_.gather(v, width); }
   void broadcast(std::vector<double>& v) const override { d_.broadcast(v); }
+  std::vector<std::int64_t> gather_to_all(const std::vector<std::int64_t>& v) const override { return d_.gather_to_all(v); }
   void gather_broken(const pd::BondList& l, pd::BondList& g) const override { d_.gather_broken(l, g); }
   std::vector<double> gather_bond_values(const pd::BondList& l, const std::vector<double>& v, int w,
                                          const pd::BondList& g) const override {

@@ -122,14 +122,20 @@ class LpsModel : public BondModel {
   // ∂f_i/∂u_i per node (lps_tangent.cpp): the bond terms and the dilatation's, derived there.
   bool jacobian_diagonal_blocks(const Model& model, const Vec3Array& u, std::vector<double>& blocks,
                                 bool definite = false) const override;
-  // A decomposed run (issue 15): the piece's law takes m_i, κ, α, a, b of every local node, ghosts
-  // too, from this whole-model law (a ghost's row is empty on the piece, so its m could not be
-  // summed there), and between the sweeps fills the ghosts' P_j from their owners (one scalar per
-  // ghost: the force sweep's t_ij + t_ji needs P of both ends).
+  // A decomposed run (issue 15): the piece's law. Made from the whole model's law (every rank
+  // holds the whole list: run/prepare whole_bonds_reason), it takes m_i, κ, α, a, b of every local
+  // node, ghosts too, from it — the constants as that law was made (a test may break bonds after).
+  // From a skeleton's law (no rows, no constants), it is made on the piece: its owned rows give the
+  // owned nodes' constants, and set_decomposed the ghosts'.
   std::shared_ptr<const BondModel> for_piece(const Model& local, const std::vector<std::int32_t>& global,
                                              std::shared_ptr<const BondModel> (*registry_make)(const Model&)) const override;
-  void set_decomposed(const Decomposed* d) const override { decomposed_ = d; }
-
+  // Between the sweeps the law fills the ghosts' P_j from their owners through d (one scalar per
+  // ghost: the force sweep's t_ij + t_ji needs P of both ends). On a piece made on its own rows a
+  // ghost's row is empty, so its m_j could not be summed there: the first call with d also takes
+  // the ghosts' m, κ, α, a, b from their owners, in one exchange — each owner summed its own row in
+  // the serial order, so these are the serial bits. Collective; the piece's maker calls it before
+  // any sweep (parallel/mpi_decomposed), the operator again (no exchange then).
+  void set_decomposed(const Decomposed* d) const override;
   // The dilatation θ_i at u over the intact bonds (for tests and output).
   std::vector<double> dilatation(const Model& model, const Vec3Array& u) const override;
   const std::vector<double>& weighted_volume() const { return m_; }
@@ -138,14 +144,16 @@ class LpsModel : public BondModel {
   int d_ = 3;                  // 3, or 2 in the plane analyses
   Influence influence_ = Influence::one;
   double horizon_ = 0.0;
-  std::vector<double> m_;      // m_i
-  std::vector<double> kappa_;  // κ of i's block
-  std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
-  std::vector<double> a_;      // α_i / m_i
-  std::vector<double> b_;      // d κ_i / m_i
+  // Per node. Mutable for set_decomposed only, which fills a piece's ghosts' entries once.
+  mutable std::vector<double> m_;      // m_i
+  mutable std::vector<double> kappa_;  // κ of i's block
+  mutable std::vector<double> alpha_;  // α of i's block (15μ in 3D, 8μ in 2D)
+  mutable std::vector<double> a_;      // α_i / m_i
+  mutable std::vector<double> b_;      // d κ_i / m_i
   std::vector<double> kappa0_, mu0_;  // κ, μ of i's block, uncorrected (continuum_energy_density)
   // Set once by the operator of a decomposed run (set_decomposed), before any sweep; null: serial.
   mutable const Decomposed* decomposed_ = nullptr;
+  mutable bool ghost_constants_ = false;  // set_decomposed has filled the ghosts' m, κ, α, a, b
 
   friend struct LpsKernel;
 };

@@ -4,6 +4,7 @@
 
 #include "core/model.hpp"
 #include "materials/lps/lps.hpp"
+#include "parallel/decomposed.hpp"
 
 namespace pd {
 
@@ -18,6 +19,12 @@ LpsModel::LpsModel(const Model& model) {
     per_block.push_back(lps_moduli(b.parameter("youngs_modulus").value_or(0.0),
                                    b.parameter("poisson_ratio").value_or(0.0), model.analysis));
   const double alpha_factor = d_ == 3 ? 15.0 : 8.0;  // α = 15μ (3D), 8μ (2D): lps.hpp
+  // A decomposed run's skeleton (run/prepare.cpp: per-node data and each row's length, but no rows,
+  // which the ranks build on their pieces) gets no per-node constants: only the law's name and
+  // for_piece are asked of it there.
+  if (model.bonds.neighbour.size() != static_cast<std::size_t>(model.bonds.offsets.empty() ? 0 : model.bonds.offsets.back())) {
+    return;
+  }
   m_.assign(n, 0.0);
   kappa_.assign(n, 0.0);
   alpha_.assign(n, 0.0);
@@ -65,23 +72,36 @@ LpsModel::LpsModel(const Model& model) {
   }
 }
 
-std::shared_ptr<const BondModel> LpsModel::for_piece(const Model&, const std::vector<std::int32_t>& global,
-                                                     std::shared_ptr<const BondModel> (*)(const Model&)) const {
-  auto local = std::make_shared<LpsModel>(*this);
+std::shared_ptr<const BondModel> LpsModel::for_piece(const Model& local, const std::vector<std::int32_t>& global,
+                                                     std::shared_ptr<const BondModel> (*registry_make)(const Model&)) const {
+  // A skeleton's law (no constants): the piece's own rows give its owned nodes' (ghosts: set_decomposed).
+  if (m_.empty()) return registry_make(local);
+  auto piece = std::make_shared<LpsModel>(*this);
   const auto pick = [&](const std::vector<double>& a) {
     std::vector<double> out(global.size());
     for (std::size_t l = 0; l < global.size(); ++l) out[l] = a[static_cast<std::size_t>(global[l])];
     return out;
   };
-  local->m_ = pick(m_);
-  local->kappa_ = pick(kappa_);
-  local->alpha_ = pick(alpha_);
-  local->a_ = pick(a_);
-  local->b_ = pick(b_);
-  local->kappa0_ = pick(kappa0_);
-  local->mu0_ = pick(mu0_);
-  local->decomposed_ = nullptr;
-  return local;
+  piece->m_ = pick(m_);
+  piece->kappa_ = pick(kappa_);
+  piece->alpha_ = pick(alpha_);
+  piece->a_ = pick(a_);
+  piece->b_ = pick(b_);
+  piece->kappa0_ = pick(kappa0_);
+  piece->mu0_ = pick(mu0_);
+  piece->decomposed_ = nullptr;
+  piece->ghost_constants_ = true;  // the ghosts' too, from the whole model
+  return piece;
+}
+
+void LpsModel::set_decomposed(const Decomposed* d) const {
+  if (d && !ghost_constants_) {
+    NodeColumns constants;
+    constants.add(m_).add(kappa_).add(alpha_).add(a_).add(b_);
+    d->update_ghosts(constants);
+    ghost_constants_ = true;
+  }
+  decomposed_ = d;
 }
 
 std::vector<double> LpsModel::damage(const Model& m) const { return bond_damage(m); }  // as PMB's
