@@ -106,14 +106,21 @@ void check_decomposable(const Prepared& p) {
 }  // namespace
 
 std::string whole_bonds_reason(const Case& c) {
-  // Nothing needs rows of nodes a rank does not own any more (issue 37 item 3): the exact limit —
-  // dt: exact, a step above eq. 2.5, the adaptive step's default Δt_max, the indenters' depth bound —
-  // runs its Lanczos on the pieces (Prepared::exact_limit); LPS's per-node constants and the surface
-  // correction's factors are summed over each rank's owned rows, the ghosts' taken from their owners
-  // (LpsModel::set_decomposed, core/surface_correction.hpp); mixed's load-path check joins the ranks'
-  // components (integrators/load_path.hpp). A feature that reads whole rows returns its name here.
-  (void)c;
-  return "";
+  // Each rank holds only its own rows (issue 37 item 3): the exact limit — dt: exact, a step above
+  // eq. 2.5, the adaptive step's default Δt_max, the indenters' depth bound — runs its Lanczos on the
+  // pieces (Prepared::exact_limit); LPS's per-node constants and the surface correction's factors are
+  // summed over each rank's owned rows, the ghosts' taken from their owners (LpsModel::set_decomposed,
+  // core/surface_correction.hpp); mixed's load-path check joins the ranks' components
+  // (integrators/load_path.hpp). One exception: LPS's Lanczos on a piece would need its second
+  // sweep's partner values exchanged inside each product (core/stability.cpp refuses it), so LPS with
+  // the exact limit keeps the whole list.
+  const std::string law = c.blocks.empty() ? std::string("pmb") : c.blocks[0].model;
+  if (law == "pmb") return "";
+  std::string needs;
+  if (c.time.dt_rule != "stable" || c.time.safety_factor > 1.0) needs = "time.dt " + c.time.dt_rule;
+  else if (c.time.integrator == "adaptive" && !c.adaptive.dt_max) needs = "adaptive without dt_max";
+  else if (!c.indenters.empty()) needs = "indenters";
+  return needs.empty() ? "" : "blocks[].model " + law + " with " + needs + " (the exact limit)";
 }
 
 double Prepared::exact_limit() {

@@ -87,7 +87,7 @@ TEST(DecomposedStabilityRows, PiecesBuiltFromTheirOwnRowsGiveTheSerialLimitBitwi
   pd::Model skeleton = pd::build_model_without_bonds(c, nodes);
   skeleton.bonds.offsets = pd::count_bonds(skeleton.nodes.x, pd::bond_search_cutoff(c));
   skeleton.bond_model = pd::material_registry().get("pmb").make(skeleton);
-  pd::MpiDecomposed dec(MPI_COMM_WORLD, skeleton, pd::bond_search_cutoff(c), c.cracks);
+  pd::MpiDecomposed dec(MPI_COMM_WORLD, skeleton, pd::bond_search_cutoff(c), c.cracks, c.surface_correction);
   const double dt = pd::exact_time_step(dec.piece().model, &dec);
   EXPECT_TRUE(same_bits(dt, serial_dt)) << dt << " vs " << serial_dt;
 }
