@@ -342,6 +342,9 @@ TEST(CaseFile, OutputDirMustStayInsideTheRunFolder) {
     std::string text = kCase;
     text.replace(text.find(dot), dot.size(), "\"output_dir\": \"" + inside + "\"");
     EXPECT_EQ(pd::parse_case(text, "out/x/case.json").output_dir, fs::path("out/x") / inside) << inside;
+    // `pdsolve case.json` in the run folder itself (no directory in the path): refused before, the
+    // folder not made yet compared as outside it.
+    EXPECT_EQ(pd::parse_case(text, "case.json").output_dir, fs::path(inside)) << inside;
   }
 
   // A symbolic link in it is followed: out of the run folder it is refused, inside it is taken.

@@ -423,8 +423,11 @@ std::filesystem::path confined_output_dir(const Checker& ck, const std::filesyst
   if (!normal.empty() && *normal.begin() == "..")
     ck.fail("output_dir", "'" + text + "' leaves the run folder (the directory of case.json)" + advice);
   std::error_code folder_error, target_error;
-  const fs::path folder = fs::weakly_canonical(dir.empty() ? fs::path(".") : dir, folder_error);
-  const fs::path target = fs::weakly_canonical(dir / normal, target_error);
+  // "case.json" in the working folder has an empty dir: both sides start from "." then, or the
+  // target of a folder not made yet stays relative ("out") and compares as outside ("/run/out").
+  const fs::path base = dir.empty() ? fs::path(".") : dir;
+  const fs::path folder = fs::weakly_canonical(base, folder_error);
+  const fs::path target = fs::weakly_canonical(base / normal, target_error);
   // Not checkable (a folder that cannot be searched): writing there fails later with its own message.
   if (!folder_error && !target_error) {
     const fs::path inside = target.lexically_relative(folder);
