@@ -33,7 +33,7 @@ int run_with_output(const RunOptions& opt, Prepared& p, Start& s, const HistoryC
     // enters once this is done.)
     if (!s.restarting && out) {
       std::filesystem::remove(checkpoint_path(p.c));
-      std::filesystem::remove_all(checkpoint_pieces_dir(checkpoint_path(p.c)));
+      remove_unnamed_checkpoint_pieces(checkpoint_path(p.c), nullptr);
     }
     log = std::make_unique<RunLog>(out ? p.c.output_dir / "run.log" : std::filesystem::path(), opt.quiet,
                                    s.restarting);

@@ -291,6 +291,25 @@ TEST(Checkpoint, RestartTimeEveryTimeWritesCheckpoints) {
   fs::remove_all(dir);
 }
 
+// The index's writer deletes the pieces no index names (an earlier checkpoint's), and only those:
+// a file of the user's in checkpoint.pieces/ stays.
+TEST(Checkpoint, OnlyPiecesNoIndexNamesAreDeleted) {
+  const fs::path dir = temp_dir("stray_pieces");
+  write_case(dir, "verlet", false, R"(, "restart_every_time": 1.5e-6)");
+  const fs::path pieces = dir / "out" / "checkpoint.pieces";
+  fs::create_directories(pieces);
+  std::ofstream(pieces / "notes.txt") << "mine";
+  std::ofstream(pieces / "s999.p7.bin") << "an old piece";
+  ASSERT_EQ(run(dir / "case.json"), pd::kOk);
+  const pd::Checkpoint ck = pd::read_checkpoint(dir / "out" / "checkpoint.bin");
+  EXPECT_TRUE(fs::exists(pieces / "notes.txt"));
+  EXPECT_FALSE(fs::exists(pieces / "s999.p7.bin"));
+  std::size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(pieces)) files += entry.is_regular_file() ? 1 : 0;
+  EXPECT_EQ(files, ck.pieces.size() + 1);  // the last checkpoint's pieces and the user's file
+  fs::remove_all(dir);
+}
+
 // output.restart_every_wall (issue 36, item 8): checkpoints by wall time, on by default, so that a
 // run killed with SIGKILL has one. They are written between steps and change no bit of the frames
 // and history rows; the last one before a run was cut off continues it bitwise. Each step here

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string_view>
 #include <iterator>
+#include <regex>
 #include <type_traits>
 
 #include "core/error.hpp"
@@ -292,14 +293,22 @@ void write_checkpoint_index(const std::filesystem::path& path, const Checkpoint&
   Writer payload;
   fields(payload, const_cast<Checkpoint&>(index));  // the writer only reads (see fields)
   write_file_atomically(path, framed(payload.bytes()), Durability::synced);
-  // The pieces of earlier checkpoints: no index names them now.
+  remove_unnamed_checkpoint_pieces(path, &index);  // earlier checkpoints' pieces
+}
+
+void remove_unnamed_checkpoint_pieces(const std::filesystem::path& index, const Checkpoint* named_by) {
+  static const std::regex piece_name(R"(s[0-9]+\.p[0-9]+\.bin)");
+  const std::filesystem::path folder = checkpoint_pieces_dir(index);
   std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(checkpoint_pieces_dir(path), ec)) {
-    const std::string name = std::string(kPiecesFolder) + "/" + entry.path().filename().string();
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    const std::string file = entry.path().filename().string();
+    if (entry.is_symlink(ec) || !entry.is_regular_file(ec) || !std::regex_match(file, piece_name)) continue;
+    const std::string name = std::string(kPiecesFolder) + "/" + file;
     bool named = false;
-    for (const CheckpointPieceRef& p : index.pieces) named = named || p.file == name;
+    for (std::size_t k = 0; named_by && k < named_by->pieces.size(); ++k) named = named || named_by->pieces[k].file == name;
     if (!named) std::filesystem::remove(entry.path(), ec);
   }
+  std::filesystem::remove(folder, ec);  // only if empty: fails quietly otherwise
 }
 
 void read_checkpoint_piece(const std::filesystem::path& index_path, const Checkpoint& index, std::size_t piece,

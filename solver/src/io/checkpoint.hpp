@@ -101,6 +101,10 @@ struct Checkpoint {
 // step so that writing a new checkpoint never touches the pieces the current index names.
 std::filesystem::path checkpoint_pieces_dir(const std::filesystem::path& index);
 std::string checkpoint_piece_name(std::int64_t step, int rank);
+// Deletes the pieces in checkpoint_pieces_dir(index) that `index` does not name (all of them when
+// null: a fresh run), then the folder if nothing else is in it. Only regular files named as
+// checkpoint_piece_name names them go: anything else there is not the solver's to delete.
+void remove_unnamed_checkpoint_pieces(const std::filesystem::path& index, const Checkpoint* named_by);
 // checkpoint.pieces/<checkpoint_piece_name>: the piece's file relative to the index's folder.
 std::string checkpoint_piece_file(std::int64_t step, int rank);
 
